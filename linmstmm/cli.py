@@ -1,0 +1,110 @@
+"""The ``linmstmm`` command line (contract: ``shared/spec/cli.md``).
+
+Exit status: 0 done; 1 the computation itself failed (clear message);
+2 bad model file, bad option or impossible request (one line on stderr,
+naming file, element and key; no traceback).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from linmstmm.model import ModelError, load_model
+
+
+class UsageError(Exception):
+    """A bad option or an impossible request (exit status 2)."""
+
+
+class ComputationError(Exception):
+    """The computation could not deliver what was asked (exit status 1)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports a bad option as one line instead of usage + exit."""
+
+    def error(self, message):
+        raise UsageError(f"{self.prog}: {message}")
+
+
+def _positive_int(text):
+    value = int(text)
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive integer, got {text}")
+    return value
+
+
+def _positive_float(text):
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be positive, got {text}")
+    return value
+
+
+def _add_request_options(parser):
+    parser.add_argument("model", help="model file (TOML, see model-format.md)")
+    parser.add_argument("--count", type=_positive_int, default=None,
+                        help="the lowest N elastic frequencies (default 10 unless --fmax)")
+    parser.add_argument("--fmax", type=_positive_float, default=None,
+                        help="all elastic frequencies up to HZ")
+    parser.add_argument("--json", action="store_true", help="one JSON object on stdout")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="linmstmm", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    freqs = sub.add_parser("freqs", help="natural frequencies by the transfer matrix method")
+    _add_request_options(freqs)
+    freqs.add_argument("--digits", type=_positive_int, default=None,
+                       help="significant digits wanted (above 14 the mpmath path is used)")
+    freqs.add_argument("--root", default=None, help="boundary point to use as the root")
+    freqs.set_defaults(run=_run_freqs)
+    return parser
+
+
+def _request(args):
+    """(count, fmax) as the solver wants them: --count defaults to 10 without --fmax."""
+    count = args.count
+    if count is None and args.fmax is None:
+        count = 10
+    return count, args.fmax
+
+
+def _print_frequency_table(title, result):
+    print(f"{title}")
+    print(f"  rigid-body modes: {result['rigid_body_modes']}")
+    if "ubar_order" in result:
+        print(f"  order of Ubar_all: {result['ubar_order']}")
+    print(f"  {'mode':>4}  {'f [Hz]':>20}  {'omega [rad/s]':>20}")
+    for index, f in enumerate(result["frequencies_hz"], start=1):
+        print(f"  {index:>4}  {f:>20.12g}  {2 * 3.141592653589793 * f:>20.12g}")
+    print(f"  solve time: {result['seconds'] * 1e3:.2f} ms")
+
+
+def _run_freqs(args):
+    from linmstmm.solve import natural_frequencies
+
+    model = load_model(args.model)
+    count, fmax = _request(args)
+    result = natural_frequencies(model, count=count, fmax=fmax, digits=args.digits, root=args.root)
+    data = result.to_dict()
+    if args.json:
+        print(json.dumps(data))
+    else:
+        _print_frequency_table(f"{model.name}: natural frequencies (MSTMM)", data)
+    return 0
+
+
+def main(argv=None) -> int:
+    """Run the command line; return the exit status."""
+    try:
+        args = build_parser().parse_args(argv)
+        return args.run(args)
+    except (ModelError, UsageError) as error:
+        print(f"linmstmm: error: {error}", file=sys.stderr)
+        return 2
+    except ComputationError as error:
+        print(f"linmstmm: computation failed: {error}", file=sys.stderr)
+        return 1

@@ -1,0 +1,36 @@
+"""Geometric helpers shared by the element modules.
+
+State index blocks: ``U`` displacement 0:3, ``R`` rotation 3:6, ``M`` moment
+6:9, ``Q`` force 9:12.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+U, R, M, Q = slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12)
+
+#: Index of the internal force/moment paired (by work) with displacement
+#: component 0..5 (x, y, z, rx, ry, rz): X-Qx, ..., Θz-Mz.
+FORCE_INDEX = np.array([9, 10, 11, 6, 7, 8])
+
+#: Energy pairing of the state: Zᵀ J Z' = d·f' − f·d' with d = (u, θ) paired
+#: with f = (q, m). A conservative element's transfer matrix keeps it:
+#: Uᵀ J U = J.
+SYMPLECTIC_FORM = np.zeros((12, 12))
+SYMPLECTIC_FORM[np.arange(6), FORCE_INDEX] = 1.0
+SYMPLECTIC_FORM[FORCE_INDEX, np.arange(6)] = -1.0
+
+
+def skew(r) -> np.ndarray:
+    """(3, 3) cross-product matrix: ``skew(r) @ v == np.cross(r, v)``."""
+    x, y, z = np.asarray(r, dtype=float)
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+
+
+def state_rotation(axes) -> np.ndarray:
+    """(12, 12) map from local to inertial state components.
+
+    ``axes`` rows are the local x, y, z unit vectors in the inertial frame, so
+    a local vector v maps to ``axes.T @ v`` in the inertial frame.
+    """
+    return np.kron(np.eye(4), np.asarray(axes, dtype=float).T)

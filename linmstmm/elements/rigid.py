@@ -1,0 +1,60 @@
+"""Rigid body: transfer matrix between two ports, and the pieces of the
+multi-input body (seed 003, eqs 3-4).
+
+Newton-Euler about the mass centre c, harmonic at ω (inertia force
+m ω² u_c, inertia moment ω² J_c θ), with the sign convention of the package
+(the force at the input is applied to the body, the force at the output is
+what the body applies downstream):
+
+    u_O = u_I + θ × (O − I),           θ_O = θ_I,
+    q_O = q_I + ω² m u_c,              u_c = u_I + θ × (c − I),
+    m_O = m_I + (I − c) × q_I − (O − c) × q_O + ω² J_c θ.
+
+A body with inputs I_1..I_L and output O:
+``Z_O = U_j Z_I1 + Σ_k U_{j,Ik} Z_Ik`` and ``H_j Z_I1 = H_{j,Ik} Z_Ik``.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from linmstmm.elements.frames import M, Q, R, U, skew
+
+
+def rigid_transfer(mass, com, inertia, inp, out, omega) -> np.ndarray:
+    """Transfer matrix stack (n, 12, 12) from port ``inp`` to port ``out``.
+
+    mass : kg. com, inp, out : (3,) positions, m. inertia : (3, 3) about the
+    mass centre, kg m². omega : (n,) rad/s.
+    """
+    omega2 = np.asarray(omega, dtype=float).reshape(-1, 1, 1) ** 2
+    inp, out, com = (np.asarray(p, dtype=float) for p in (inp, out, com))
+    kinematic = np.eye(12)  # the ω-independent part
+    kinematic[U, R] = -skew(out - inp)
+    kinematic[M, Q] = skew(inp - out)
+    inertial = np.zeros((12, 12))  # the part proportional to ω²
+    com_from_input = np.hstack([np.eye(3), -skew(com - inp)])  # u_c = this @ (u_I, θ_I)
+    inertial[Q, 0:6] = mass * com_from_input
+    inertial[M, 0:6] = -skew(out - com) @ (mass * com_from_input)
+    inertial[M, R] += np.asarray(inertia, dtype=float)
+    return kinematic + omega2 * inertial
+
+
+def force_extraction(inp_k, out) -> np.ndarray:
+    """(12, 12) U_{j,Ik}: carries the force and moment of input k to the output."""
+    extraction = np.zeros((12, 12))
+    extraction[M, M] = np.eye(3)
+    extraction[Q, Q] = np.eye(3)
+    extraction[M, Q] = skew(np.asarray(inp_k, float) - np.asarray(out, float))
+    return extraction
+
+
+def position_extraction() -> np.ndarray:
+    """(6, 12) H_j: the displacement and rotation of a state vector."""
+    return np.eye(6, 12)
+
+
+def position_incidence(inp_1, inp_k) -> np.ndarray:
+    """(6, 12) H_{j,Ik} with ``H_j Z_I1 = H_{j,Ik} Z_Ik`` (rigid kinematics)."""
+    incidence = np.eye(6, 12)
+    incidence[U, R] = skew(np.asarray(inp_k, float) - np.asarray(inp_1, float))
+    return incidence

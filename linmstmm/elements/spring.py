@@ -1,0 +1,36 @@
+"""Elastic hinge: massless, zero length, six stiffnesses in its own axes.
+
+Forces pass through unchanged; the displacement jumps by the compliance times
+the internal force (the spring pulls its downstream end back):
+``u_O = u_I - C_t q``, ``θ_O = θ_I - C_r m``. ``inf`` stiffness = zero
+compliance = rigid direction. The matrix does not depend on which end is
+the input (the spring is symmetric).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from linmstmm.elements.frames import M, Q, R, U
+
+
+def spring_compliance(k, axes) -> tuple[np.ndarray, np.ndarray]:
+    """Translational and rotational compliance in the inertial frame.
+
+    k : (6,) N/m and N m/rad, ``inf`` allowed. axes : (3, 3) rows = local axes.
+    Returns (C_t, C_r), each (3, 3), m/N and rad/(N m).
+    """
+    k = np.asarray(k, dtype=float)
+    axes = np.asarray(axes, dtype=float)
+    compliance = 1.0 / k  # inf -> 0: rigid direction
+    C_t = axes.T @ np.diag(compliance[:3]) @ axes
+    C_r = axes.T @ np.diag(compliance[3:]) @ axes
+    return C_t, C_r
+
+
+def spring_transfer(k, axes, omega) -> np.ndarray:
+    """Transfer matrix stack (n, 12, 12) of a spring; constant in omega."""
+    C_t, C_r = spring_compliance(k, axes)
+    U_single = np.eye(12)
+    U_single[U, Q] = -C_t
+    U_single[R, M] = -C_r
+    return np.broadcast_to(U_single, (np.size(omega), 12, 12)).copy()

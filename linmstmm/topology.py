@@ -1,0 +1,232 @@
+"""Topology of a model for the automatic deduction theorem.
+
+From the model records this module finds the transfer elements (every
+element, plus one massless rigid *junction* body at each point where three or
+more element ends meet, or two ends and a boundary condition), the boundary
+ends (points with one element end, and the free far side of every one-port
+rigid body), picks the root boundary, directs transfer from the tips to the
+root along a spanning tree, picks each multi-input body's first input, and
+cuts every closed loop. A cut makes two new boundary ends whose states are
+tied by a supplement equation: equal displacements, opposite forces.
+
+A model with no boundary end at all (a free ring) is closed at one
+connection point instead: that point's state leaves the last element as the
+root state and enters the first as a tip state, and the two are equal.
+"""
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from linmstmm.model import Model, ModelError
+
+
+@dataclass(frozen=True)
+class Boundary:
+    """A boundary end: where a transfer element meets the ground or nothing.
+
+    label : name shown to users (point name, ``"<rigid> free end"``, ...).
+    position : (3,) m. fixed : (6,) bool, fixed displacement components.
+    """
+
+    label: str
+    position: np.ndarray
+    fixed: np.ndarray
+
+
+@dataclass
+class Port:
+    """One end of a transfer element.
+
+    point : point name. position : (3,) m.
+    link : ``("element", e, p)`` to port p of element e, ``("boundary", b)``,
+    or ``("cut", c, side)`` after loop cutting (side 0 or 1 of cut c).
+    """
+
+    point: str
+    position: np.ndarray
+    link: tuple = ()
+
+
+@dataclass
+class TransferElement:
+    """An element in the transfer graph (a model element or a junction).
+
+    record : the model record (``None`` for a junction). output : index of the
+    port towards the root; inputs : the other ports, first input first.
+    """
+
+    name: str
+    kind: str
+    record: object
+    ports: list[Port]
+    output: int = -1
+    inputs: list[int] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Cut:
+    """A cut connection point: two new tips, ``Z_side1 = C Z_side0``.
+
+    ends : ((element, port), (element, port)). closing : True for the cut of a
+    boundary-less model, where side 0 is the root and ``C = I``.
+    """
+
+    point: str
+    ends: tuple
+    closing: bool = False
+
+
+@dataclass
+class Topology:
+    """Directed spanning tree of transfer elements, tips to root.
+
+    order : element indices, every element after all elements upstream of it.
+    root : ``("boundary", b)`` or ``("cut", c)`` for a closing cut.
+    """
+
+    elements: list[TransferElement]
+    boundaries: list[Boundary]
+    cuts: list[Cut]
+    root: tuple
+    order: list[int]
+
+    @property
+    def root_label(self) -> str:
+        kind, index = self.root
+        return self.boundaries[index].label if kind == "boundary" else self.cuts[index].point
+
+
+def _model_elements(model: Model) -> list[TransferElement]:
+    """Transfer elements for the model's own elements, with their ports."""
+    elements = []
+    for rigid in model.rigids:
+        ports = [Port(p, model.points[p]) for p in rigid.ports]
+        if len(ports) == 1:  # a tip body: its far side is a free boundary end
+            ports.append(Port(f"{rigid.name} free end", model.points[rigid.ports[0]],
+                              ("free-end",)))
+        elements.append(TransferElement(rigid.name, "rigid", rigid, ports))
+    for element in model.beams + model.springs:
+        ports = [Port(p, model.points[p]) for p in element.ends]
+        elements.append(TransferElement(element.name, element.kind, element, ports))
+    return elements
+
+
+def _link_points(model: Model, elements: list[TransferElement]) -> list[Boundary]:
+    """Connect ports at shared points, add junctions, return the boundary ends."""
+    at_point: dict[str, list[tuple[int, int]]] = {p: [] for p in model.points}
+    boundaries: list[Boundary] = []
+    for e, element in enumerate(elements):
+        for p, port in enumerate(element.ports):
+            if port.link == ("free-end",):
+                port.link = ("boundary", len(boundaries))
+                boundaries.append(Boundary(port.point, port.position, np.zeros(6, dtype=bool)))
+            else:
+                at_point[port.point].append((e, p))
+    for point, ends in at_point.items():
+        fixed = model.fixed_mask(point)
+        if len(ends) == 1:
+            e, p = ends[0]
+            elements[e].ports[p].link = ("boundary", len(boundaries))
+            boundaries.append(Boundary(point, model.points[point], fixed))
+        elif len(ends) == 2 and not fixed.any():
+            (e, p), (f, q) = ends
+            elements[e].ports[p].link = ("element", f, q)
+            elements[f].ports[q].link = ("element", e, p)
+        elif ends:
+            junction = TransferElement(f"junction {point}", "junction", None, [])
+            j = len(elements)
+            elements.append(junction)
+            for e, p in ends:
+                elements[e].ports[p].link = ("element", j, len(junction.ports))
+                junction.ports.append(Port(point, model.points[point], ("element", e, p)))
+            if fixed.any():
+                junction.ports.append(Port(point, model.points[point], ("boundary", len(boundaries))))
+                boundaries.append(Boundary(point, model.points[point], fixed))
+    return boundaries
+
+
+def _choose_root(model, elements, boundaries, root_point):
+    """The root boundary index: ``root_point`` if given, else the most constrained end."""
+    if root_point is not None:
+        for b, boundary in enumerate(boundaries):
+            if boundary.label == root_point:
+                return b
+        names = ", ".join(repr(b.label) for b in boundaries) or "none"
+        raise ModelError(model.source or model.name, f"'{root_point}' is not a boundary end "
+                         f"(boundary ends: {names})", key="--root")
+    if not boundaries:
+        return None
+    return max(range(len(boundaries)), key=lambda b: (boundaries[b].fixed.sum(), -b))
+
+
+def _find_port(elements, link):
+    for e, element in enumerate(elements):
+        for p, port in enumerate(element.ports):
+            if port.link == link:
+                return e, p
+    raise AssertionError(f"no port has link {link}")
+
+
+def _grow_tree(elements, start, cuts):
+    """Breadth-first spanning tree from element ``start`` (its output already set).
+
+    Sets every reached element's output and inputs, turns every non-tree
+    connection into a cut. Returns the visiting order (root element first).
+    """
+    visited = {start}
+    order = []
+    queue = deque([start])
+    while queue:
+        e = queue.popleft()
+        order.append(e)
+        element = elements[e]
+        element.inputs = [p for p in range(len(element.ports)) if p != element.output]
+        for p in element.inputs:
+            link = element.ports[p].link
+            if link[0] != "element":
+                continue
+            _, f, q = link
+            if f in visited:  # a second path to f: close the loop by a cut here
+                c = len(cuts)
+                cuts.append(Cut(element.ports[p].point, ((e, p), (f, q))))
+                element.ports[p].link = ("cut", c, 0)
+                elements[f].ports[q].link = ("cut", c, 1)
+            else:
+                visited.add(f)
+                elements[f].output = q
+                queue.append(f)
+    return order
+
+
+def build_topology(model: Model, root: str | None = None) -> Topology:
+    """Deduce the directed transfer structure of ``model``.
+
+    root : boundary end label (point name) to use as the root; default: the
+    end with the most fixed components, first in file order among equals.
+    """
+    elements = _model_elements(model)
+    boundaries = _link_points(model, elements)
+    cuts: list[Cut] = []
+    b = _choose_root(model, elements, boundaries, root)
+    if b is not None:
+        start, port = _find_port(elements, ("boundary", b))
+        root_link = ("boundary", b)
+    else:  # no boundary at all: close the structure at its first connection
+        start, port = next((e, p) for e, el in enumerate(elements)
+                           for p, pt in enumerate(el.ports) if pt.link[0] == "element")
+        _, f, q = elements[start].ports[port].link
+        cuts.append(Cut(elements[start].ports[port].point, ((start, port), (f, q)), closing=True))
+        elements[start].ports[port].link = ("cut", 0, 0)
+        elements[f].ports[q].link = ("cut", 0, 1)
+        root_link = ("cut", 0)
+    elements[start].output = port
+    order = _grow_tree(elements, start, cuts)
+    unreached = [el.name for e, el in enumerate(elements) if e not in set(order)]
+    if unreached:
+        raise ModelError(model.source or model.name,
+                         f"the model is not connected: {', '.join(unreached)} "
+                         f"cannot be reached from {elements[start].name}")
+    return Topology(elements, boundaries, cuts, root_link, order[::-1])

@@ -105,6 +105,6 @@ def main(argv=None) -> int:
     except (ModelError, UsageError) as error:
         print(f"linmstmm: error: {error}", file=sys.stderr)
         return 2
-    except ComputationError as error:
+    except (ComputationError, RuntimeError) as error:
         print(f"linmstmm: computation failed: {error}", file=sys.stderr)
         return 1

@@ -8,7 +8,7 @@ import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.model import Model
-from linmstmm.roots import RootFinder
+from linmstmm.roots import OMEGA_CEILING, DeflatedSystem, RootFinder
 from linmstmm.topology import build_topology
 
 
@@ -27,6 +27,7 @@ class FrequencyResult:
     ubar_order: int
     seconds: float
     precision: str = "float64"
+    note: str = ""
 
     def to_dict(self) -> dict:
         """The ``linmstmm freqs --json`` object (``shared/spec/cli.md``)."""
@@ -38,6 +39,7 @@ class FrequencyResult:
             "seconds": float(self.seconds),
             "precision": self.precision,
             "method": "mstmm",
+            **({"note": self.note} if self.note else {}),
         }
 
 
@@ -50,12 +52,13 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     """
     start = time.perf_counter()
     deduction = Deduction(build_topology(model, root=root))
-    finder = RootFinder(deduction.log_det, deduction.matrix)
+    system = DeflatedSystem(deduction.matrix)
+    finder = RootFinder(system.log_det, system.matrix)
     rigid = finder.rigid_body_modes()
     omega_max = None if fmax is None else 2 * np.pi * fmax
-    roots = finder.find(count, omega_max)
-    omegas = np.repeat([r.omega for r in roots], [r.multiplicity for r in roots])
-    if count is not None:
-        omegas = omegas[:count]
+    omegas = np.array(finder.find(count, omega_max))
+    note = ""
+    if count is not None and omegas.size < count and fmax is None:
+        note = f"only {omegas.size} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s"
     return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.order,
-                           time.perf_counter() - start)
+                           time.perf_counter() - start, note=note)

@@ -1,0 +1,54 @@
+"""The ``linmstmm`` command line against its contract (shared/spec/cli.md)."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run(*args):
+    return subprocess.run([sys.executable, "-m", "linmstmm", *args], cwd=ROOT,
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_freqs_json_follows_the_contract():
+    result = run("freqs", "models/spring_mass_chain.toml", "--json", "--count", "4")
+    assert result.returncode == 0, result.stderr
+    data = json.loads(result.stdout)
+    assert data["model"] == "spring-mass chain"
+    assert data["rigid_body_modes"] == 0 and data["ubar_order"] == 12
+    assert isinstance(data["seconds"], float) and data["seconds"] > 0
+    omega2 = np.array([(4 - np.sqrt(7)) / 3, (4 + np.sqrt(7)) / 3]) * 1000.0 / 2.0
+    expected = np.repeat(np.sqrt(omega2) / (2 * np.pi), 3)[:4]
+    np.testing.assert_allclose(data["frequencies_hz"], expected, rtol=1e-12)
+
+
+def test_freqs_fmax_and_count_stop_at_whichever_comes_first():
+    by_fmax = json.loads(run("freqs", "models/cantilever_tip_mass.toml", "--json", "--fmax", "100").stdout)
+    assert by_fmax["frequencies_hz"] == sorted(by_fmax["frequencies_hz"])
+    assert len(by_fmax["frequencies_hz"]) == 4 and max(by_fmax["frequencies_hz"]) <= 100
+    both = json.loads(run("freqs", "models/cantilever_tip_mass.toml", "--json", "--fmax", "100",
+                          "--count", "3").stdout)
+    assert both["frequencies_hz"] == by_fmax["frequencies_hz"][:3]
+
+
+def test_freqs_table_is_readable():
+    result = run("freqs", "models/cantilever_tip_mass.toml", "--count", "2")
+    assert result.returncode == 0
+    assert "cantilever with tip mass" in result.stdout and "6.7535" in result.stdout
+
+
+@pytest.mark.parametrize("args", [("freqs", "models/cantilever_tip_mass.toml", "--count", "0"),
+                                  ("freqs", "models/cantilever_tip_mass.toml", "--fmax", "-3"),
+                                  ("freqs", "models/cantilever_tip_mass.toml", "--bogus"),
+                                  ("freqs", "models/cantilever_tip_mass.toml", "--root", "nowhere")])
+def test_bad_options_exit_2_with_one_line(args):
+    result = run(*args)
+    assert result.returncode == 2
+    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr

@@ -1,0 +1,128 @@
+"""Chains against closed forms (independent of the transfer matrices).
+
+Beam eigenvalues λ = βL are roots of the classical frequency equations
+(e.g. Blevins, *Formulas for Natural Frequency and Mode Shape*, table 8-1),
+solved here with mpmath to 30 digits; ω = λ² √(EI/(ρA L⁴)).
+"""
+from __future__ import annotations
+
+import mpmath as mp
+import numpy as np
+import pytest
+from builders import fixed, make_rigid, make_spring, single_beam_model
+
+from linmstmm.model import Model
+from linmstmm.solve import natural_frequencies
+
+mp.mp.dps = 30
+FREQUENCY_EQUATIONS = {
+    "cantilever": lambda x: mp.cos(x) * mp.cosh(x) + 1,
+    "free-free": lambda x: mp.cos(x) * mp.cosh(x) - 1,
+    "clamped-clamped": lambda x: mp.cos(x) * mp.cosh(x) - 1,
+    "pinned-pinned": lambda x: mp.sin(x),
+    "clamped-pinned": lambda x: mp.tan(x) - mp.tanh(x),
+}
+# Published starting values (Blevins table 8-1), refined by mpmath.
+STARTS = {
+    "cantilever": [1.8751, 4.6941, 7.8548, 10.9955, 14.1372],
+    "free-free": [4.7300, 7.8532, 10.9956, 14.1372, 17.2788],
+    "clamped-clamped": [4.7300, 7.8532, 10.9956, 14.1372, 17.2788],
+    "pinned-pinned": [np.pi * n for n in range(1, 6)],
+    "clamped-pinned": [3.9266, 7.0686, 10.2102, 13.3518, 16.4934],
+}
+ENDS = {
+    "cantilever": (fixed(), None),
+    "free-free": (None, None),
+    "clamped-clamped": (fixed(), fixed()),
+    "pinned-pinned": (fixed("x", "y", "z", "rx"), fixed("y", "z")),
+    "clamped-pinned": (fixed(), fixed("y", "z")),
+}
+
+
+def beam_lambdas(case):
+    return np.array([float(mp.findroot(FREQUENCY_EQUATIONS[case], x0)) for x0 in STARTS[case]])
+
+
+def bending_frequencies_hz(lambdas, EI, rhoA, L):
+    return lambdas**2 * np.sqrt(EI / (rhoA * L**4)) / (2 * np.pi)
+
+
+@pytest.mark.parametrize("case", sorted(FREQUENCY_EQUATIONS))
+def test_beam_bending_in_one_plane(case):
+    """Iz ≠ Iy separates the two planes; axial/torsion pushed out of the band."""
+    L, Iz, Iy = 2.0, 2e-7, 7e-7
+    model = single_beam_model(*ENDS[case], length=L, Iz=Iz, Iy=Iy, axial=False, torsion=False)
+    beam = model.beams[0]
+    lambdas = beam_lambdas(case)
+    want_z = bending_frequencies_hz(lambdas, beam.E * Iz, beam.rho * beam.A, L)
+    want_y = bending_frequencies_hz(lambdas, beam.E * Iy, beam.rho * beam.A, L)
+    want = np.sort(np.r_[want_z, want_y])
+    want = want[want <= want_z[-1]]
+    got = natural_frequencies(model, fmax=want_z[-1] * (1 + 1e-6), count=None)
+    np.testing.assert_allclose(got.frequencies_hz, want, rtol=1e-9)
+    assert got.rigid_body_modes == (6 if case == "free-free" else 0)
+
+
+def test_round_tube_cantilever_gives_double_roots():
+    model = single_beam_model(fixed(), None, Iz=3e-7, Iy=3e-7, axial=False, torsion=False)
+    beam = model.beams[0]
+    want = bending_frequencies_hz(beam_lambdas("cantilever"), beam.E * 3e-7, beam.rho * beam.A, 2.0)
+    got = natural_frequencies(model, count=10)
+    np.testing.assert_allclose(got.frequencies_hz, np.repeat(want, 2), rtol=1e-9)
+
+
+def test_axial_rod_and_torsional_shaft_fixed_free():
+    """ω_n = (2n−1)π/(2L) √(E/ρ) and (2n−1)π/(2L) √(GJ/(ρ Ip)) (e.g. Blevins table 8-16)."""
+    L = 3.0
+    model = single_beam_model(fixed(), None, length=L, Iz=1.0, Iy=1.0, J=2e-7, Ip=4e-7)
+    beam = model.beams[0]
+    n = np.arange(1, 4)
+    axial = (2 * n - 1) * np.pi / (2 * L) * np.sqrt(beam.E / beam.rho) / (2 * np.pi)
+    torsion = (2 * n - 1) * np.pi / (2 * L) * np.sqrt(beam.G * beam.J / (beam.rho * beam.Ip)) / (2 * np.pi)
+    fmax = 0.999 * min(axial[-1], torsion[-1])
+    # Iy = Iz = 1 m^4 pushes bending far above fmax.
+    want = np.sort(np.r_[axial, torsion])
+    got = natural_frequencies(model, fmax=fmax, count=None)
+    np.testing.assert_allclose(got.frequencies_hz, want[want <= fmax], rtol=1e-10)
+
+
+def test_cantilever_with_tip_mass_ratio_one():
+    """Tip mass = beam mass: λ² = 1.557298, 16.25009, 50.89584 (Blevins table 8-8, and the
+    frequency equation 1 + cos λ cosh λ + λ (cos λ sinh λ − sin λ cosh λ) = 0)."""
+    L = 2.0
+    base = single_beam_model(fixed(), None, length=L, Iy=1e-2, axial=False, torsion=False)
+    beam = base.beams[0]
+    tip = make_rigid("payload", ["b"], beam.rho * beam.A * L, [L, 0.0, 0.0])
+    model = Model("tip mass", base.points, rigids=(tip,), beams=base.beams, boundary=base.boundary)
+    equation = lambda x: 1 + mp.cos(x) * mp.cosh(x) + x * (mp.cos(x) * mp.sinh(x) - mp.sin(x) * mp.cosh(x))
+    lambdas = np.array([float(mp.findroot(equation, mp.sqrt(x))) for x in (1.557298, 16.25009, 50.89584)])
+    np.testing.assert_allclose(lambdas**2, [1.557298, 16.25009, 50.89584], rtol=1e-6)
+    scale = np.sqrt(beam.E * beam.Iz / (beam.rho * beam.A * L**4)) / (2 * np.pi)
+    got = natural_frequencies(model, fmax=lambdas[-1] ** 2 * scale * 1.0001, count=None)
+    np.testing.assert_allclose(got.frequencies_hz[:3], lambdas**2 * scale, rtol=1e-9)
+
+
+def spring_mass_chain(k=1000.0, m=2.0):
+    """fixed–k–3m–k–m–k–fixed along x; rotations locked by rigid rotational springs.
+
+    Every translation direction repeats the 1-D chain: ω² = (4 ∓ √7)/3 · k/m, three times each.
+    """
+    points = {name: np.array([x, 0.0, 0.0]) for name, x in
+              [("g0", 0.0), ("a1", 0.0), ("b1", 1.0), ("a2", 1.0), ("b2", 2.0), ("g3", 2.0)]}
+    stiff = [k, k, k, np.inf, np.inf, np.inf]
+    return Model(
+        "spring-mass chain", points,
+        rigids=(make_rigid("m1", ["a1", "b1"], 3 * m, [0.5, 0, 0]),
+                make_rigid("m2", ["a2", "b2"], m, [1.5, 0, 0])),
+        springs=(make_spring("k1", "g0", "a1", stiff), make_spring("k2", "b1", "a2", stiff),
+                 make_spring("k3", "b2", "g3", stiff)),
+        boundary={"g0": fixed(), "g3": fixed()})
+
+
+@pytest.mark.parametrize("root", ["g0", "g3"])
+def test_spring_mass_chain_exact(root):
+    k, m = 1000.0, 2.0
+    got = natural_frequencies(spring_mass_chain(k, m), count=6, root=root)
+    omega2 = np.array([(4 - np.sqrt(7)) / 3, (4 + np.sqrt(7)) / 3]) * k / m
+    np.testing.assert_allclose(got.frequencies_hz, np.repeat(np.sqrt(omega2) / (2 * np.pi), 3), rtol=1e-12)
+    assert got.ubar_order == 12

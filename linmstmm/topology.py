@@ -201,15 +201,32 @@ def _grow_tree(elements, start, cuts):
     return order
 
 
-def build_topology(model: Model, root: str | None = None) -> Topology:
+def _cut_connections(model, elements, points, cuts):
+    """Cut the two-element connections at ``points`` before the tree is grown."""
+    for point in points:
+        ends = [(e, p) for e, el in enumerate(elements) for p, port in enumerate(el.ports)
+                if port.point == point and port.link[0] == "element"]
+        if len(ends) != 2 or elements[ends[0][0]].kind == "junction" or elements[ends[1][0]].kind == "junction":
+            raise ModelError(model.source or model.name,
+                             f"'{point}' is not a connection of exactly two elements", key="cut")
+        c = len(cuts)
+        cuts.append(Cut(point, tuple(ends)))
+        for side, (e, p) in enumerate(ends):
+            elements[e].ports[p].link = ("cut", c, side)
+
+
+def build_topology(model: Model, root: str | None = None, cut_at=()) -> Topology:
     """Deduce the directed transfer structure of ``model``.
 
     root : boundary end label (point name) to use as the root; default: the
     end with the most fixed components, first in file order among equals.
+    cut_at : connection points to cut first (loops not cut there are cut
+    where the spanning tree closes them).
     """
     elements = _model_elements(model)
     boundaries = _link_points(model, elements)
     cuts: list[Cut] = []
+    _cut_connections(model, elements, cut_at, cuts)
     b = _choose_root(model, elements, boundaries, root)
     if b is not None:
         start, port = _find_port(elements, ("boundary", b))

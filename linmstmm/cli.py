@@ -11,6 +11,7 @@ import json
 import sys
 
 from linmstmm.model import ModelError, load_model
+from linmstmm.structure import add_check_command
 
 
 class UsageError(Exception):
@@ -61,6 +62,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="significant digits wanted (above 14 the mpmath path is used)")
     freqs.add_argument("--root", default=None, help="boundary point to use as the root")
     freqs.set_defaults(run=_run_freqs)
+    add_check_command(sub)
     return parser
 
 

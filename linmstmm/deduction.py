@@ -32,8 +32,11 @@ from linmstmm.elements.frames import FORCE_INDEX
 from linmstmm.elements.rigid import (force_extraction, position_extraction,
                                      position_incidence, rigid_transfer)
 from linmstmm.elements.spring import spring_transfer
+from linmstmm.numeric import frequencies, zeros_like_stack
 from linmstmm.topology import Topology
 
+#: Largest βL of one beam piece in the stable evaluation (growth e^1.5 ≈ 4.5).
+_BEAM_PIECE_BETA_L = 1.5
 _CUT_SIGN = np.diag(np.r_[np.ones(6), -np.ones(6)])
 
 
@@ -60,8 +63,9 @@ def boundary_selection(fixed) -> np.ndarray:
 class Deduction:
     """The deduced overall transfer equation of one topology.
 
-    Attributes: ``order`` (= ``ubar_order``, the order N of Ū_all) and
-    ``columns``: a label per unknown, e.g. ``"tyre1.Qz"``.
+    Attributes: ``order`` (= ``ubar_order``, the order N of Ū_all, less any
+    released indeterminate unknowns) and ``columns``: a label per unknown,
+    e.g. ``"tyre1.Qz"``.
     """
 
     def __init__(self, topology: Topology):
@@ -78,9 +82,10 @@ class Deduction:
             self._cut_columns[c] = np.arange(len(labels), len(labels) + 12)
             labels += [f"cut {cut.point}.{name}" for name in names]
         self.columns = labels
-        self.order = len(labels)
+        self.full_order = self.order = len(labels)
+        self.released_columns = self.released_rows = np.zeros(0, dtype=int)
         n_geometric = sum(max(len(el.inputs) - 1, 0) for el in topology.elements)
-        if 12 + 6 * n_geometric != self.order:
+        if 12 + 6 * n_geometric != self.full_order:
             raise AssertionError(f"U_all is not square: {12 + 6 * n_geometric} rows, "
                                  f"{self.order} unknowns")
 
@@ -102,68 +107,131 @@ class Deduction:
 
     # -- boundary states ------------------------------------------------------------
     def _tip_state(self, link, n) -> PortState:
+        """State of a boundary end or cut side in terms of its unknowns (less released ones)."""
         if link[0] == "boundary":
-            b = link[1]
-            selection = boundary_selection(self.topology.boundaries[b].fixed)
-            return PortState(self._boundary_columns[b], np.broadcast_to(selection, (n, 12, 6)))
-        _, c, side = link
-        closing = self.topology.cuts[c].closing
-        tie = np.eye(12) if (side == 0 or closing) else _CUT_SIGN
-        return PortState(self._cut_columns[c], np.broadcast_to(tie, (n, 12, 12)))
+            columns = self._boundary_columns[link[1]]
+            selection = boundary_selection(self.topology.boundaries[link[1]].fixed)
+        else:
+            _, c, side = link
+            columns = self._cut_columns[c]
+            selection = np.eye(12) if (side == 0 or self.topology.cuts[c].closing) else _CUT_SIGN
+        kept = ~np.isin(columns, self.released_columns)
+        return PortState(columns[kept], np.broadcast_to(selection[:, kept], (n, 12, int(kept.sum()))))
+
+    def release(self, columns, rows) -> None:
+        """Drop statically indeterminate unknowns and the as many dependent rows.
+
+        Redundant rigid constraints leave some internal forces undetermined:
+        Ū_all then has constant null vectors (right, over ``columns``) and
+        constant left null vectors (over ``rows``) at every ω. Setting one
+        indeterminate unknown per null vector to zero and deleting one
+        dependent row each leaves a square matrix whose determinant vanishes
+        exactly at the natural frequencies. ``order`` shrinks accordingly.
+        """
+        self.released_columns = np.asarray(sorted(columns), dtype=int)
+        self.released_rows = np.asarray(sorted(rows), dtype=int)
+        self.order = self.full_order - len(self.released_columns)
 
     # -- the theorem ----------------------------------------------------------------
     def port_states(self, omega):
         """States of every element's output port, and the geometric rows.
 
         Returns (outputs, rows): outputs[e] is the PortState at element e's
-        output; rows is a list of (label, columns, (n, 6, k) matrix).
+        output; rows is a list of [label, columns, (n, 6, k) matrix].
         """
-        omega = np.atleast_1d(np.asarray(omega, dtype=float))
+        outputs, rows, _ = self._carry(frequencies(omega), stable=False)
+        return outputs, rows
+
+    def _carry(self, omega, stable: bool):
+        """Carry states from the tips to the root.
+
+        stable : orthonormalise columns on the way (:class:`_Orthonormaliser`)
+        and split beams into pieces of βL <= _BEAM_PIECE_BETA_L.
+
+        Returns (outputs, rows, log_scale); log_scale (n,) = log det R > 0,
+        with det Ū_all = det(Ū built from these) · exp(log_scale).
+        """
         n = omega.size
         elements = self.topology.elements
         outputs: dict[int, PortState] = {}
+        open_states: dict[int, PortState] = {}
         rows = []
+        normaliser = _Orthonormaliser(omega, self._shared_columns()) if stable else None
         for e in self.topology.order:
             element = elements[e]
             inputs = []
             for p in element.inputs:
                 link = element.ports[p].link
-                inputs.append(outputs[link[1]] if link[0] == "element" else self._tip_state(link, n))
+                inputs.append(open_states.pop(link[1]) if link[0] == "element" else self._tip_state(link, n))
             out_position = element.ports[element.output].position
-            terms = [(self.transfer(e, omega), inputs[0])]
             first_position = element.ports[element.inputs[0]].position
+            if stable and element.kind == "beam":
+                inputs[0] = self._carry_through_beam(element, omega, inputs[0], normaliser, rows, open_states)
+                terms = [(np.eye(12), inputs[0])]
+            else:
+                terms = [(self.transfer(e, omega), inputs[0])]
             for p, state in zip(element.inputs[1:], inputs[1:]):
                 position = element.ports[p].position
                 terms.append((force_extraction(position, out_position), state))
-                rows.append((f"{element.name} input {element.ports[p].point}",
+                rows.append([f"{element.name} input {element.ports[p].point}",
                              *_combine([(-position_extraction(), inputs[0]),
-                                        (position_incidence(first_position, position), state)])))
-            outputs[e] = PortState(*_combine(terms))
-        return outputs, rows
+                                        (position_incidence(first_position, position), state)])])
+            state = PortState(*_combine(terms))
+            if stable:
+                state = normaliser.apply(state, rows, open_states)
+            outputs[e] = open_states[e] = state
+        log_scale = normaliser.log_scale if stable else np.zeros(n)
+        return outputs, rows, log_scale
+
+    def _carry_through_beam(self, element, omega, state, normaliser, rows, open_states):
+        """The state carried along a beam piece by piece, orthonormalised between pieces."""
+        beam = element.record
+        stiffness = beam.E * min(beam.Iy, beam.Iz)
+        beta_L = (beam.rho * beam.A * np.max(np.abs(omega)) ** 2 / stiffness) ** 0.25 * beam.length
+        pieces = max(int(np.ceil(beta_L / _BEAM_PIECE_BETA_L)), 1)
+        piece = beam_transfer(beam, omega, reverse=element.inputs[0] == 1, length=beam.length / pieces)
+        for _ in range(pieces):
+            state = PortState(state.columns, piece @ state.matrix)
+            state = normaliser.apply(state, rows, open_states)
+        return state
+
+    def _shared_columns(self) -> set:
+        """Columns never orthonormalised: the closing cut's, which the root row holds too."""
+        return {int(c) for index, cut in enumerate(self.topology.cuts) if cut.closing
+                for c in self._cut_columns[index]}
 
     def root_state(self, outputs) -> PortState:
         """The computed state at the root (output of the last element)."""
         return outputs[self.topology.order[-1]]
 
-    def matrix(self, omega) -> np.ndarray:
-        """Ū_all(ω): stack (n, N, N), rows = main equation then geometric equations."""
-        omega = np.atleast_1d(np.asarray(omega, dtype=float))
-        outputs, rows = self.port_states(omega)
+    def matrix(self, omega, stable: bool = False):
+        """Ū_all(ω): stack (n, N, N), rows = main equation then geometric equations.
+
+        With ``stable`` the columns are orthonormalised on the way (a change of
+        unknowns; same null space dimension, same roots) and the result is
+        (matrix, log_scale) with det Ū_all = det(matrix) · exp(log_scale).
+        """
+        omega = frequencies(omega)
+        outputs, rows, scale = self._carry(omega, stable)
         root = self.root_state(outputs)
-        ubar = np.zeros((omega.size, self.order, self.order))
+        ubar = zeros_like_stack(omega, (self.full_order, self.full_order))
         ubar[:, :12, root.columns] += root.matrix
         kind, index = self.topology.root
-        root_columns = self._boundary_columns[index] if kind == "boundary" else self._cut_columns[index]
         root_given = self._tip_state(self.topology.root if kind == "boundary" else ("cut", index, 0),
                                      omega.size)
-        ubar[:, :12, root_columns] -= root_given.matrix
+        ubar[:, :12, root_given.columns] -= root_given.matrix
         for r, (_, columns, block) in enumerate(rows):
             ubar[:, 12 + 6 * r:18 + 6 * r, columns] += block
-        return ubar
+        ubar = np.delete(np.delete(ubar, self.released_rows, axis=1), self.released_columns, axis=2)
+        return (ubar, scale) if stable else ubar
 
-    def log_det(self, omega):
-        """(sign, log|det Ū_all|) over the frequency stack, each shape (n,)."""
-        return np.linalg.slogdet(self.matrix(omega))
+    def log_det(self, omega, stable: bool = True):
+        """(sign or phase, log|det Ū_all|) over the frequency stack, each shape (n,)."""
+        if not stable:
+            return balanced_slogdet(self.matrix(omega))
+        ubar, log_scale = self.matrix(omega, stable=True)
+        sign, log_abs = balanced_slogdet(ubar)
+        return sign, log_abs + log_scale
 
 
 def _combine(terms):
@@ -174,7 +242,77 @@ def _combine(terms):
     columns = np.unique(np.concatenate([state.columns for _, state in terms]))
     first = terms[0][0]
     n = max(np.shape(state.matrix)[0] for _, state in terms)
-    total = np.zeros((n, np.shape(first)[-2], columns.size))
+    dtype = np.result_type(*[A for A, _ in terms], *[state.matrix for _, state in terms])
+    total = np.zeros((n, np.shape(first)[-2], columns.size), dtype=dtype)
     for A, state in terms:
         total[:, :, np.searchsorted(columns, state.columns)] += A @ state.matrix
     return columns, total
+
+
+class _Orthonormaliser:
+    """Godunov orthonormalisation of the unknowns carried by one port state.
+
+    The columns S of a state that no other open state shares are replaced by
+    an orthonormal basis of [rows on S; state on S] (QR with a positive real
+    diagonal, so the basis is smooth in ω): z̄_S = R⁻¹ w_S. The geometric rows
+    already formed on S are rewritten in the new unknowns, det R is
+    accumulated, and growing beam solutions can no longer swamp the
+    decaying ones. Only float and complex stacks are handled.
+    """
+
+    def __init__(self, omega, shared_columns):
+        self.shared = shared_columns
+        self.log_scale = np.zeros(omega.size)
+
+    def apply(self, state: PortState, rows, open_states) -> PortState:
+        """The state on orthonormalised columns (or unchanged if they are shared).
+
+        open_states : the other states not yet consumed downstream.
+        """
+        columns = set(int(c) for c in state.columns)
+        if columns & self.shared or any(columns & set(int(c) for c in other.columns)
+                                        for other in open_states.values()):
+            return state
+        touching = [row for row in rows if columns & set(int(c) for c in row[1])]
+        if any(not set(int(c) for c in row[1]) <= columns for row in touching):
+            return state
+        blocks = [_embed(row[1], row[2], state.columns) for row in touching]
+        stacked = np.concatenate(blocks + [state.matrix], axis=1)
+        if stacked.shape[1] < stacked.shape[2]:
+            return state
+        row_scale = _power_of_two_scale(np.abs(stacked).max(axis=2))  # mixed units: m, rad, N, N m
+        q, r = np.linalg.qr(stacked * row_scale[:, :, None])
+        diagonal = np.diagonal(r, axis1=1, axis2=2)
+        q = q * (diagonal / np.abs(diagonal))[:, None, :] / row_scale[:, :, None]
+        self.log_scale += np.log(np.abs(diagonal)).sum(axis=1)
+        offset = 0
+        for row in touching:
+            row[1], row[2] = state.columns, q[:, offset:offset + row[2].shape[1]]
+            offset += row[2].shape[1]
+        return PortState(state.columns, q[:, offset:])
+
+
+def _power_of_two_scale(magnitude):
+    """1 / (nearest power of two of ``magnitude``), 1 where it is 0: exact rescaling."""
+    safe = np.where(magnitude > 0, magnitude, 1.0)
+    return np.exp2(-np.round(np.log2(safe)))
+
+
+def balanced_slogdet(stack):
+    """slogdet of a (n, N, N) stack after exact power-of-two row and column scaling.
+
+    Ū_all mixes metres, radians, newtons and newton-metres; balancing first
+    keeps LU's error relative to each row's and column's own size.
+    """
+    rows = _power_of_two_scale(np.abs(stack).max(axis=2))
+    balanced = stack * rows[:, :, None]
+    cols = _power_of_two_scale(np.abs(balanced).max(axis=1))
+    sign, log_abs = np.linalg.slogdet(balanced * cols[:, None, :])
+    return sign, log_abs - np.log(rows).sum(axis=1) - np.log(cols).sum(axis=1)
+
+
+def _embed(columns, block, onto):
+    """``block`` (n, r, len(columns)) placed on the columns ``onto`` (a superset)."""
+    out = np.zeros(block.shape[:2] + (len(onto),), dtype=block.dtype)
+    out[:, :, np.searchsorted(onto, columns)] = block
+    return out

@@ -8,7 +8,7 @@ import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.model import Model
-from linmstmm.roots import OMEGA_CEILING, DeflatedSystem, RootFinder
+from linmstmm.roots import OMEGA_CEILING, RootFinder, release_indeterminate
 from linmstmm.topology import build_topology
 
 
@@ -17,7 +17,9 @@ class FrequencyResult:
     """Elastic natural frequencies (Hz, ascending, repeated per multiplicity).
 
     rigid_body_modes : number of zero-frequency modes. ubar_order : order of
-    Ū_all. seconds : wall time of the solve (loading excluded).
+    Ū_all as deduced. indeterminate_released : statically indeterminate
+    unknowns (redundant rigid constraints) released before the root search.
+    seconds : wall time of the solve (loading excluded).
     precision : "float64" or "mpmath:<digits>".
     """
 
@@ -28,6 +30,7 @@ class FrequencyResult:
     seconds: float
     precision: str = "float64"
     note: str = ""
+    indeterminate_released: int = 0
 
     def to_dict(self) -> dict:
         """The ``linmstmm freqs --json`` object (``shared/spec/cli.md``)."""
@@ -39,6 +42,7 @@ class FrequencyResult:
             "seconds": float(self.seconds),
             "precision": self.precision,
             "method": "mstmm",
+            "indeterminate_released": int(self.indeterminate_released),
             **({"note": self.note} if self.note else {}),
         }
 
@@ -52,13 +56,13 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     """
     start = time.perf_counter()
     deduction = Deduction(build_topology(model, root=root))
-    system = DeflatedSystem(deduction.matrix)
-    finder = RootFinder(system.log_det, system.matrix)
+    released = release_indeterminate(deduction)
+    finder = RootFinder(deduction.log_det, lambda omega: deduction.matrix(omega, stable=True)[0])
     rigid = finder.rigid_body_modes()
     omega_max = None if fmax is None else 2 * np.pi * fmax
     omegas = np.array(finder.find(count, omega_max))
     note = ""
     if count is not None and omegas.size < count and fmax is None:
         note = f"only {omegas.size} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s"
-    return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.order,
-                           time.perf_counter() - start, note=note)
+    return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.full_order,
+                           time.perf_counter() - start, note=note, indeterminate_released=released)

@@ -18,9 +18,12 @@ from __future__ import annotations
 
 import math
 
+import mpmath
 import numpy as np
 
 from linmstmm.elements.frames import state_rotation
+from linmstmm.numeric import (cos, cosh, frequencies, is_mp, magnitude, sin, sin_over, sinh, sqrt,
+                              zeros_like_stack)
 
 #: |βL| below which the Krylov functions are summed as power series.
 _SERIES_LIMIT = 2.0
@@ -38,21 +41,33 @@ _TORSION = [3, 6]
 _XZ_SIGNS = np.array([1.0, -1.0, -1.0, 1.0])
 
 
+def _series_coefficients(mp: bool) -> np.ndarray:
+    """(4, terms) table of 1/(4j + r)!, in mpmath at the working precision if ``mp``."""
+    if not mp:
+        return _SERIES_COEFFS
+    terms = _SERIES_TERMS + int(mpmath.mp.dps)  # enough for |w| < 16 at any precision
+    return np.array([[mpmath.mpf(1) / mpmath.factorial(4 * j + r) for j in range(terms)]
+                     for r in range(4)], dtype=object)
+
+
 def krylov(w) -> np.ndarray:
     """Scaled Krylov functions F_r(w) = Σ_j w^j/(4j+r)!, r = 0..3, shape (4, n).
 
-    With z = w^(1/4): F0 = (cosh z + cos z)/2, F1 = (sinh z + sin z)/(2z),
+    With z = w^(1/4) (any fourth root: the F_r are entire in w):
+    F0 = (cosh z + cos z)/2, F1 = (sinh z + sin z)/(2z),
     F2 = (cosh z − cos z)/(2z²), F3 = (sinh z − sin z)/(2z³).
+    w may be float, complex or mpmath (object) valued.
     """
-    w = np.asarray(w, dtype=float)
-    out = np.empty((4,) + w.shape)
-    small = w < _SERIES_LIMIT ** 4
+    w = np.asarray(w)
+    out = np.empty((4,) + w.shape, dtype=object if is_mp(w) else np.result_type(w, float))
+    small = magnitude(w) < _SERIES_LIMIT ** 4
     if np.any(small):
-        powers = w[small][None, :] ** np.arange(_SERIES_TERMS)[:, None]
-        out[:, small] = _SERIES_COEFFS @ powers
+        coefficients = _series_coefficients(is_mp(w))
+        powers = w[small][None, :] ** np.arange(coefficients.shape[1])[:, None]
+        out[:, small] = coefficients @ powers
     if np.any(~small):
-        z = w[~small] ** 0.25
-        ch, c, sh, s = np.cosh(z), np.cos(z), np.sinh(z), np.sin(z)
+        z = sqrt(sqrt(w[~small]))
+        ch, c, sh, s = cosh(z), cos(z), sinh(z), sin(z)
         out[0, ~small] = (ch + c) / 2
         out[1, ~small] = (sh + s) / (2 * z)
         out[2, ~small] = (ch - c) / (2 * z**2)
@@ -62,10 +77,9 @@ def krylov(w) -> np.ndarray:
 
 def bending_transfer(EI, rhoA, L, omega) -> np.ndarray:
     """(n, 4, 4) transfer of (v, θ, m, q) in the x-y form of the bending equations."""
-    omega = np.asarray(omega, dtype=float)
     w = rhoA * omega**2 * L**4 / EI
     F0, F1, F2, F3 = krylov(w)
-    out = np.empty(omega.shape + (4, 4))
+    out = zeros_like_stack(omega, (4, 4))
     out[:, 0] = np.stack([F0, L * F1, -L**2 * F2 / EI, L**3 * F3 / EI], axis=-1)
     out[:, 1] = np.stack([w * F3 / L, F0, -L * F1 / EI, L**2 * F2 / EI], axis=-1)
     out[:, 2] = np.stack([-EI * w * F2 / L**2, -EI * w * F3 / L, F0, -L * F1], axis=-1)
@@ -79,18 +93,16 @@ def rod_transfer(stiffness, inertia, L, omega, rigid=False) -> np.ndarray:
     stiffness : EA (N) or GJ (N m²). inertia : ρA (kg/m) or ρIp (kg m).
     rigid : no deformation, inertia kept (the limit stiffness -> inf).
     """
-    omega = np.asarray(omega, dtype=float)
-    out = np.empty(omega.shape + (2, 2))
+    out = zeros_like_stack(omega, (2, 2))
     if rigid:
-        out[:, 0, 0], out[:, 0, 1] = 1.0, 0.0
-        out[:, 1, 0], out[:, 1, 1] = inertia * omega**2 * L, 1.0
+        out[:, 0, 0] = out[:, 1, 1] = 1
+        out[:, 1, 0] = inertia * omega**2 * L
         return out
-    root_s = omega * L * np.sqrt(inertia / stiffness)  # k L
-    sinc = np.sinc(root_s / np.pi)  # sin(kL)/(kL)
-    out[:, 0, 0] = np.cos(root_s)
+    kL = omega * L * math.sqrt(inertia / stiffness)
+    sinc = sin_over(kL)
+    out[:, 0, 0] = out[:, 1, 1] = cos(kL)
     out[:, 0, 1] = -L / stiffness * sinc
-    out[:, 1, 0] = stiffness / L * root_s**2 * sinc
-    out[:, 1, 1] = np.cos(root_s)
+    out[:, 1, 0] = stiffness / L * kL**2 * sinc
     return out
 
 
@@ -99,10 +111,11 @@ def beam_local_transfer(beam, omega, length=None) -> np.ndarray:
 
     length : m, a piece of the beam (default: the whole beam).
     """
+    omega = frequencies(omega)
     L = beam.length if length is None else length
     rhoA = beam.rho * beam.A
-    n = np.size(omega)
-    out = np.zeros((n, 12, 12))
+    n = omega.size
+    out = zeros_like_stack(omega, (12, 12))
     out[np.ix_(range(n), _BENDING_XY, _BENDING_XY)] = bending_transfer(beam.E * beam.Iz, rhoA, L, omega)
     xz = bending_transfer(beam.E * beam.Iy, rhoA, L, omega)
     out[np.ix_(range(n), _BENDING_XZ, _BENDING_XZ)] = _XZ_SIGNS[:, None] * xz * _XZ_SIGNS[None, :]

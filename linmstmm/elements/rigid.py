@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from linmstmm.elements.frames import M, Q, R, U, skew
+from linmstmm.numeric import frequencies
 
 
 def rigid_transfer(mass, com, inertia, inp, out, omega) -> np.ndarray:
@@ -26,7 +27,7 @@ def rigid_transfer(mass, com, inertia, inp, out, omega) -> np.ndarray:
     mass : kg. com, inp, out : (3,) positions, m. inertia : (3, 3) about the
     mass centre, kg m². omega : (n,) rad/s.
     """
-    omega2 = np.asarray(omega, dtype=float).reshape(-1, 1, 1) ** 2
+    omega2 = frequencies(omega).reshape(-1, 1, 1) ** 2
     inp, out, com = (np.asarray(p, dtype=float) for p in (inp, out, com))
     kinematic = np.eye(12)  # the ω-independent part
     kinematic[U, R] = -skew(out - inp)

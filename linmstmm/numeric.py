@@ -1,0 +1,70 @@
+"""One set of elementwise functions for the three number types the solver uses.
+
+* float64 arrays: the fast path over a stack of real frequencies;
+* complex128 arrays: complex frequencies (the counting contour);
+* object arrays of ``mpmath.mpf``/``mpc``: the arbitrary-precision path.
+
+The element modules call these instead of ``np.cos`` etc. so the same code
+serves all three.
+"""
+from __future__ import annotations
+
+import mpmath
+import numpy as np
+
+_MP_FUNCTIONS = {name: np.frompyfunc(getattr(mpmath, name), 1, 1)
+                 for name in ("cos", "sin", "cosh", "sinh", "sqrt")}
+
+
+def is_mp(x) -> bool:
+    """True for an object array (mpmath numbers)."""
+    return isinstance(x, np.ndarray) and x.dtype == object
+
+
+def frequencies(omega) -> np.ndarray:
+    """``omega`` as a 1-D array, keeping its number type (float, complex or mpmath)."""
+    omega = np.atleast_1d(np.asarray(omega))
+    if omega.dtype.kind in "iub":
+        omega = omega.astype(float)
+    return omega
+
+
+def result_dtype(omega):
+    """dtype of matrices built from ``omega``: float64, complex128 or object."""
+    return object if is_mp(omega) else np.result_type(omega, np.float64)
+
+
+def _elementwise(name):
+    float_function = getattr(np, name)
+    mp_function = _MP_FUNCTIONS[name]
+
+    def apply(x):
+        return mp_function(x) if is_mp(x) else float_function(x)
+
+    apply.__name__ = name
+    apply.__doc__ = f"Elementwise {name} for float, complex or mpmath arrays."
+    return apply
+
+
+cos, sin, cosh, sinh, sqrt = (_elementwise(name) for name in ("cos", "sin", "cosh", "sinh", "sqrt"))
+
+
+def magnitude(x) -> np.ndarray:
+    """|x| as float64 (for branch decisions only)."""
+    return np.abs(x.astype(complex)) if is_mp(x) else np.abs(x)
+
+
+def sin_over(x):
+    """sin(x)/x with the value 1 at 0."""
+    if is_mp(x):
+        return np.frompyfunc(lambda v: mpmath.sinc(v), 1, 1)(x)
+    return np.sinc(x / np.pi)
+
+
+def zeros_like_stack(omega, shape) -> np.ndarray:
+    """Zeros of shape ``(len(omega),) + shape`` in the number type of ``omega``."""
+    dtype = result_dtype(omega)
+    out = np.zeros((omega.size,) + tuple(shape), dtype=dtype)
+    if dtype == object:
+        out[...] = mpmath.mpf(0)
+    return out

@@ -129,6 +129,8 @@ class RootFinder:
         self.xtol = xtol
         self.points_per_octave = points_per_octave
         self.points_per_root = points_per_root
+        #: root -> relative size of the last Newton step that reached it
+        self.last_step: dict[float, float] = {}
 
     def rigid_body_modes(self) -> int:
         """Nullity of Ū_all at ω = 0: zero-frequency (rigid-body) modes."""
@@ -164,6 +166,7 @@ class RootFinder:
             step = abs(mu[0])
             omega -= mu[0]
             if step <= self.xtol * omega or (step <= self.STAGNATION * omega and step > previous / 2):
+                self.last_step[omega] = step / omega
                 return omega, self._offsets(omega)
             previous = step
         return None, mu

@@ -4,12 +4,22 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
+import mpmath
 import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.model import Model
+from linmstmm.precision import refine_roots
 from linmstmm.roots import OMEGA_CEILING, RootFinder, release_indeterminate
 from linmstmm.topology import build_topology
+
+
+#: Digits float64 delivers; more are computed in mpmath.
+FLOAT64_DIGITS = 14
+#: A root whose last Newton step was larger than this (relative) is not certified in float64.
+CERTIFIED_STEP = 1e-12
+#: Digits used when an uncertified root is escalated to mpmath.
+ESCALATION_DIGITS = 20
 
 
 @dataclass(frozen=True)
@@ -20,7 +30,10 @@ class FrequencyResult:
     Ū_all as deduced. indeterminate_released : statically indeterminate
     unknowns (redundant rigid constraints) released before the root search.
     seconds : wall time of the solve (loading excluded).
-    precision : "float64" or "mpmath:<digits>".
+    precision : "float64", or "mpmath:<digits>" when roots were refined in
+    mpmath (all of them for ``digits`` > 15, else only those float64 could
+    not certify). frequencies_text : the frequencies as decimal strings at
+    that precision (mpmath only).
     """
 
     model: str
@@ -31,6 +44,7 @@ class FrequencyResult:
     precision: str = "float64"
     note: str = ""
     indeterminate_released: int = 0
+    frequencies_text: list | None = None
 
     def to_dict(self) -> dict:
         """The ``linmstmm freqs --json`` object (``shared/spec/cli.md``)."""
@@ -44,6 +58,7 @@ class FrequencyResult:
             "method": "mstmm",
             "indeterminate_released": int(self.indeterminate_released),
             **({"note": self.note} if self.note else {}),
+            **({"frequencies_hz_text": self.frequencies_text} if self.frequencies_text else {}),
         }
 
 
@@ -52,6 +67,9 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     """Elastic natural frequencies of ``model`` by the transfer matrix method.
 
     count : the lowest N; fmax : Hz, all up to fmax; both: whichever stops first.
+    digits : significant digits wanted; above FLOAT64_DIGITS every root is
+    refined in mpmath. Without it, roots float64 cannot certify are refined
+    at ESCALATION_DIGITS automatically.
     root : boundary end (point name) to use as the root of the transfer tree.
     """
     start = time.perf_counter()
@@ -61,8 +79,19 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     rigid = finder.rigid_body_modes()
     omega_max = None if fmax is None else 2 * np.pi * fmax
     omegas = np.array(finder.find(count, omega_max))
+    precision, text = "float64", None
+    uncertain = sorted({w for w in omegas if finder.last_step.get(w, 0.0) > CERTIFIED_STEP})
+    wanted = digits if digits and digits > FLOAT64_DIGITS else (ESCALATION_DIGITS if uncertain else None)
+    if wanted:
+        chosen = omegas if digits and digits > FLOAT64_DIGITS else [w for w in omegas if w in uncertain]
+        refined = dict(zip(chosen, refine_roots(deduction, model, list(chosen), wanted)))
+        text = [mpmath.nstr(refined[w] / (2 * mpmath.pi), wanted) if w in refined else repr(w / (2 * np.pi))
+                for w in omegas]
+        omegas = np.array([float(refined.get(w, w)) for w in omegas])
+        precision = f"mpmath:{wanted}" + ("" if len(chosen) == len(omegas) else f" ({len(set(chosen))} roots)")
     note = ""
     if count is not None and omegas.size < count and fmax is None:
         note = f"only {omegas.size} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s"
     return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.full_order,
-                           time.perf_counter() - start, note=note, indeterminate_released=released)
+                           time.perf_counter() - start, precision=precision, note=note,
+                           indeterminate_released=released, frequencies_text=text)

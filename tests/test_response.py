@@ -1,0 +1,246 @@
+"""Modal response and FRF (linmstmm.response) against closed forms and direct solves.
+
+The single-DOF model is a mass on a spring that is rigid (``inf``) in every
+direction but x, so it has exactly one mode, ω = √(k/m); its responses are
+the textbook Duhamel integrals. The two-mass chain's M and K are written by
+hand here, and its FRF and impulse response are solved directly.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.linalg
+from builders import fixed, make_rigid, make_spring
+
+from linmstmm.model import Model, ModelError
+from linmstmm.modes import mode_shapes
+from linmstmm.response import (PointLoad, frf, half_sine, harmonic, impulse, load_loads,
+                               modal_response, respond, step, table)
+
+K_SDOF, M_SDOF, F = 4.0e4, 2.5, 30.0
+OMEGA = np.sqrt(K_SDOF / M_SDOF)
+TIMES = np.linspace(0.0, 1.5, 3001)
+
+
+def sdof(damping=None):
+    points = {"g": np.zeros(3), "p": np.zeros(3)}
+    return Model("sdof", points, rigids=(make_rigid("mass", ["p"], M_SDOF, [0.0, 0.0, 0.0]),),
+                 springs=(make_spring("k", "g", "p", [K_SDOF] + [np.inf] * 5),),
+                 boundary={"g": fixed()}, damping=damping)
+
+
+def sdof_response(function, damping=None):
+    model = sdof(damping)
+    modes = mode_shapes(model, count=1)
+    assert modes.omega == pytest.approx([OMEGA], rel=1e-13)
+    load = PointLoad("p", np.array([F, 0.0, 0.0]), np.zeros(3), function)
+    result = modal_response(modes, [load], TIMES, ["p"], model.damping)
+    return result.displacement[:, 0, 0], result.velocity[:, 0, 0], result.acceleration[:, 0, 0]
+
+
+def assert_history(got, want):
+    assert np.abs(got - want).max() < 1e-10 * np.abs(want).max()
+
+
+def test_step_with_damping():
+    zeta = 0.03
+    x, v, a = sdof_response(step(0.1), damping=(2 * zeta * OMEGA, 0.0))
+    tau = np.maximum(TIMES - 0.1, 0.0)
+    wd = OMEGA * np.sqrt(1 - zeta**2)
+    decay = np.exp(-zeta * OMEGA * tau)
+    want = F / K_SDOF * (1 - decay * (np.cos(wd * tau) + zeta / np.sqrt(1 - zeta**2) * np.sin(wd * tau)))
+    assert_history(x, np.where(TIMES >= 0.1, want, 0.0))
+    assert_history(v, np.where(TIMES >= 0.1, F / (M_SDOF * wd) * decay * np.sin(wd * tau), 0.0))
+
+
+def test_impulse_with_stiffness_proportional_damping():
+    beta = 2e-4
+    zeta = beta * OMEGA / 2
+    x, v, a = sdof_response(impulse(0.05), damping=(0.0, beta))
+    tau = np.maximum(TIMES - 0.05, 0.0)
+    wd = OMEGA * np.sqrt(1 - zeta**2)
+    want = F / (M_SDOF * wd) * np.exp(-zeta * OMEGA * tau) * np.sin(wd * tau)
+    assert_history(x, np.where(TIMES >= 0.05, want, 0.0))
+    assert_history(a, np.where(TIMES >= 0.05, -2 * zeta * OMEGA * v - OMEGA**2 * want, 0.0))
+
+
+def _undamped_sine(rate, tau):
+    """Response to F sin(rate τ) from rest, undamped."""
+    r = rate / OMEGA
+    return F / K_SDOF * (np.sin(rate * tau) - r * np.sin(OMEGA * tau)) / (1 - r**2)
+
+
+def test_half_sine_pulse_undamped():
+    duration, start = 0.013, 0.2
+    x, v, a = sdof_response(half_sine(duration, start))
+    tau = TIMES - start
+    rate = np.pi / duration
+    want = np.where(tau < 0, 0.0, _undamped_sine(rate, np.maximum(tau, 0))
+                    + np.where(tau >= duration, _undamped_sine(rate, np.maximum(tau - duration, 0)), 0.0))
+    assert_history(x, want)
+    load = np.where((tau >= 0) & (tau < duration), F * np.sin(rate * np.maximum(tau, 0)), 0.0)
+    assert_history(a, load / M_SDOF - OMEGA**2 * x)
+
+
+def test_harmonic_from_rest_with_damping():
+    zeta, rate, phase = 0.05, 0.8 * OMEGA, 0.4
+    x, _, _ = sdof_response(harmonic(rate / (2 * np.pi), phase), damping=(2 * zeta * OMEGA, 0.0))
+    amplitude = F / M_SDOF / np.hypot(OMEGA**2 - rate**2, 2 * zeta * OMEGA * rate)
+    lag = np.arctan2(2 * zeta * OMEGA * rate, OMEGA**2 - rate**2)
+    steady = amplitude * np.sin(rate * TIMES + phase - lag)
+    wd = OMEGA * np.sqrt(1 - zeta**2)
+    A = -amplitude * np.sin(phase - lag)
+    B = (zeta * OMEGA * A - amplitude * rate * np.cos(phase - lag)) / wd
+    transient = np.exp(-zeta * OMEGA * TIMES) * (A * np.cos(wd * TIMES) + B * np.sin(wd * TIMES))
+    assert_history(x, steady + transient)
+
+
+def test_tabulated_ramp_and_hold():
+    rise = 0.021
+    x, _, _ = sdof_response(table([0.0, rise], [0.0, 1.0], hold=True))
+
+    def ramp(t):
+        t = np.maximum(t, 0.0)
+        return F / K_SDOF * (t / rise - np.sin(OMEGA * t) / (OMEGA * rise))
+
+    assert_history(x, ramp(TIMES) - ramp(TIMES - rise))
+
+
+def test_tabulated_samples_end_at_zero():
+    """A triangle given by samples, then nothing: free vibration afterwards."""
+    function = table([0.01, 0.02, 0.04], [0.0, 1.0, 0.0])
+    assert function(0.015) == pytest.approx(0.5)
+    assert function(0.05) == 0.0
+    x, v, a = sdof_response(function)
+    after = TIMES > 0.04
+    energy = 0.5 * K_SDOF * x[after] ** 2 + 0.5 * M_SDOF * v[after] ** 2
+    assert np.ptp(energy) < 1e-10 * energy.max()
+
+
+# --- two-mass chain: hand-written M, K ------------------------------------------
+
+K_CHAIN, M_CHAIN, DAMPING = 1000.0, 2.0, (0.3, 2e-4)
+M_HAND = np.diag([3 * M_CHAIN, M_CHAIN])
+K_HAND = K_CHAIN * np.array([[2.0, -1.0], [-1.0, 2.0]])
+
+
+def chain():
+    """fixed–k–3m–k–m–k–fixed along x; every translation direction is this 2-DOF chain."""
+    points = {name: np.array([x, 0.0, 0.0]) for name, x in
+              [("g0", 0.0), ("a1", 0.0), ("b1", 1.0), ("a2", 1.0), ("b2", 2.0), ("g3", 2.0)]}
+    stiff = [K_CHAIN] * 3 + [np.inf] * 3
+    return Model(
+        "chain", points,
+        rigids=(make_rigid("m1", ["a1", "b1"], 3 * M_CHAIN, [0.5, 0, 0]),
+                make_rigid("m2", ["a2", "b2"], M_CHAIN, [1.5, 0, 0])),
+        springs=(make_spring("k1", "g0", "a1", stiff), make_spring("k2", "b1", "a2", stiff),
+                 make_spring("k3", "b2", "g3", stiff)),
+        boundary={"g0": fixed(), "g3": fixed()}, damping=DAMPING)
+
+
+def test_frf_matches_direct_harmonic_solve():
+    modes = mode_shapes(chain(), count=6)
+    force = np.array([1.0, -0.5, 0.25])
+    frequencies = np.linspace(0.5, 12.0, 200)
+    result = frf(modes, "b1", np.r_[force, np.zeros(3)], frequencies, ["a1", "b2"], DAMPING)
+    alpha, beta = DAMPING
+    for f, H in zip(frequencies, result.receptance):
+        W = 2 * np.pi * f
+        dynamic = K_HAND - W**2 * M_HAND + 1j * W * (alpha * M_HAND + beta * K_HAND)
+        direct = np.linalg.solve(dynamic, np.array([[1.0], [0.0]]))[:, 0] * force[:, None]  # (3, 2)
+        np.testing.assert_allclose(H[:, :3], direct.T, rtol=1e-10, atol=1e-12 * np.abs(direct).max())
+        assert np.abs(H[:, 3:]).max() < 1e-12 * np.abs(direct).max()
+    np.testing.assert_allclose(result.mobility, 2j * np.pi * frequencies[:, None, None] * result.receptance)
+
+
+def test_chain_impulse_matches_state_space_solution():
+    """All six modes of the chain against expm of its hand-written first-order system."""
+    modes = mode_shapes(chain(), count=6)
+    kick = 2.0  # N s on m2 along y
+    load = PointLoad("b2", np.array([0.0, kick, 0.0]), np.zeros(3), impulse(0.0))
+    times = np.linspace(0.0, 2.0, 401)
+    result = modal_response(modes, [load], times, ["b1", "b2"], DAMPING)
+    alpha, beta = DAMPING
+    minv = np.linalg.inv(M_HAND)
+    system = np.block([[np.zeros((2, 2)), np.eye(2)],
+                       [-minv @ K_HAND, -minv @ (alpha * M_HAND + beta * K_HAND)]])
+    start = np.r_[0.0, 0.0, minv @ np.array([0.0, kick])]
+    direct = np.array([scipy.linalg.expm(system * t) @ start for t in times])
+    assert_history(result.displacement[:, :, 1], direct[:, :2])
+    assert_history(result.velocity[:, :, 1], direct[:, 2:])
+    assert np.abs(result.displacement[:, :, [0, 2]]).max() < 1e-12 * np.abs(direct).max()
+
+
+# --- the load file ----------------------------------------------------------------
+
+LOADS = """\
+[[load]]
+point = "b2"
+force = [0.0, 10.0, 0.0]
+time = { kind = "half_sine", duration = 0.01, start = 0.1 }
+
+[[load]]
+point = "b1"
+moment = [0.0, 0.0, 1.0]
+time = { kind = "table", time = [0.0, 0.1, 0.2], value = [0.0, 5.0, 0.0] }
+
+[output]
+points = ["b1", "b2"]
+duration = 0.5
+step = 0.001
+modes = 6
+"""
+
+
+def test_load_file_round_trip(tmp_path):
+    path = tmp_path / "loads.toml"
+    path.write_text(LOADS)
+    model = chain()
+    case = load_loads(path, model)
+    assert [load.point for load in case.loads] == ["b2", "b1"]
+    assert case.times.size == 501 and case.times[-1] == pytest.approx(0.5)
+    assert case.points == ("b1", "b2") and case.modes == 6
+    assert case.loads[1].time(0.05) == pytest.approx(2.5)
+    result = respond(model, case)
+    assert result.displacement.shape == (501, 2, 6)
+    assert set(result.to_dict()) == {"times", "points", "displacement", "velocity", "acceleration"}
+
+
+@pytest.mark.parametrize("edit, key, words", [
+    (('"half_sine"', '"half_cosine"'), "time", "kind must be one of"),
+    (('point = "b2"', 'point = "b3"'), "point", "unknown point"),
+    (("duration = 0.01,", ""), "duration", "missing required key"),
+    (("[0.0, 0.1, 0.2]", "[0.0, 0.2, 0.1]"), "time", "increase strictly"),
+    (("force = [0.0, 10.0, 0.0]", "force = [0.0, 10.0]"), "force", "array of 3 numbers"),
+    (("modes = 6", "modes = 0"), "modes", "positive integer"),
+])
+def test_load_file_errors_name_load_and_key(tmp_path, edit, key, words):
+    path = tmp_path / "loads.toml"
+    path.write_text(LOADS.replace(*edit))
+    with pytest.raises(ModelError) as error:
+        load_loads(path, chain())
+    assert error.value.key == key
+    assert words in error.value.message
+    assert str(path) in str(error.value)
+
+
+def test_frf_matches_the_finite_element_modal_sum():
+    """Same truncation (12 modes) on both routes: the modal data agree, not just the frequencies."""
+    fe_module = pytest.importorskip("linmstmm.fe")
+    from test_modes import tree
+
+    model = tree()
+    modes = mode_shapes(model, count=12)
+    fe = fe_module.assemble(model, 24)
+    lam, X, _ = fe_module.fe_modes(fe, 12)
+    vector, damping = np.r_[0.0, 0.3, 1.0, 0.0, 0.0, 0.0], (0.5, 1e-4)
+    frequencies = np.array([5.0, 20.0, 40.0, 75.0])
+    points = list(model.points)
+    got = frf(modes, "tip", vector, frequencies, points, damping).receptance
+    load = np.zeros(fe.n_full)
+    load[fe.dof_index.point("tip")] = vector
+    W = 2 * np.pi * frequencies[:, None]
+    modal = (X.T @ (fe.T.T @ load)) / (lam - W**2 + 1j * W * (damping[0] + damping[1] * lam))
+    full = (fe.T @ (X @ modal.T)).T  # (n_f, n_full)
+    want = np.stack([full[:, fe.dof_index.point(p)] for p in points], axis=1)
+    assert np.abs(got - want).max() < 1e-6 * np.abs(want).max()

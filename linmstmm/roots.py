@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.linalg
-from scipy.optimize import brentq, minimize_scalar
 
 #: Grid points per octave of the scan.
 POINTS_PER_OCTAVE = 32
@@ -51,9 +50,16 @@ def equilibrate(matrix: np.ndarray) -> np.ndarray:
     return rows[:, None] * matrix * cols
 
 
-def nullity(matrix: np.ndarray, tolerance: float = NULL_TOLERANCE) -> int:
-    """Number of singular values of the equilibrated matrix below ``tolerance`` × the largest."""
-    sigma = np.linalg.svd(equilibrate(matrix), compute_uv=False)
+def nullity(matrix: np.ndarray, tolerance: float = NULL_TOLERANCE, scales=None) -> int:
+    """Number of singular values of the equilibrated matrix below ``tolerance`` × the largest.
+
+    scales : (rows, cols) to balance with; default from ``matrix`` itself. At
+    a root, take them from a nearby frequency: balancing exactly there would
+    blow up a row whose only entry vanishes at the root (cos kL of a rod)
+    and hide the singularity.
+    """
+    rows, cols = equilibration(matrix) if scales is None else scales
+    sigma = np.linalg.svd(rows[:, None] * matrix * cols, compute_uv=False)
     return int(np.sum(sigma < tolerance * sigma[0]))
 
 
@@ -119,6 +125,9 @@ class RootFinder:
     SAME_ROOT = 1e-9
     #: Newton steps |μ|/ω that stop shrinking below this have reached the rounding floor.
     STAGNATION = 1e-11
+    #: Newton that has not settled after all iterations but moves less than this
+    #: is accepted as uncertain (refined in mpmath by the caller).
+    UNCERTAIN = 1e-7
     #: Offsets |μ|/ω below this are polished as members of the same cluster.
     CLUSTER_WINDOW = 2e-3
 
@@ -131,103 +140,151 @@ class RootFinder:
         self.points_per_root = points_per_root
         #: root -> relative size of the last Newton step that reached it
         self.last_step: dict[float, float] = {}
+        #: why the search ended early, if it did
+        self.note = ""
 
     def rigid_body_modes(self) -> int:
         """Nullity of Ū_all at ω = 0: zero-frequency (rigid-body) modes."""
         return nullity(self.matrix(np.array([0.0]))[0])
 
-    def _offsets(self, omega: float) -> np.ndarray:
-        """Real generalized eigenvalues μ of (Ū(ω), dŪ/dω), sorted by |μ|."""
-        if not (np.isfinite(omega) and omega > 0):
-            return np.zeros(0)
-        step = 1e-6 * omega
-        A, plus, minus = self.matrix(np.array([omega, omega + step, omega - step]))
-        if not (np.all(np.isfinite(A)) and np.all(np.isfinite(plus)) and np.all(np.isfinite(minus))):
-            return np.zeros(0)
-        rows, cols = equilibration(A)
-        scale = rows[:, None] * cols[None, :]
-        mu = scipy.linalg.eigvals(A * scale, (plus - minus) / (2 * step) * scale)
-        mu = mu[np.isfinite(mu)]
-        real = mu[np.abs(mu.imag) <= 1e-6 * np.abs(mu) + 1e-300].real
-        return real[np.argsort(np.abs(real))]
+    def _offsets(self, omegas) -> list[np.ndarray]:
+        """For each ω: real generalized eigenvalues μ of (Ū(ω), dŪ/dω), sorted by |μ|.
 
-    def polish(self, omega: float, iterations: int = 40):
-        """Converge on the root nearest ``omega``.
-
-        Stops at |μ| <= xtol·ω, or when the steps stop shrinking below
-        STAGNATION·ω (the rounding floor of Ū_all). Returns (root, offsets
-        there), or (None, offsets) if it did not converge.
+        One evaluation of Ū for all ω and their ±1e-6 neighbours (the
+        derivative is a central difference); empty where Ū is not finite.
         """
-        previous = np.inf
+        omegas = np.asarray(omegas, dtype=float)
+        n = omegas.size
+        steps = 1e-6 * omegas
+        stack = self.matrix(np.concatenate([omegas, omegas + steps, omegas - steps]))
+        offsets = []
+        for i in range(n):
+            A, derivative = stack[i], (stack[n + i] - stack[2 * n + i]) / (2 * steps[i])
+            if not (omegas[i] > 0 and np.all(np.isfinite(A)) and np.all(np.isfinite(derivative))):
+                offsets.append(np.zeros(0))
+                continue
+            rows, cols = equilibration(A)
+            scale = rows[:, None] * cols[None, :]
+            mu = scipy.linalg.eigvals(A * scale, derivative * scale)
+            mu = mu[np.isfinite(mu)]
+            real = mu[np.abs(mu.imag) <= 1e-6 * np.abs(mu) + 1e-300].real
+            offsets.append(real[np.argsort(np.abs(real))])
+        return offsets
+
+    def polish(self, starts, iterations: int = 40):
+        """Converge on the root nearest each start, all starts at once.
+
+        Newton for the nonlinear eigenproblem: ω ← ω − μ with μ the offset
+        of smallest size. Stops at |μ| <= xtol·ω, or when the steps stop
+        shrinking below STAGNATION·ω (the rounding floor of Ū_all); gives up
+        on a start whose step twice fails to shrink (not near a root).
+        Returns a list of (root or None if it did not converge, offsets).
+        """
+        omega = np.array(starts, dtype=float)
+        previous = np.full(omega.size, np.inf)
+        setbacks = np.zeros(omega.size, dtype=int)
+        results: list = [(None, np.zeros(0))] * omega.size
+        active = list(range(omega.size))
         for _ in range(iterations):
-            mu = self._offsets(omega)
-            if mu.size == 0:
-                return None, mu
-            step = abs(mu[0])
-            omega -= mu[0]
-            if step <= self.xtol * omega or (step <= self.STAGNATION * omega and step > previous / 2):
-                self.last_step[omega] = step / omega
-                return omega, self._offsets(omega)
-            previous = step
-        return None, mu
+            if not active:
+                break
+            still = []
+            for i, mu in zip(active, self._offsets(omega[active])):
+                if mu.size == 0:
+                    continue
+                step = abs(mu[0])
+                omega[i] -= mu[0]
+                if step <= self.xtol * omega[i] or (step <= self.STAGNATION * omega[i]
+                                                    and step > previous[i] / 2):
+                    self.last_step[omega[i]] = step / omega[i]
+                    results[i] = (omega[i], mu + mu[0])  # offsets moved to the new ω
+                else:
+                    setbacks[i] += step >= previous[i]
+                    previous[i] = step
+                    if setbacks[i] < 2:  # Newton that twice fails to shrink its step is lost
+                        still.append(i)
+            active = still
+        for i in active:  # converging but noisy: accept, and let the caller escalate
+            if previous[i] <= self.UNCERTAIN * omega[i]:
+                self.last_step[omega[i]] = previous[i] / omega[i]
+                results[i] = (omega[i], np.zeros(1))
+        return results
+
+    def clusters(self, starts) -> list[list[float]]:
+        """For each start, every root in the cluster around the root nearest it, ascending.
+
+        The multiplicity of a polished root is the number of offsets μ that
+        vanish there (|μ| < SAME_ROOT·ω: a semisimple root of multiplicity m
+        is an m-fold eigenvalue of the linearised pencil; the singular values
+        of a 60×60 Ū_all are too spread to count on); the other small
+        offsets are polished in turn and kept when they reach another root.
+        """
+        polished = self.polish(starts)
+        groups, members_from = [], []
+        for centre, mu in polished:
+            if centre is None:
+                groups.append([])
+                continue
+            groups.append([centre] * max(int(np.sum(np.abs(mu) < self.SAME_ROOT * centre)), 1))
+            near = mu[(np.abs(mu) < self.CLUSTER_WINDOW * centre) & (np.abs(mu) >= self.SAME_ROOT * centre)]
+            members_from += [(len(groups) - 1, centre - offset) for offset in near]
+        if members_from:
+            for (g, _), (member, _) in zip(members_from, self.polish([s for _, s in members_from])):
+                if member is not None and all(abs(member - r) > self.SAME_ROOT * r for r in groups[g]):
+                    groups[g].append(member)
+        return [sorted(group) for group in groups]
 
     def cluster(self, omega: float) -> list[float]:
-        """Every root in the cluster around the root nearest ``omega``, ascending.
+        """Every root in the cluster around the root nearest ``omega`` (see :meth:`clusters`)."""
+        return self.clusters([omega])[0]
 
-        The multiplicity of the polished root is the numerical null-space
-        dimension of the balanced Ū_all there; the other small offsets μ are
-        polished in turn and kept when they reach a different root.
+    def shrink_brackets(self, lo, hi, width: float = 1e-7) -> np.ndarray:
+        """Midpoints of sign-change brackets (lo_i, hi_i) bisected to ``width``·hi, all at once."""
+        lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
+        if lo.size == 0:
+            return lo
+        sign_lo = self.log_det(lo)[0]
+        while np.any(hi - lo > width * hi):
+            middle = (lo + hi) / 2
+            sign_middle = self.log_det(middle)[0]
+            left = sign_middle * sign_lo < 0
+            hi, lo = np.where(left, middle, hi), np.where(left, lo, middle)
+            sign_lo = np.where(left, sign_lo, sign_middle)
+        return (lo + hi) / 2
+
+    def _roots_in(self, grid, expected: int) -> list[float]:
+        """Roots inside (grid[0], grid[-1]) reached from the scan, up to ``expected`` of them.
+
+        Polishing starts from every sign change bisected to 1e-7 (roots of
+        odd multiplicity; Newton from there cannot wander off), then from local minima of log|det| without a sign
+        change (roots of even multiplicity, close pairs), deepest first, as
+        many as the count says are still missing.
         """
-        centre, mu = self.polish(omega)
-        if centre is None:
-            return []
-        multiplicity = max(nullity(self.matrix(np.array([centre]))[0], MULTIPLICITY_TOLERANCE), 1)
-        roots = [centre] * multiplicity
-        for offset in mu[np.abs(mu) < self.CLUSTER_WINDOW * centre]:
-            if abs(offset) < self.SAME_ROOT * centre:
-                continue
-            member = self.polish(centre - offset)[0]
-            if member is not None and all(abs(member - r) > self.SAME_ROOT * r for r in roots):
-                roots.append(member)
-        return sorted(roots)
-
-    def _refine_sign_change(self, lo, hi, log_lo, log_hi) -> float:
-        reference = max(log_lo, log_hi)
-
-        def scaled_det(omega):
-            sign, log_abs = self.log_det(np.array([omega]))
-            return sign[0] * np.exp(min(log_abs[0] - reference, 700.0))
-
-        # Only a starting point for polish(): a loose tolerance is enough, and
-        # a root of odd multiplicity > 1 is too flat for a tight one.
-        return brentq(scaled_det, lo, hi, xtol=1e-6 * hi, maxiter=200)
-
-    def _candidates(self, grid) -> list[float]:
-        """Starting points: brackets of sign changes and sharp minima of log|det|."""
         sign, log_abs = self.log_det(grid)
-        starts = [self._refine_sign_change(grid[i], grid[i + 1], log_abs[i], log_abs[i + 1])
-                  for i in range(len(grid) - 1) if sign[i] * sign[i + 1] < 0]
-        for i in range(1, len(grid) - 1):
-            is_minimum = log_abs[i] < log_abs[i - 1] and log_abs[i] < log_abs[i + 1]
-            if is_minimum and sign[i - 1] == sign[i] == sign[i + 1]:
-                result = minimize_scalar(lambda w: self.log_det(np.array([w]))[1][0],
-                                         bounds=(grid[i - 1], grid[i + 1]), method="bounded")
-                if nullity(self.matrix(np.array([result.x]))[0], 1e-5):
-                    starts.append(float(result.x))
-        return sorted(starts)
-
-    def _roots_in(self, grid) -> list[float]:
-        """Roots inside (grid[0], grid[-1]) reached from the scan's candidates."""
         found: list[float] = []
-        for start in self._candidates(grid):
-            self._merge(found, self.cluster(start), grid[0], grid[-1])
+        brackets = np.flatnonzero(sign[:-1] * sign[1:] < 0)
+        for members in self.clusters(self.shrink_brackets(grid[brackets], grid[brackets + 1])):
+            self._merge(found, members, grid[0], grid[-1])
+        inner = np.arange(1, len(grid) - 1)
+        minima = inner[(log_abs[inner] < log_abs[inner - 1]) & (log_abs[inner] < log_abs[inner + 1])
+                       & (sign[inner - 1] == sign[inner]) & (sign[inner] == sign[inner + 1])]
+        minima = [i for i in minima[np.argsort(log_abs[minima] - np.maximum(log_abs[minima - 1],
+                                                                            log_abs[minima + 1]))]
+                  if not any(grid[i - 1] < r < grid[i + 1] for r in found)]
+        missing = expected - len(found)
+        if missing > 0 and minima:
+            for members in self.clusters(grid[minima[:2 * missing]]):
+                self._merge(found, members, grid[0], grid[-1])
         return sorted(found)
 
     def _merge(self, found: list[float], members, lo, hi) -> None:
-        """Add the cluster ``members`` inside (lo, hi] to ``found`` unless already there."""
-        members = [m for m in members if lo < m <= hi]
-        if members and not any(abs(members[0] - r) <= self.SAME_ROOT * r for r in found):
-            found += members
+        """Add the roots of a cluster inside (lo, hi] to ``found``, each distinct root once.
+
+        Equal entries of ``members`` are one root's multiplicity and go in together.
+        """
+        for value in sorted(set(m for m in members if lo < m <= hi)):
+            if not any(abs(value - r) <= self.SAME_ROOT * r for r in found):
+                found += [m for m in members if m == value]
 
     def _split_point(self, lo, hi) -> float:
         """A point in the middle half of (lo, hi) where |det| is largest: far from any root."""
@@ -251,7 +308,9 @@ class RootFinder:
             raise RuntimeError(f"cannot separate the {expected} roots in ({lo:.12g}, {hi:.12g}) "
                                f"rad/s in float64 (found {len(inside)}): ask for more digits")
         found = list(found)
-        self._merge(found, self.cluster((lo + hi) / 2), lo, hi)
+        sign_lo, sign_hi = self.log_det(np.array([lo, hi]))[0]
+        start = self.shrink_brackets([lo], [hi])[0] if sign_lo * sign_hi < 0 else (lo + hi) / 2
+        self._merge(found, self.cluster(start), lo, hi)
         inside = sorted(r for r in found if lo < r <= hi)
         if len(inside) == expected:
             return inside
@@ -261,20 +320,34 @@ class RootFinder:
             roots += self._isolate(a, b, count_zeros(self.log_det, a, b), found, depth + 1)
         return sorted(roots)
 
-    def segment(self, lo: float, hi: float) -> list[float]:
+    def segment(self, lo: float, hi: float, expected: int | None = None) -> list[float]:
         """Every root in (lo, hi], rad/s, ascending, repeated per multiplicity.
 
         The argument-principle count says how many there are; a scan with at
         least ``points_per_root`` points per counted root finds them; bisection
         on the count finds any the scan missed.
         """
-        expected = count_zeros(self.log_det, lo, hi)
+        if expected is None:
+            expected = count_zeros(self.log_det, lo, hi)
         if expected == 0:
             return []
         octaves = max(np.log2(hi / lo), 1.0)
         points = max(octaves * self.points_per_octave, self.points_per_root * expected)
         grid = np.geomspace(lo, hi, int(np.ceil(points)) + 1)
-        return self._isolate(lo, hi, expected, self._roots_in(grid))
+        return self._isolate(lo, hi, expected, self._roots_in(grid, expected))
+
+    def _lowest(self, lo: float, hi: float, needed: int | None) -> list[float]:
+        """The roots in (lo, hi], or only enough of the lowest to give ``needed``.
+
+        A segment holding far more roots than needed is halved (geometrically)
+        and its upper half searched only if the lower one falls short.
+        """
+        expected = count_zeros(self.log_det, lo, hi)
+        if needed is not None and expected > 2 * needed + 4 and hi > lo * (1 + 1e-3):
+            middle = float(np.sqrt(lo * hi))
+            lower = self._lowest(lo, middle, needed)
+            return lower if len(lower) >= needed else lower + self._lowest(middle, hi, needed - len(lower))
+        return self.segment(lo, hi, expected)
 
     def find(self, count: int | None, omega_max: float | None,
              omega_start: float = 2 * np.pi) -> list[float]:
@@ -289,7 +362,15 @@ class RootFinder:
         roots: list[float] = []
         lo, hi = OMEGA_FLOOR, min(omega_start, omega_max) if omega_max else omega_start
         while True:
-            roots += self.segment(lo, hi)
+            try:
+                roots += self._lowest(lo, hi, None if count is None else count - len(roots))
+            except RuntimeError as error:
+                if not roots or lo < 100 * roots[-1]:
+                    raise
+                # Far above the last root of a discrete model, Ū_all is dominated by
+                # inertia (ω² m / k beyond 1e15): stop there and say so.
+                self.note = f"search stopped at {lo:.4g} rad/s ({error})"
+                break
             done_by_count = count is not None and len(roots) >= count
             done_by_range = omega_max is not None and hi >= omega_max
             if done_by_count or done_by_range or hi >= OMEGA_CEILING:

@@ -17,7 +17,7 @@ from linmstmm.topology import build_topology
 #: Digits float64 delivers; more are computed in mpmath.
 FLOAT64_DIGITS = 14
 #: A root whose last Newton step was larger than this (relative) is not certified in float64.
-CERTIFIED_STEP = 1e-12
+CERTIFIED_STEP = 1e-11
 #: Digits used when an uncertified root is escalated to mpmath.
 ESCALATION_DIGITS = 20
 
@@ -91,7 +91,7 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         precision = f"mpmath:{wanted}" + ("" if len(chosen) == len(omegas) else f" ({len(set(chosen))} roots)")
     note = ""
     if count is not None and omegas.size < count and fmax is None:
-        note = f"only {omegas.size} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s"
+        note = finder.note or f"only {omegas.size} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s"
     return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.full_order,
                            time.perf_counter() - start, precision=precision, note=note,
                            indeterminate_released=released, frequencies_text=text)

@@ -1,0 +1,148 @@
+"""Numerical stability at the extremes (issue 4), each against a closed form.
+
+Discrete references are the eigenvalues of the K, M matrices written by hand
+in the test and solved in mpmath at 50 digits (independent of the transfer
+matrices); beam references are roots of the classical frequency equations.
+"""
+from __future__ import annotations
+
+import mpmath as mp
+import numpy as np
+import pytest
+from builders import fixed, make_beam, make_rigid, make_spring, single_beam_model
+
+from linmstmm.model import Model
+from linmstmm.solve import natural_frequencies
+
+
+def chain_along_x(masses, stiffnesses, right_end_fixed=False, name="chain"):
+    """ground–k0–m0–k1–m1–…: point masses, isotropic translational springs, rotations locked.
+
+    Every translation direction repeats the 1-D chain, so each frequency is triple.
+    """
+    n = len(masses)
+    points = {"g": np.zeros(3)}
+    rigids, springs = [], []
+    for i, (m, k) in enumerate(zip(masses, stiffnesses)):
+        points[f"a{i}"] = np.array([float(i), 0.0, 0.0])
+        points[f"b{i}"] = np.array([i + 1.0, 0.0, 0.0])
+        before = "g" if i == 0 else f"b{i - 1}"
+        springs.append(make_spring(f"k{i}", before, f"a{i}", [k, k, k, np.inf, np.inf, np.inf]))
+        rigids.append(make_rigid(f"m{i}", [f"a{i}", f"b{i}"], m, [i + 0.5, 0.0, 0.0]))
+    boundary = {"g": fixed()}
+    if right_end_fixed:
+        points["h"] = points[f"b{n - 1}"].copy()
+        k = stiffnesses[n]
+        springs.append(make_spring(f"k{n}", f"b{n - 1}", "h", [k, k, k, np.inf, np.inf, np.inf]))
+        boundary["h"] = fixed()
+    return Model(name, points, rigids=tuple(rigids), springs=tuple(springs), boundary=boundary)
+
+
+def chain_reference_hz(masses, stiffnesses, right_end_fixed=False):
+    """Eigenfrequencies of the 1-D chain from its K and M in mpmath (50 digits), Hz."""
+    with mp.workdps(50):
+        n = len(masses)
+        K = mp.zeros(n, n)
+        for i in range(n):
+            K[i, i] += stiffnesses[i]
+            if i > 0:
+                K[i, i - 1] -= stiffnesses[i]
+                K[i - 1, i] -= stiffnesses[i]
+                K[i - 1, i - 1] += stiffnesses[i]
+        if right_end_fixed:
+            K[n - 1, n - 1] += stiffnesses[n]
+        scale = mp.diag([1 / mp.sqrt(m) for m in masses])
+        eigenvalues = mp.eigsy(scale * K * scale, eigvals_only=True)
+        return np.sort([float(mp.sqrt(v) / (2 * mp.pi)) for v in eigenvalues])
+
+
+@pytest.mark.parametrize("masses, stiffnesses", [
+    pytest.param([2.0, 3.0, 1.5], [1e3, 1e9, 1e13, 1e3], id="stiffness contrasts 1e6 and 1e10"),
+    pytest.param([1.0, 1e6, 1.0], [1e4, 2e4, 3e4, 1e4], id="mass ratios 1e6"),
+])
+def test_contrasts_in_one_model(masses, stiffnesses):
+    reference = np.repeat(chain_reference_hz(masses, stiffnesses, True), 3)
+    got = natural_frequencies(chain_along_x(masses, stiffnesses, True), count=9)
+    np.testing.assert_allclose(got.frequencies_hz, reference, rtol=1e-9)
+
+
+def test_chain_of_2000_rigid_bodies_and_springs():
+    """Uniform fixed–free chain: ω_n = 2√(k/m) sin((2n−1)π / (2(2N+1)))."""
+    n, m, k = 2000, 1.0, 1e6
+    got = natural_frequencies(chain_along_x([m] * n, [k] * n), count=12)
+    modes = np.arange(1, 5)
+    omega = 2 * np.sqrt(k / m) * np.sin((2 * modes - 1) * np.pi / (2 * (2 * n + 1)))
+    np.testing.assert_allclose(got.frequencies_hz, np.repeat(omega / (2 * np.pi), 3), rtol=1e-9)
+
+
+def test_cantilever_first_40_bending_modes_per_plane():
+    """βL up to ≈ 124: the frequency equation cos λ + 1/cosh λ = 0 in mpmath."""
+    L, Iz, Iy = 2.0, 2e-7, 4.5e-7
+    model = single_beam_model(fixed(), None, length=L, Iz=Iz, Iy=Iy, axial=False, torsion=False)
+    beam = model.beams[0]
+    with mp.workdps(40):
+        starts = [1.875, 4.694] + [(2 * n - 1) * mp.pi / 2 for n in range(3, 41)]
+        lambdas = [mp.findroot(lambda x: mp.cos(x) + 1 / mp.cosh(x), x0) for x0 in starts]
+
+        def plane(I):
+            scale = mp.sqrt(mp.mpf(beam.E) * mp.mpf(I) / (mp.mpf(beam.rho) * mp.mpf(beam.A) * mp.mpf(L) ** 4))
+            return [float(lam**2 * scale / (2 * mp.pi)) for lam in lambdas]
+
+        z_plane, y_plane = plane(beam.Iz), plane(beam.Iy)
+    got = natural_frequencies(model, fmax=z_plane[-1] * (1 + 1e-9), count=None)
+    want = np.sort([f for f in z_plane + y_plane if f <= z_plane[-1] * (1 + 1e-9)])
+    assert len(got.frequencies_hz) == len(want) >= 80 - 40 + 1
+    np.testing.assert_allclose(got.frequencies_hz, want, rtol=1e-9)
+
+
+def nafems_fv2_double_cross():
+    """NAFEMS FV2: eight 5 m arms pinned at their ends, 0.125 m square section, in plane.
+
+    The reference values are those of inextensible arms (the 7-fold roots are
+    arms clamped at the centre, pinned outside: 3.9266² / (2π L²) √(EI/ρA));
+    so the arms are axially rigid, and out-of-plane bending is made 1e6 times
+    stiffer and torsion rigid so that only in-plane modes fall below 60 Hz.
+    Rigid arms pinned at both ends leave axial forces statically
+    indeterminate: the solver has to release them.
+    """
+    side = 0.125
+    I = side**4 / 12
+    material = {"E": 200e9, "G": 80e9, "rho": 8000.0}
+    points = {"c": np.zeros(3)}
+    beams = []
+    for i in range(8):
+        angle = i * np.pi / 4
+        points[f"e{i}"] = 5.0 * np.array([np.cos(angle), np.sin(angle), 0.0])
+        beams.append(make_beam(f"arm{i}", "c", f"e{i}", points, A=side**2, Iz=I, Iy=I * 1e6,
+                               J=2.25 * side**4 / 16, material=material, axial=False, torsion=False))
+    boundary = {f"e{i}": fixed("x", "y", "z") for i in range(8)}
+    return Model("NAFEMS FV2", points, beams=tuple(beams), boundary=boundary)
+
+
+def test_nafems_fv2_root_of_multiplicity_seven():
+    """In-plane closed form 11.336, 17.709 (×7), 45.345, 57.390 (×7) Hz (NAFEMS FV2)."""
+    got = natural_frequencies(nafems_fv2_double_cross(), fmax=60.0, count=None)
+    want = np.array([11.336] + [17.709] * 7 + [45.345] + [57.390] * 7)
+    assert got.ubar_order == 48
+    np.testing.assert_allclose(got.frequencies_hz, want, rtol=5e-5)
+    sevens = got.frequencies_hz[1:8]
+    assert np.ptp(sevens) < 1e-9 * sevens[0]
+
+
+def test_near_zero_elastic_modes_next_to_rigid_body_modes():
+    """Two free bodies on a very soft spring at their common mass centre.
+
+    Relative translation: ω² = k (1/m1 + 1/m2); relative rotation about axis i:
+    ω² = k_r (1/J1_i + 1/J2_i). Six rigid-body modes at zero.
+    """
+    m1, m2, k, kr = 2.0, 3.0, 1e-4, 2e-4
+    J1, J2 = np.array([1.0, 2.0, 3.0]), np.array([1.5, 2.5, 0.5])
+    points = {"p": np.zeros(3), "q": np.zeros(3)}
+    model = Model("soft pair", points,
+                  rigids=(make_rigid("one", ["p"], m1, [0, 0, 0], J1),
+                          make_rigid("two", ["q"], m2, [0, 0, 0], J2)),
+                  springs=(make_spring("soft", "p", "q", [k, k, k, kr, kr, kr]),))
+    got = natural_frequencies(model, count=6)
+    want = np.sort(np.r_[[np.sqrt(k * (1 / m1 + 1 / m2))] * 3, np.sqrt(kr * (1 / J1 + 1 / J2))]) / (2 * np.pi)
+    assert got.rigid_body_modes == 6
+    np.testing.assert_allclose(got.frequencies_hz, want, rtol=1e-9)

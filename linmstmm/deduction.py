@@ -30,7 +30,7 @@ import numpy as np
 from linmstmm.elements.beam import beam_transfer
 from linmstmm.elements.frames import FORCE_INDEX
 from linmstmm.elements.rigid import (force_extraction, position_extraction,
-                                     position_incidence, rigid_transfer)
+                                     position_incidence, rigid_transfer_parts)
 from linmstmm.elements.spring import spring_transfer
 from linmstmm.numeric import frequencies, zeros_like_stack
 from linmstmm.topology import Topology
@@ -77,6 +77,7 @@ class Deduction:
 
     def __init__(self, topology: Topology):
         self.topology = topology
+        self._parts: dict[int, tuple] = {}
         self._boundary_columns = {}
         self._cut_columns = {}
         labels = []
@@ -100,20 +101,31 @@ class Deduction:
     def transfer(self, e: int, omega) -> np.ndarray:
         """(n, 12, 12) U_j of element e from its first input to its output."""
         element = self.topology.elements[e]
-        record = element.record
-        inp = element.ports[element.inputs[0]]
-        out = element.ports[element.output]
-        if element.kind == "junction":
-            return np.broadcast_to(np.eye(12), (np.size(omega), 12, 12))
-        if element.kind == "rigid":
-            return rigid_transfer(record.mass, record.com, record.inertia,
-                                  inp.position, out.position, omega)
-        if element.kind == "spring":
-            return spring_transfer(record.k, record.axes, omega)
-        return beam_transfer(record, omega, reverse=element.inputs[0] == 1)
+        if element.kind == "beam":
+            return beam_transfer(element.record, omega, reverse=element.inputs[0] == 1)
+        kinematic, inertial = self._polynomial_parts(e)
+        if inertial is None:
+            return np.broadcast_to(kinematic, (np.size(omega), 12, 12))
+        return kinematic + np.reshape(omega, (-1, 1, 1)) ** 2 * inertial
+
+    def _polynomial_parts(self, e: int):
+        """(U0, U2) with U_j = U0 + ω² U2 for a rigid body, spring or junction (U2 None
+        when constant); built once per element."""
+        if e not in self._parts:
+            element = self.topology.elements[e]
+            record = element.record
+            if element.kind == "rigid":
+                self._parts[e] = rigid_transfer_parts(
+                    record.mass, record.com, record.inertia,
+                    element.ports[element.inputs[0]].position, element.ports[element.output].position)
+            elif element.kind == "spring":
+                self._parts[e] = (spring_transfer(record.k, record.axes, np.zeros(1))[0], None)
+            else:  # junction: a massless rigid body whose ports coincide
+                self._parts[e] = (np.eye(12), None)
+        return self._parts[e]
 
     # -- boundary states ------------------------------------------------------------
-    def _tip_state(self, link, n) -> PortState:
+    def tip_state(self, link, n) -> PortState:
         """State of a boundary end or cut side in terms of its unknowns (less released ones)."""
         if link[0] == "boundary":
             columns = self._boundary_columns[link[1]]
@@ -169,7 +181,7 @@ class Deduction:
             inputs = []
             for p in element.inputs:
                 link = element.ports[p].link
-                inputs.append(open_states.pop(link[1]) if link[0] == "element" else self._tip_state(link, n))
+                inputs.append(open_states.pop(link[1]) if link[0] == "element" else self.tip_state(link, n))
                 if stable and link[0] == "cut":
                     normaliser.consume_cut_side(link[1], self._cut_columns[link[1]])
             out_position = element.ports[element.output].position
@@ -225,7 +237,7 @@ class Deduction:
         ubar = zeros_like_stack(omega, (self.full_order, self.full_order))
         ubar[:, :12, root.columns] += root.matrix
         kind, index = self.topology.root
-        root_given = self._tip_state(self.topology.root if kind == "boundary" else ("cut", index, 0),
+        root_given = self.tip_state(self.topology.root if kind == "boundary" else ("cut", index, 0),
                                      omega.size)
         ubar[:, :12, root_given.columns] -= root_given.matrix
         for r, (_, columns, block) in enumerate(rows):

@@ -35,8 +35,8 @@ import numpy as np
 from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import beam_transfer
 from linmstmm.model import Model
-from linmstmm.roots import NULL_TOLERANCE, RootFinder, equilibration, release_indeterminate
-from linmstmm.topology import build_topology
+from linmstmm.roots import NULL_TOLERANCE, equilibration
+from linmstmm.solve import frequency_finder
 
 #: Normalisations of the modes: unit modal mass, or unit largest translation.
 NORMALIZATIONS = ("mass", "max")
@@ -193,9 +193,7 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         raise ValueError(f"normalization must be one of {NORMALIZATIONS}, got {normalization!r}")
     if stations < 2:
         raise ValueError(f"stations must be >= 2, got {stations}")
-    deduction = Deduction(build_topology(model, root=root))
-    release_indeterminate(deduction)
-    finder = RootFinder(deduction.log_det, lambda omega: deduction.matrix(omega, stable=True)[0])
+    deduction, finder, _ = frequency_finder(model, root)
     omega_max = None if fmax is None else 2 * np.pi * fmax
     eigenspaces = _group(finder.find(None if count is None else count + EIGENSPACE_MARGIN, omega_max))
     if count is not None:  # whole eigenspaces that start within the first ``count`` modes
@@ -466,7 +464,7 @@ def _element_states(deduction: Deduction, omega: np.ndarray, zbar: np.ndarray) -
             elif port.link[0] == "element":
                 ports.append(evaluate(outputs[port.link[1]]))
             else:
-                ports.append(evaluate(deduction._tip_state(port.link, n)))
+                ports.append(evaluate(deduction.tip_state(port.link, n)))
         states.append(np.stack(ports, axis=1))
     return states
 

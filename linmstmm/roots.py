@@ -238,7 +238,7 @@ class RootFinder:
         """Every root in the cluster around the root nearest ``omega`` (see :meth:`clusters`)."""
         return self.clusters([omega])[0]
 
-    def shrink_brackets(self, lo, hi, width: float = 1e-7) -> np.ndarray:
+    def shrink_brackets(self, lo, hi, width: float = 1e-4) -> np.ndarray:
         """Midpoints of sign-change brackets (lo_i, hi_i) bisected to ``width``·hi, all at once."""
         lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
         if lo.size == 0:
@@ -255,8 +255,8 @@ class RootFinder:
     def _roots_in(self, grid, expected: int) -> list[float]:
         """Roots inside (grid[0], grid[-1]) reached from the scan, up to ``expected`` of them.
 
-        Polishing starts from every sign change bisected to 1e-7 (roots of
-        odd multiplicity; Newton from there cannot wander off), then from local minima of log|det| without a sign
+        Polishing starts from every sign change bisected to 1e-4 (roots of
+        odd multiplicity; Newton from there does not wander off), then from local minima of log|det| without a sign
         change (roots of even multiplicity, close pairs), deepest first, as
         many as the count says are still missing.
         """

@@ -62,6 +62,19 @@ class FrequencyResult:
         }
 
 
+def frequency_finder(model: Model, root: str | None = None, cut_at=(), **options):
+    """The deduced system of ``model`` and a root finder on its stable determinant.
+
+    root, cut_at : see :func:`linmstmm.topology.build_topology`. options go to
+    :class:`linmstmm.roots.RootFinder` (xtol, points_per_octave, points_per_root).
+    Returns (deduction, finder, number of indeterminate unknowns released).
+    """
+    deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
+    released = release_indeterminate(deduction)
+    finder = RootFinder(deduction.log_det, lambda omega: deduction.matrix(omega, stable=True)[0], **options)
+    return deduction, finder, released
+
+
 def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None = None,
                         digits: int | None = None, root: str | None = None) -> FrequencyResult:
     """Elastic natural frequencies of ``model`` by the transfer matrix method.
@@ -73,9 +86,7 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     root : boundary end (point name) to use as the root of the transfer tree.
     """
     start = time.perf_counter()
-    deduction = Deduction(build_topology(model, root=root))
-    released = release_indeterminate(deduction)
-    finder = RootFinder(deduction.log_det, lambda omega: deduction.matrix(omega, stable=True)[0])
+    deduction, finder, released = frequency_finder(model, root)
     rigid = finder.rigid_body_modes()
     omega_max = None if fmax is None else 2 * np.pi * fmax
     omegas = np.array(finder.find(count, omega_max))

@@ -21,23 +21,32 @@ from linmstmm.elements.frames import M, Q, R, U, skew
 from linmstmm.numeric import frequencies
 
 
+def rigid_transfer_parts(mass, com, inertia, inp, out) -> tuple[np.ndarray, np.ndarray]:
+    """(kinematic, inertial), each (12, 12): ``U(ω) = kinematic + ω² inertial``.
+
+    mass : kg. com, inp, out : (3,) positions, m. inertia : (3, 3) about the
+    mass centre, kg m².
+    """
+    inp, out, com = (np.asarray(p, dtype=float) for p in (inp, out, com))
+    kinematic = np.eye(12)
+    kinematic[U, R] = -skew(out - inp)
+    kinematic[M, Q] = skew(inp - out)
+    inertial = np.zeros((12, 12))
+    com_from_input = np.hstack([np.eye(3), -skew(com - inp)])  # u_c = this @ (u_I, θ_I)
+    inertial[Q, 0:6] = mass * com_from_input
+    inertial[M, 0:6] = -skew(out - com) @ (mass * com_from_input)
+    inertial[M, R] += np.asarray(inertia, dtype=float)
+    return kinematic, inertial
+
+
 def rigid_transfer(mass, com, inertia, inp, out, omega) -> np.ndarray:
     """Transfer matrix stack (n, 12, 12) from port ``inp`` to port ``out``.
 
     mass : kg. com, inp, out : (3,) positions, m. inertia : (3, 3) about the
     mass centre, kg m². omega : (n,) rad/s.
     """
-    omega2 = frequencies(omega).reshape(-1, 1, 1) ** 2
-    inp, out, com = (np.asarray(p, dtype=float) for p in (inp, out, com))
-    kinematic = np.eye(12)  # the ω-independent part
-    kinematic[U, R] = -skew(out - inp)
-    kinematic[M, Q] = skew(inp - out)
-    inertial = np.zeros((12, 12))  # the part proportional to ω²
-    com_from_input = np.hstack([np.eye(3), -skew(com - inp)])  # u_c = this @ (u_I, θ_I)
-    inertial[Q, 0:6] = mass * com_from_input
-    inertial[M, 0:6] = -skew(out - com) @ (mass * com_from_input)
-    inertial[M, R] += np.asarray(inertia, dtype=float)
-    return kinematic + omega2 * inertial
+    kinematic, inertial = rigid_transfer_parts(mass, com, inertia, inp, out)
+    return kinematic + frequencies(omega).reshape(-1, 1, 1) ** 2 * inertial
 
 
 def force_extraction(inp_k, out) -> np.ndarray:

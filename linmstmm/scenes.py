@@ -1,0 +1,258 @@
+"""Firing scenes of the MLRS-style launcher (seed 003, ``models/mlrs/``).
+
+"Model only what a scene requires": in the scene of tube l (l = 1 … 18, its
+slot in the 3 × 6 bundle) only that tube is flexible — two Euler beams on a
+rear and a front elastic support, with the breech body on its rear end. The
+other seventeen tubes are rigid masses lumped into the cradle. A scene
+therefore moves the flexible tube's points to slot l and rebuilds the
+cradle's mass, mass centre and inertia by parallel-axis sums of the empty
+cradle frame and the seventeen lumped tubes; rockets already fired leave
+their tubes lighter in the same sums.
+
+``bundle.toml`` beside the model file describes the bundle: the slot grid,
+the slot of the model file's own flexible tube, the names of the cradle and
+of the flexible tube's elements, the empty cradle frame and the rocket mass
+(smeared over the tube beams in the model file).
+"""
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from linmstmm.model import Model, load_model
+from linmstmm.solve import natural_frequencies
+
+
+@dataclass(frozen=True)
+class MassProps:
+    """Mass (kg), mass centre (3,) m and inertia tensor (3, 3) kg m² about it, inertial axes."""
+
+    mass: float
+    com: np.ndarray
+    inertia: np.ndarray
+
+    def origin_tensor(self) -> np.ndarray:
+        """Inertia tensor about the inertial origin (parallel-axis theorem)."""
+        c = self.com
+        return self.inertia + self.mass * (c @ c * np.eye(3) - np.outer(c, c))
+
+    def __add__(self, other: MassProps) -> MassProps:
+        return _from_origin(self.mass + other.mass, self.mass * self.com + other.mass * other.com,
+                            self.origin_tensor() + other.origin_tensor())
+
+    def __sub__(self, other: MassProps) -> MassProps:
+        return _from_origin(self.mass - other.mass, self.mass * self.com - other.mass * other.com,
+                            self.origin_tensor() - other.origin_tensor())
+
+    def scaled(self, factor: float) -> MassProps:
+        """The same shape with ``factor`` times the density."""
+        return MassProps(factor * self.mass, self.com, factor * self.inertia)
+
+    def shifted(self, offset) -> MassProps:
+        """The same body translated by ``offset`` (m)."""
+        return MassProps(self.mass, self.com + offset, self.inertia)
+
+
+def _from_origin(mass, first_moment, origin_tensor) -> MassProps:
+    """MassProps from the mass, the first moment Σ m c and the inertia tensor about the origin."""
+    com = first_moment / mass
+    inertia = origin_tensor - mass * (com @ com * np.eye(3) - np.outer(com, com))
+    return MassProps(mass, com, (inertia + inertia.T) / 2)
+
+
+def rigid_props(rigid) -> MassProps:
+    """Mass properties of a Rigid record."""
+    return MassProps(rigid.mass, np.asarray(rigid.com, float), np.asarray(rigid.inertia, float))
+
+
+def beam_props(beam, points) -> MassProps:
+    """Mass properties of a Beam record moving rigidly.
+
+    Euler beams carry no rotary inertia in bending, so the rigid limit is a
+    slender rod: m L²/12 about the transverse axes and ρ Ip L about its own axis.
+    """
+    a, b = (np.asarray(points[p], float) for p in beam.ends)
+    along = np.outer(beam.axes[0], beam.axes[0])
+    inertia = (beam.rho * beam.Ip * beam.length * along
+               + beam.mass * beam.length**2 / 12 * (np.eye(3) - along))
+    return MassProps(beam.mass, (a + b) / 2, inertia)
+
+
+def tube_frame(along) -> np.ndarray:
+    """(3, 3) rows: along the tubes, lateral (left, e_Z × along), normal (upwards)."""
+    along = np.asarray(along, float) / np.linalg.norm(along)
+    lateral = np.cross([0.0, 0.0, 1.0], along)
+    lateral /= np.linalg.norm(lateral)
+    return np.array([along, lateral, np.cross(along, lateral)])
+
+
+@dataclass(frozen=True)
+class Bundle:
+    """The tube bundle of a ``bundle.toml``.
+
+    rows × columns slots; tube l = (row − 1) · columns + column, row 1 on
+    top, column 1 on the left; spacings in m. base_tube : the slot of the
+    model file's flexible tube. cradle : name of the cradle body. tube :
+    names of the flexible tube's elements (beams, bodies, supports).
+    frame_mass (kg), frame_com (3,) m, frame_inertia (3,) kg m²: the empty
+    cradle frame, principal moments about the tube axes (along, lateral,
+    normal). rocket_mass : kg, smeared over the tube's beams.
+    """
+
+    rows: int
+    columns: int
+    row_spacing: float
+    column_spacing: float
+    base_tube: int
+    cradle: str
+    tube: tuple[str, ...]
+    frame_mass: float
+    frame_com: np.ndarray
+    frame_inertia: np.ndarray
+    rocket_mass: float
+
+    @property
+    def slots(self) -> range:
+        """All tube numbers, 1 … rows · columns."""
+        return range(1, self.rows * self.columns + 1)
+
+    def grid(self, tube: int) -> tuple[int, int]:
+        """(row, column) of slot ``tube``, both counted from 1."""
+        if tube not in self.slots:
+            raise ValueError(f"tube {tube} is not a slot of the {self.rows} x {self.columns} "
+                             f"bundle (1 … {len(self.slots)})")
+        row, column = divmod(tube - 1, self.columns)
+        return row + 1, column + 1
+
+    def offset(self, tube: int, axes: np.ndarray) -> np.ndarray:
+        """(3,) m: slot ``tube`` relative to the base slot; ``axes`` from :func:`tube_frame`."""
+        row, column = self.grid(tube)
+        row0, column0 = self.grid(self.base_tube)
+        return ((column0 - column) * self.column_spacing * axes[1]
+                + (row0 - row) * self.row_spacing * axes[2])
+
+    def frame(self, axes: np.ndarray) -> MassProps:
+        """The empty cradle frame in inertial axes."""
+        return MassProps(self.frame_mass, self.frame_com,
+                         axes.T @ np.diag(self.frame_inertia) @ axes)
+
+
+def load_bundle(path) -> Bundle:
+    """Read a ``bundle.toml`` (see ``models/mlrs/bundle.toml``)."""
+    with open(path, "rb") as stream:
+        data = tomllib.load(stream)
+    grid, frame = data["grid"], data["frame"]
+    return Bundle(grid["rows"], grid["columns"], grid["row_spacing"], grid["column_spacing"],
+                  grid["base_tube"], data["cradle"], tuple(data["tube"]),
+                  float(frame["mass"]), np.array(frame["com"], float),
+                  np.array(frame["inertia_tube_axes"], float), float(data["rocket"]["mass"]))
+
+
+def bundle_beside(model: Model) -> Bundle:
+    """The ``bundle.toml`` in the directory of the model file."""
+    if model.source is None:
+        raise ValueError(f"model {model.name!r} has no file, so no bundle.toml beside it: "
+                         "pass bundle= explicitly")
+    return load_bundle(Path(model.source).with_name("bundle.toml"))
+
+
+def tube_axes(model: Model, bundle: Bundle) -> np.ndarray:
+    """Tube frame (along, lateral, normal) of the flexible tube's first beam."""
+    beam = next(b for b in model.beams if b.name in bundle.tube)
+    return tube_frame(beam.axes[0])
+
+
+def loaded_tube(model: Model, bundle: Bundle) -> tuple[MassProps, MassProps]:
+    """(whole loaded tube, its rocket) as rigid masses in the base slot.
+
+    The rocket is smeared uniformly over the tube's beams, so it is the
+    beams' mass properties scaled by rocket mass / beam mass.
+    """
+    parts = [model.element(name) for name in bundle.tube]
+    beams = [beam_props(p, model.points) for p in parts if p.kind == "beam"]
+    bodies = [rigid_props(p) for p in parts if p.kind == "rigid"]
+    beam_total = sum(beams[1:], beams[0])
+    return sum(bodies, beam_total), beam_total.scaled(bundle.rocket_mass / beam_total.mass)
+
+
+def cradle_props(model: Model, bundle: Bundle, tube: int,
+                 rockets_fired=frozenset()) -> MassProps:
+    """The cradle of scene ``tube``: frame + every other tube, rocket-less where fired."""
+    axes = tube_axes(model, bundle)
+    loaded, rocket = loaded_tube(model, bundle)
+    total = bundle.frame(axes)
+    for slot in bundle.slots:
+        if slot != tube:
+            lumped = loaded - rocket if slot in rockets_fired else loaded
+            total = total + lumped.shifted(bundle.offset(slot, axes))
+    return total
+
+
+def scene_model(base, tube: int, rockets_fired=frozenset(), bundle: Bundle | None = None) -> Model:
+    """The model of the scene where tube ``tube`` fires.
+
+    base : a Model or a model file path (``bundle.toml`` is read beside it
+    unless ``bundle`` is given). rockets_fired : slots whose rockets are gone
+    (not ``tube`` itself: the firing tube is loaded).
+    """
+    model = base if isinstance(base, Model) else load_model(base)
+    bundle = bundle or bundle_beside(model)
+    fired = frozenset(rockets_fired)
+    if tube in fired:
+        raise ValueError(f"tube {tube} fires in this scene, so its rocket cannot be already fired")
+    unknown = sorted(fired - set(bundle.slots))
+    if unknown:
+        raise ValueError(f"rockets_fired: {unknown} are not slots of the bundle (1 … {len(bundle.slots)})")
+    offset = bundle.offset(tube, tube_axes(model, bundle))
+    moving = set()
+    for element in map(model.element, bundle.tube):
+        moving.update(element.ports if element.kind == "rigid" else element.ends)
+    points = {name: _frozen(p + offset) if name in moving else p
+              for name, p in model.points.items()}
+    cradle = cradle_props(model, bundle, tube, fired)
+    rigids = []
+    for rigid in model.rigids:
+        if rigid.name == bundle.cradle:
+            rigid = dataclasses.replace(rigid, mass=cradle.mass, com=_frozen(cradle.com),
+                                        inertia=_frozen(cradle.inertia))
+        elif rigid.name in bundle.tube:
+            rigid = dataclasses.replace(rigid, com=_frozen(rigid.com + offset))
+        rigids.append(rigid)
+    name = f"{model.name}, tube {tube} firing"
+    if fired:
+        name += f", rockets {', '.join(map(str, sorted(fired)))} fired"
+    return dataclasses.replace(model, name=name, points=points, rigids=tuple(rigids))
+
+
+def salvo(tube: int) -> frozenset:
+    """Rockets gone when tube ``tube`` fires in a salvo in slot order 1, 2, …"""
+    return frozenset(range(1, tube))
+
+
+def scene_sweep(base, count: int = 6, tubes=range(1, 19), fired=None,
+                bundle: Bundle | None = None) -> list:
+    """[(tube, frequencies in Hz)] of the scenes of ``tubes``.
+
+    base : a Model or a model file path. The file and its bundle are read
+    and validated once; each scene only moves the tube and rebuilds the
+    cradle. fired : callable tube -> slots already fired (e.g. :func:`salvo`),
+    default none. bundle : default the ``bundle.toml`` beside the model file.
+    """
+    model = base if isinstance(base, Model) else load_model(base)
+    bundle = bundle or bundle_beside(model)
+    results = []
+    for tube in tubes:
+        scene = scene_model(model, tube, fired(tube) if fired else frozenset(), bundle)
+        results.append((tube, natural_frequencies(scene, count=count).frequencies_hz))
+    return results
+
+
+def _frozen(array) -> np.ndarray:
+    """A read-only float copy, like the records of :func:`linmstmm.model.load_model`."""
+    array = np.array(array, dtype=float)
+    array.flags.writeable = False
+    return array

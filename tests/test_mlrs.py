@@ -1,0 +1,142 @@
+"""The MLRS-style launcher (models/mlrs/) and its firing scenes (linmstmm.scenes).
+
+Seed 003: eight boundary ends and one closed loop give Ū_all of order 60, and
+the first six natural frequencies lie in 2-6 Hz. A scene only changes how the
+same launcher is modelled (which tube is flexible), so the whole launcher's
+mass, mass centre and inertia must not change from scene to scene.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from linmstmm.deduction import Deduction
+from linmstmm.model import load_model
+from linmstmm.scenes import (beam_props, bundle_beside, cradle_props, rigid_props, salvo,
+                             scene_model, scene_sweep)
+from linmstmm.solve import natural_frequencies
+from linmstmm.topology import build_topology
+
+MODEL = Path(__file__).resolve().parents[1] / "models" / "mlrs" / "mlrs.toml"
+
+
+@pytest.fixture(scope="module")
+def model():
+    return load_model(MODEL)
+
+
+@pytest.fixture(scope="module")
+def bundle(model):
+    return bundle_beside(model)
+
+
+@pytest.fixture(scope="module")
+def mstmm(model):
+    return natural_frequencies(model, count=10)
+
+
+def whole(model):
+    """Mass properties of the whole launcher moving rigidly."""
+    parts = [rigid_props(r) for r in model.rigids] + [beam_props(b, model.points) for b in model.beams]
+    return sum(parts[1:], parts[0])
+
+
+def test_topology_is_the_seeds(model):
+    topology = build_topology(model)
+    labels = sorted(b.label for b in topology.boundaries)
+    assert labels == sorted(["breech free end", "muzzle"] + [f"ground{i}" for i in range(1, 7)])
+    assert all(b.fixed.all() for b in topology.boundaries if b.label.startswith("ground"))
+    assert len(topology.cuts) == 1
+    assert Deduction(topology).order == 60
+
+
+def test_about_twenty_tonnes(model):
+    assert 19e3 < whole(model).mass < 21e3
+
+
+def test_file_cradle_is_frame_plus_lumped_tubes(model, bundle):
+    """The cradle in mlrs.toml is what the scene code builds for the base tube."""
+    cradle = rigid_props(model.element("cradle"))
+    built = cradle_props(model, bundle, bundle.base_tube)
+    assert built.mass == pytest.approx(cradle.mass, rel=1e-6)
+    np.testing.assert_allclose(built.com, cradle.com, atol=1e-6)
+    np.testing.assert_allclose(built.inertia, cradle.inertia, atol=1e-6 * np.abs(cradle.inertia).max())
+
+
+def test_smeared_rocket_leaves_steel(model, bundle):
+    """The tube beams' density is steel plus the bundle's rocket smeared over them."""
+    beams = [model.element(name) for name in ("tube_aft", "tube_fore")]
+    length = sum(b.length for b in beams)
+    assert length == pytest.approx(4.4, abs=1e-5)
+    steel = beams[0].rho - bundle.rocket_mass / (beams[0].A * length)
+    assert steel == pytest.approx(7850.0, rel=1e-5)
+
+
+@pytest.mark.parametrize("tube", [1, 6, 8, 13, 18])
+def test_scene_models_the_same_launcher(model, bundle, tube):
+    """Same rigid-body mass properties as the base scene (the file's cradle is rounded)."""
+    scene = scene_model(model, tube)
+    assert Deduction(build_topology(scene)).order == 60
+    for spring in scene.springs:
+        a, b = (scene.points[p] for p in spring.ends)
+        np.testing.assert_allclose(a, b, atol=1e-9)
+    for beam in scene.beams:
+        a, b = (scene.points[p] for p in beam.ends)
+        assert np.linalg.norm(b - a) == pytest.approx(beam.length, abs=1e-9)
+    reference, moved = whole(scene_model(model, bundle.base_tube)), whole(scene)
+    assert moved.mass == pytest.approx(reference.mass, rel=1e-12)
+    np.testing.assert_allclose(moved.com, reference.com, atol=1e-9)
+    np.testing.assert_allclose(moved.inertia, reference.inertia, atol=1e-9 * reference.inertia.max())
+
+
+def test_scene_moves_the_tube_to_its_slot(model, bundle):
+    """Tube 18 (bottom right) sits two rows down and five columns right of tube 1."""
+    scene = scene_model(model, 18)
+    shift = scene.points["muzzle"] - model.points["muzzle"]
+    along = model.element("tube_aft").axes[0]
+    assert shift @ along == pytest.approx(0.0, abs=1e-12)
+    assert shift[1] == pytest.approx(-5 * bundle.column_spacing)
+    assert np.linalg.norm(shift) == pytest.approx(np.hypot(5 * 0.30, 2 * 0.30))
+    assert scene.points["trunnion_cradle"] is model.points["trunnion_cradle"]
+
+
+def test_fired_rockets_lighten_the_cradle(model, bundle):
+    scene = scene_model(model, 5, salvo(5))
+    assert whole(model).mass - whole(scene).mass == pytest.approx(4 * bundle.rocket_mass)
+    with pytest.raises(ValueError, match="fires in this scene"):
+        scene_model(model, 5, {5})
+    with pytest.raises(ValueError, match="not slots"):
+        scene_model(model, 5, {19})
+    with pytest.raises(ValueError, match="not a slot"):
+        scene_model(model, 0)
+
+
+def test_first_six_in_the_seeds_band(mstmm):
+    assert mstmm.ubar_order == 60
+    assert mstmm.rigid_body_modes == 0
+    assert np.all((mstmm.frequencies_hz[:6] > 2.0) & (mstmm.frequencies_hz[:6] < 6.0))
+
+
+def test_agrees_with_finite_elements(model, mstmm):
+    fe = pytest.importorskip("linmstmm.fe", reason="the finite-element route is not available yet")
+    reference = fe.fe_frequencies(model, count=10).frequencies_hz
+    np.testing.assert_allclose(mstmm.frequencies_hz, reference, rtol=1e-7)
+
+
+def test_sweep_over_a_salvo(model, mstmm):
+    """Scene 1 is the model file (whose cradle is rounded to 7 digits); by tube 18,
+    17 rockets are gone and every mode is higher."""
+    (_, first), (_, last) = scene_sweep(model, count=6, tubes=[1, 18], fired=salvo)
+    np.testing.assert_allclose(first, mstmm.frequencies_hz[:6], rtol=1e-6)
+    assert np.all(last > 1.05 * first)
+
+
+@pytest.mark.parametrize("tube, fired", [(18, frozenset()), (13, salvo(13))])
+def test_scene_agrees_with_finite_elements(model, tube, fired):
+    fe = pytest.importorskip("linmstmm.fe", reason="the finite-element route is not available yet")
+    scene = scene_model(model, tube, fired)
+    reference = fe.fe_frequencies(scene, count=10).frequencies_hz
+    np.testing.assert_allclose(natural_frequencies(scene, count=10).frequencies_hz, reference,
+                               rtol=1e-7)

@@ -349,6 +349,27 @@ class RootFinder:
             return lower if len(lower) >= needed else lower + self._lowest(middle, hi, needed - len(lower))
         return self.segment(lo, hi, expected)
 
+    def find_near(self, guesses, count: int) -> list[float]:
+        """The lowest ``count`` roots, warm-started from ``guesses`` (rad/s).
+
+        Guesses (e.g. the roots of a neighbouring scene of the same model) are
+        polished all at once; the result stands only if one count over
+        (OMEGA_FLOOR, just above the count-th root) confirms that none was
+        missed. Otherwise the full search runs.
+        """
+        found: list[float] = []
+        for members in self.clusters(guesses):
+            self._merge(found, members, OMEGA_FLOOR, np.inf)
+        found = sorted(found)
+        if len(found) >= count:
+            top = found[count - 1]
+            above = [r for r in found if r > top * (1 + self.SAME_ROOT)]
+            upper = (top + above[0]) / 2 if above else top * 1.01
+            below = [r for r in found if r <= upper]
+            if count_zeros(self.log_det, OMEGA_FLOOR, upper) == len(below):
+                return below[:count]
+        return self.find(count, None)
+
     def find(self, count: int | None, omega_max: float | None,
              omega_start: float = 2 * np.pi) -> list[float]:
         """Elastic roots (rad/s) ascending, each repeated per multiplicity.

@@ -234,8 +234,13 @@ def salvo(tube: int) -> frozenset:
 
 
 def scene_sweep(base, count: int = 6, tubes=range(1, 19), fired=None,
-                bundle: Bundle | None = None) -> list:
+                bundle: Bundle | None = None, warm_start: bool = True) -> list:
     """[(tube, frequencies in Hz)] of the scenes of ``tubes``.
+
+    warm_start : start each scene's root search from the previous scene's
+    frequencies (polished, then confirmed by one root count; a full search
+    if the count disagrees). Scenes differ only in one tube's position and
+    the cradle's inertia, so the roots move little.
 
     base : a Model or a model file path. The file and its bundle are read
     and validated once; each scene only moves the tube and rebuilds the
@@ -245,9 +250,12 @@ def scene_sweep(base, count: int = 6, tubes=range(1, 19), fired=None,
     model = base if isinstance(base, Model) else load_model(base)
     bundle = bundle or bundle_beside(model)
     results = []
+    guess = None
     for tube in tubes:
         scene = scene_model(model, tube, fired(tube) if fired else frozenset(), bundle)
-        results.append((tube, natural_frequencies(scene, count=count).frequencies_hz))
+        frequencies = natural_frequencies(scene, count=count, guess_hz=guess).frequencies_hz
+        results.append((tube, frequencies))
+        guess = frequencies if warm_start else None
     return results
 
 

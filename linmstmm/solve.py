@@ -76,7 +76,8 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), **options
 
 
 def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None = None,
-                        digits: int | None = None, root: str | None = None) -> FrequencyResult:
+                        digits: int | None = None, root: str | None = None,
+                        guess_hz=None) -> FrequencyResult:
     """Elastic natural frequencies of ``model`` by the transfer matrix method.
 
     count : the lowest N; fmax : Hz, all up to fmax; both: whichever stops first.
@@ -84,12 +85,17 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     refined in mpmath. Without it, roots float64 cannot certify are refined
     at ESCALATION_DIGITS automatically.
     root : boundary end (point name) to use as the root of the transfer tree.
+    guess_hz : frequencies of a similar model (a neighbouring scene) to start
+    from; used with ``count`` only, and checked by a root count either way.
     """
     start = time.perf_counter()
     deduction, finder, released = frequency_finder(model, root)
     rigid = finder.rigid_body_modes()
     omega_max = None if fmax is None else 2 * np.pi * fmax
-    omegas = np.array(finder.find(count, omega_max))
+    if guess_hz is not None and count is not None and fmax is None:
+        omegas = np.array(finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count))
+    else:
+        omegas = np.array(finder.find(count, omega_max))
     precision, text = "float64", None
     uncertain = sorted({w for w in omegas if finder.last_step.get(w, 0.0) > CERTIFIED_STEP})
     wanted = digits if digits and digits > FLOAT64_DIGITS else (ESCALATION_DIGITS if uncertain else None)

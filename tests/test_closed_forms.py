@@ -126,3 +126,11 @@ def test_spring_mass_chain_exact(root):
     omega2 = np.array([(4 - np.sqrt(7)) / 3, (4 + np.sqrt(7)) / 3]) * k / m
     np.testing.assert_allclose(got.frequencies_hz, np.repeat(np.sqrt(omega2) / (2 * np.pi), 3), rtol=1e-12)
     assert got.ubar_order == 12
+
+
+def test_a_misleading_guess_falls_back_to_the_full_search():
+    """A warm start that misses roots is caught by the root count."""
+    model = spring_mass_chain()
+    cold = natural_frequencies(model, count=6)
+    warm = natural_frequencies(model, count=6, guess_hz=[cold.frequencies_hz[-1]])
+    np.testing.assert_allclose(warm.frequencies_hz, cold.frequencies_hz, rtol=1e-12)

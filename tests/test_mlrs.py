@@ -140,3 +140,12 @@ def test_scene_agrees_with_finite_elements(model, tube, fired):
     reference = fe.fe_frequencies(scene, count=10).frequencies_hz
     np.testing.assert_allclose(natural_frequencies(scene, count=10).frequencies_hz, reference,
                                rtol=1e-7)
+
+
+def test_warm_started_sweep_equals_cold_sweep():
+    """Scenes started from the previous scene's roots give the cold search's roots."""
+    tubes = [1, 7, 18]
+    warm = scene_sweep(MODEL, count=6, tubes=tubes, warm_start=True)
+    cold = scene_sweep(MODEL, count=6, tubes=tubes, warm_start=False)
+    for (_, w), (_, c) in zip(warm, cold):
+        np.testing.assert_allclose(w, c, rtol=1e-10)

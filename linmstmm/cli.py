@@ -110,3 +110,6 @@ def main(argv=None) -> int:
     except (ComputationError, RuntimeError) as error:
         print(f"linmstmm: computation failed: {error}", file=sys.stderr)
         return 1
+    except BrokenPipeError:  # output piped into head & co.: stop quietly
+        sys.stderr.close()
+        return 0

@@ -1,0 +1,106 @@
+"""Mode shapes as a universal file (UFF): geometry as dataset 15, modes as dataset 55.
+
+The file opens with one dataset 15 (nodes) holding the model's connection
+points, numbered 1, 2, … in the model's point order, followed by one
+dataset 55 (data at nodes) per mode: real normal-mode data with six values
+per node (ux, uy, uz, θx, θy, θz in the global frame). Record layouts follow
+the SDRC / I-DEAS universal file descriptions, as read by pyuff and modal
+test software:
+
+Every dataset is delimited by ``-1`` lines (I6) and starts with its number (I6).
+
+Dataset 15, one record per node, FORMAT(4I10, 1P3E13.5): node label,
+definition coordinate system (0 = global), displacement coordinate system
+(0), colour, x, y, z.
+
+Dataset 55, per mode:
+
+* records 1–5, FORMAT(40A2): five 80-character ID lines;
+* record 6, FORMAT(6I10): model type 1 (structural), analysis type 2 (normal
+  mode), data characteristic 3 (6 DOF global translation & rotation), specific
+  data type 8 (displacement), data type 2 (real), 6 values per node;
+* record 7, FORMAT(8I10): 2 integer and 4 real values follow, load case 1,
+  mode number;
+* record 8, FORMAT(6E13.5): frequency (Hz), modal mass, modal viscous damping
+  ratio, modal hysteretic damping ratio (0);
+* records 9 and 10 per node: FORMAT(I10) node label, FORMAT(6E13.5) the six values.
+
+Units are SI (m, rad, kg). The modal mass belongs to the shapes as written
+(``ModalResult.normalization``); the viscous damping ratio is
+ζ_k = (α + β ω_k²) / (2 ω_k) for the model's ``[damping]`` (0 without it, and
+for rigid-body modes).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from linmstmm.model import Model
+from linmstmm.modes import ModalResult
+from linmstmm.response import modal_damping
+
+#: Record 6 of dataset 55: structural, normal mode, 6 DOF global translation &
+#: rotation, displacement, real, six values per node.
+MODE_DEFINITION = (1, 2, 3, 8, 2, 6)
+#: Colour of the nodes in dataset 15.
+NODE_COLOR = 1
+#: Values this small are written as 0: E13.5 has room for two exponent digits only.
+_SMALLEST = 1e-99
+
+
+def write_uff(result: ModalResult, model: Model, path) -> dict[str, int]:
+    """Write the modes of ``result`` (of ``model``) to the universal file ``path``.
+
+    Returns the node label of every point (point name -> label, from 1).
+    """
+    labels = {point: label for label, point in enumerate(model.points, start=1)}
+    ratios = _damping_ratios(result.omega, model.damping)
+    lines = _dataset(15, [_integers(label, 0, 0, NODE_COLOR) + _reals(model.points[point])
+                          for point, label in labels.items()])
+    for k in range(result.omega.size):
+        lines += _dataset(55, _mode_records(result, model, k, labels, ratios[k]))
+    with open(path, "w", encoding="ascii") as file:
+        file.write("\n".join(lines) + "\n")
+    return labels
+
+
+def _mode_records(result: ModalResult, model: Model, k: int, labels: dict, ratio: float) -> list[str]:
+    """Records 1–10 of dataset 55 for mode ``k``."""
+    frequency = result.natural_freq[k]
+    ids = [model.name,
+           f"mode {k + 1}: {frequency:.9g} Hz, {result.normalization} normalisation",
+           "linmstmm: MSTMM normal modes at the connection points, SI units (m, rad, kg)",
+           "NONE", "NONE"]
+    records = [_text(line) for line in ids]
+    records += [_integers(*MODE_DEFINITION), _integers(2, 4, 1, k + 1),
+                _reals([frequency, result.modal_mass[k], ratio, 0.0])]
+    for point, label in labels.items():
+        records += [_integers(label), _reals(result.point_displacements[point][k])]
+    return records
+
+
+def _damping_ratios(omega: np.ndarray, damping) -> np.ndarray:
+    """(n,) viscous damping ratios c_k / (2 ω_k); 0 for rigid-body modes."""
+    rate = modal_damping(omega, damping)
+    return np.divide(rate, 2 * omega, out=np.zeros_like(omega), where=omega > 0)
+
+
+def _dataset(number: int, records: list[str]) -> list[str]:
+    """Lines of one dataset: delimiter, number, records, delimiter."""
+    return [f"{-1:6d}", f"{number:6d}", *records, f"{-1:6d}"]
+
+
+def _text(line: str) -> str:
+    """An 80-character ID line (FORMAT 40A2), ASCII only."""
+    return line.encode("ascii", "replace").decode("ascii")[:80].ljust(80)
+
+
+def _integers(*values) -> str:
+    """One record of I10 fields."""
+    return "".join(f"{int(value):10d}" for value in values)
+
+
+def _reals(values) -> str:
+    """One record of E13.5 fields (at most six)."""
+    values = np.asarray(values, dtype=float)
+    values = np.where(np.abs(values) < _SMALLEST, 0.0, values)
+    return "".join(f"{value:13.5E}" for value in values)

@@ -1,0 +1,291 @@
+"""Figures (linmstmm.plot), the commands modes / scan / response / frf and the scripts.
+
+Every figure command must write its files: PNGs and GIFs are checked by
+their signatures (and the GIF's frame count). The commands run through
+``cli.main`` on a parser with :func:`add_mode_commands` registered, whether
+or not cli.py wires them in yet; one subprocess test runs the real command
+line once it does.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from builders import fixed, single_beam_model
+from PIL import Image
+
+from linmstmm import cli
+from linmstmm.mode_commands import add_mode_commands, align_eigenspaces
+from linmstmm.model import load_model
+from linmstmm.modes import mac_matrix, mode_shapes
+from linmstmm.plot import (AMPLITUDE, _scene, animate_mode, plot_frf, plot_mac, plot_mode,
+                           plot_response, plot_scan, significant_components)
+from linmstmm.response import PointLoad, frf, modal_response, step
+
+ROOT = Path(__file__).resolve().parents[1]
+CANTILEVER = str(ROOT / "models/cantilever_tip_mass.toml")
+CHAIN = str(ROOT / "models/spring_mass_chain.toml")
+STEP = str(ROOT / "models/loads/cantilever_step.toml")
+PNG = b"\x89PNG\r\n\x1a\n"
+GIF = (b"GIF87a", b"GIF89a")
+
+
+def is_png(path) -> bool:
+    return Path(path).read_bytes()[:8] == PNG
+
+
+@pytest.fixture(scope="module")
+def cantilever():
+    model = load_model(CANTILEVER)
+    return model, mode_shapes(model, 4, normalization="max")
+
+
+@pytest.fixture(scope="module")
+def chain():
+    model = load_model(CHAIN)
+    return model, mode_shapes(model, 3)
+
+
+# --- the figure functions -------------------------------------------------------------
+
+@pytest.mark.parametrize("which", ["cantilever", "chain"])
+def test_mode_figure_is_a_png(tmp_path, request, which):
+    model, modes = request.getfixturevalue(which)
+    plot_mode(modes, model, 0, tmp_path / "mode.png")
+    assert is_png(tmp_path / "mode.png")
+
+
+def test_largest_drawn_translation_is_a_tenth_of_the_model(cantilever):
+    model, modes = cantilever
+    scene = _scene(modes, model, 2)
+    drawn = np.linalg.norm(scene.scale * scene.segment_motion, axis=-1).max()
+    assert drawn == pytest.approx(AMPLITUDE * 2.0)  # the arm is 2 m long
+    assert "mode 3" in scene.title and "50.899" in scene.title
+
+
+def test_rotation_only_mode_is_drawn_undeformed(tmp_path):
+    """A shaft's torsion mode moves nothing off its axis."""
+    model = single_beam_model(fixed(), None, Iz=1.0, Iy=1.0, J=2e-7, Ip=4e-7, axial=False)
+    modes = mode_shapes(model, 1)
+    scene = _scene(modes, model, 0)
+    assert scene.scale == 0 and "rotation only" in scene.title
+    plot_mode(modes, model, 0, tmp_path / "torsion.png")
+    assert is_png(tmp_path / "torsion.png")
+
+
+def test_mode_index_out_of_range(cantilever, tmp_path):
+    model, modes = cantilever
+    with pytest.raises(IndexError):
+        plot_mode(modes, model, modes.omega.size, tmp_path / "none.png")
+
+
+def test_animation_is_a_gif_with_every_frame(chain, tmp_path):
+    model, modes = chain
+    animate_mode(modes, model, 1, tmp_path / "mode.gif", frames=5)
+    assert (tmp_path / "mode.gif").read_bytes()[:6] in GIF
+    with Image.open(tmp_path / "mode.gif") as image:
+        assert image.n_frames == 5
+
+
+def test_scan_figure(tmp_path):
+    omegas = np.linspace(1.0, 100.0, 200)
+    values = np.cos(omegas / 10)
+    roots = 10 * (np.pi / 2 + np.pi * np.arange(3))
+    plot_scan(omegas, np.sign(values), np.log(np.abs(values)), roots,
+              np.searchsorted(roots, omegas, side="right"), tmp_path / "scan.png")
+    assert is_png(tmp_path / "scan.png")
+
+
+@pytest.fixture(scope="module")
+def tip_response(cantilever):
+    model, modes = cantilever
+    load = PointLoad("tip", np.array([0.0, 0.0, -100.0]), np.zeros(3), step(0.01))
+    return modal_response(modes, [load], np.linspace(0.0, 0.3, 301), ["tip", "root"])
+
+
+@pytest.mark.parametrize("quantity", ["displacement", "acceleration"])
+def test_response_figure(tip_response, tmp_path, quantity):
+    plot_response(tip_response, tmp_path / "response.png", quantity)
+    assert is_png(tmp_path / "response.png")
+
+
+def test_response_figure_rejects_an_unknown_quantity(tip_response, tmp_path):
+    with pytest.raises(ValueError, match="quantity"):
+        plot_response(tip_response, tmp_path / "response.png", "jerk")
+
+
+def test_frf_figure_and_its_significant_components(cantilever, tmp_path):
+    model, modes = cantilever
+    result = frf(modes, "tip", np.r_[0.0, 0.0, 1.0, 0.0, 0.0, 0.0], np.linspace(1.0, 100.0, 300), ["tip"])
+    assert significant_components(result.receptance) == [(0, 2), (0, 4)]  # tip z and its slope ry
+    plot_frf(result, tmp_path / "frf.png", modes.natural_freq)
+    assert is_png(tmp_path / "frf.png")
+
+
+def test_mac_figure(tmp_path):
+    plot_mac(np.eye(3) * 0.9 + 0.05, tmp_path / "mac.png", [1.0, 2.0, 3.0], [1.1, 2.1, 3.1])
+    assert is_png(tmp_path / "mac.png")
+
+
+def test_aligned_eigenspace_recovers_the_reference_modes():
+    rng = np.random.default_rng(5)
+    reference = rng.normal(size=(3, 12))
+    turn = np.linalg.qr(rng.normal(size=(2, 2)))[0]
+    other = np.vstack([turn @ reference[:2], 2.0 * reference[2]])  # modes 1, 2: one repeated frequency
+    assert np.diag(mac_matrix(reference, other))[:2].min() < 0.999
+    aligned = align_eigenspaces(reference, other, [5.0, 5.0, 7.0])
+    np.testing.assert_allclose(np.diag(mac_matrix(reference, aligned)), 1.0, rtol=1e-12)
+
+
+# --- the commands ---------------------------------------------------------------------
+
+def _subcommands(parser):
+    return next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+
+
+_BUILD = cli.build_parser  # before any monkeypatching
+
+
+def _parser_with_mode_commands():
+    """cli's parser with the mode commands registered (whether or not cli.py wires them yet)."""
+    parser = _BUILD()
+    if "modes" not in _subcommands(parser).choices:
+        add_mode_commands(_subcommands(parser))
+    return parser
+
+
+@pytest.fixture
+def run(monkeypatch, capsys):
+    """cli.main on the parser with the mode commands: (status, stdout, stderr)."""
+    monkeypatch.setattr(cli, "build_parser", _parser_with_mode_commands)
+
+    def invoke(*argv):
+        status = cli.main([str(a) for a in argv])
+        captured = capsys.readouterr()
+        return status, captured.out, captured.err
+    return invoke
+
+
+def test_modes_json_plots_animations_uff_and_mac(run, tmp_path):
+    status, out, _ = run("modes", CANTILEVER, "--count", "2", "--json", "--plot", tmp_path / "figs",
+                         "--animate", "--uff", tmp_path / "modes.uff", "--mac-fe")
+    assert status == 0
+    data = json.loads(out)
+    for key in ("model", "natural_freq_hz", "rigid_body_modes", "modal_mass", "modal_stiffness",
+                "mass_orthogonality_error", "stiffness_orthogonality_error", "point_displacements",
+                "points", "mac_fe", "files"):
+        assert key in data
+    assert len(data["natural_freq_hz"]) == 2 and data["mass_orthogonality_error"] < 1e-9
+    assert len(data["point_displacements"]["tip"]) == 2 and len(data["point_displacements"]["tip"][0]) == 6
+    assert min(np.diag(data["mac_fe"]["matrix"])) > 0.9999
+    pngs, gifs = sorted((tmp_path / "figs").glob("*.png")), sorted((tmp_path / "figs").glob("*.gif"))
+    assert [p.name for p in pngs] == ["mac_fe.png", "mode_1.png", "mode_2.png"] and all(map(is_png, pngs))
+    assert len(gifs) == 2 and all(g.read_bytes()[:6] in GIF for g in gifs)
+    assert (tmp_path / "modes.uff").read_text().startswith("    -1\n    15\n")
+
+
+def test_modes_table(run):
+    status, out, _ = run("modes", CHAIN, "--count", "3")
+    assert status == 0
+    assert "spring-mass chain" in out and "modal mass" in out and "orthogonality error" in out
+
+
+def test_scan_json_and_figure(run, tmp_path):
+    status, out, _ = run("scan", CANTILEVER, "--fmax", "60", "--points", "300", "--plot",
+                         tmp_path / "scan.png", "--json")
+    assert status == 0
+    data = json.loads(out)
+    assert data["ubar_order"] == 12 and data["points"] == 300
+    np.testing.assert_allclose(data["frequencies_hz"], [6.7535653, 6.7535653, 50.899157, 50.899157], rtol=1e-7)
+    assert is_png(tmp_path / "scan.png")
+
+
+def test_response_json_and_figure(run, tmp_path):
+    status, out, _ = run("response", CANTILEVER, STEP, "--json", "--plot", tmp_path / "step.png")
+    assert status == 0
+    data = json.loads(out)
+    for key in ("times", "points", "displacement", "velocity", "acceleration", "peaks", "peak_times"):
+        assert key in data
+    assert data["points"] == ["tip"]
+    # undamped step: the tip swings to about twice its static deflection, 6.35 mm + beam mass
+    assert 0.012 < data["peaks"]["tip"][2] < 0.0135
+    assert is_png(tmp_path / "step.png")
+
+
+def test_response_table(run):
+    status, out, _ = run("response", CANTILEVER, STEP)
+    assert status == 0 and "peak |displacement|" in out and "tip" in out
+
+
+def test_frf_json_and_figure(run, tmp_path):
+    status, out, _ = run("frf", CANTILEVER, "--point", "tip", "--direction", "z", "--fmax", "60",
+                         "--frequencies", "200", "--response-points", "tip", "root", "--json",
+                         "--plot", tmp_path / "frf.png")
+    assert status == 0
+    data = json.loads(out)
+    for key in ("load", "natural_freq_hz", "modes_in_sum", "frequencies_hz", "points", "receptance"):
+        assert key in data
+    assert data["points"] == ["tip", "root"] and len(data["frequencies_hz"]) == 200
+    static = 2.0**3 / (3 * 2.1e11 * 2e-7)  # tip flexibility, m/N; the sum has only two z modes
+    assert data["receptance"]["tip"]["real"][0][2] == pytest.approx(static, rel=3e-3)
+    assert is_png(tmp_path / "frf.png")
+
+
+def test_frf_table(run):
+    status, out, _ = run("frf", CANTILEVER, "--point", "tip", "--direction", "ry", "--fmax", "20",
+                         "--frequencies", "50")
+    assert status == 0 and "per N m" in out and "undamped" in out
+
+
+@pytest.mark.parametrize("argv, key", [
+    (("modes", CANTILEVER, "--animate"), "--animate"),
+    (("modes", CANTILEVER, "--plot", "{tmp}/file.txt/figs"), "--plot"),
+    (("modes", CANTILEVER, "--uff", "{tmp}/missing/modes.uff"), "--uff"),
+    (("modes", CANTILEVER, "--fmax", "1"), "--fmax"),
+    (("scan", CANTILEVER, "--fmax", "10", "--plot", "{tmp}/missing/scan.png"), "--plot"),
+    (("scan", CANTILEVER, "--plot", "{tmp}/scan.png"), "--fmax"),
+    (("scan", CANTILEVER, "--fmax", "-1", "--plot", "{tmp}/scan.png"), "--fmax"),
+    (("response", CANTILEVER, "{tmp}/nowhere.toml"), "nowhere.toml"),
+    (("response", CHAIN, STEP), "tip"),
+    (("frf", CANTILEVER, "--point", "tipp", "--direction", "z", "--fmax", "10"), "--point"),
+    (("frf", CANTILEVER, "--point", "tip", "--direction", "w", "--fmax", "10"), "--direction"),
+    (("frf", CANTILEVER, "--point", "tip", "--direction", "z", "--fmax", "10",
+      "--response-points", "nowhere"), "--response-points"),
+    (("frf", CANTILEVER, "--point", "tip", "--direction", "z", "--fmax", "1"), "--fmax"),
+])
+def test_bad_input_exits_2_with_one_line(run, tmp_path, argv, key):
+    (tmp_path / "file.txt").write_text("not a folder")
+    status, _, err = run(*[a.format(tmp=tmp_path) for a in argv])
+    assert status == 2
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err and key in err
+
+
+@pytest.mark.skipif("modes" not in _subcommands(_BUILD()).choices,
+                    reason="the mode commands are not wired into cli.py yet")
+def test_modes_subcommand_end_to_end(tmp_path):
+    result = subprocess.run([sys.executable, "-m", "linmstmm", "modes", CANTILEVER, "--count", "1",
+                             "--json", "--plot", str(tmp_path)], cwd=ROOT, capture_output=True,
+                            text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert json.loads(result.stdout)["natural_freq_hz"][0] == pytest.approx(6.7535653, rel=1e-7)
+    assert is_png(tmp_path / "mode_1.png")
+
+
+# --- the scripts ----------------------------------------------------------------------
+
+@pytest.mark.parametrize("script, words", [
+    ("frf_sweep.py", ["natural frequencies", "largest |H|"]),
+    ("firing_impulse.py", ["peak |displacement|", "muzzle", "tube_rear"]),
+])
+def test_script_writes_its_figure(tmp_path, script, words):
+    figure = tmp_path / "figure.png"
+    result = subprocess.run([sys.executable, str(ROOT / "scripts" / script), "--plot", str(figure)],
+                            cwd=tmp_path, capture_output=True, text=True, timeout=180)
+    assert result.returncode == 0, result.stderr
+    assert all(word in result.stdout for word in words)
+    assert is_png(figure)

@@ -16,8 +16,9 @@ from linmstmm.topology import build_topology
 
 #: Digits float64 delivers; more are computed in mpmath.
 FLOAT64_DIGITS = 14
-#: A root whose last Newton step was larger than this (relative) is not certified in float64.
-CERTIFIED_STEP = 1e-11
+#: A root whose last Newton step (its rounding floor in float64) was larger than
+#: this, relative, is refined in mpmath.
+CERTIFIED_STEP = 1e-9
 #: Digits used when an uncertified root is escalated to mpmath.
 ESCALATION_DIGITS = 20
 

@@ -11,6 +11,7 @@ import json
 import sys
 
 from linmstmm.model import ModelError, load_model
+from linmstmm.fe_command import add_fe_command
 from linmstmm.mode_commands import add_mode_commands
 from linmstmm.structure import add_check_command
 
@@ -64,6 +65,7 @@ def build_parser() -> argparse.ArgumentParser:
     freqs.add_argument("--root", default=None, help="boundary point to use as the root")
     freqs.set_defaults(run=_run_freqs)
     add_check_command(sub)
+    add_fe_command(sub)
     add_mode_commands(sub)
     return parser
 

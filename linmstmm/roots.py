@@ -146,8 +146,14 @@ class RootFinder:
         self.note = ""
 
     def rigid_body_modes(self) -> int:
-        """Nullity of Ū_all at ω = 0: zero-frequency (rigid-body) modes."""
-        return nullity(self.matrix(np.array([0.0]))[0])
+        """Nullity of Ū_all at ω = 0: zero-frequency (rigid-body) modes.
+
+        Balanced with the scales of a generic frequency (1 rad/s): at ω = 0
+        itself, columns that vanish there (a closed ring's T − I) would be
+        blown up and hide the null vectors.
+        """
+        at_zero, generic = self.matrix(np.array([0.0, 1.0]))
+        return nullity(at_zero, scales=equilibration(generic))
 
     def _offsets(self, omegas) -> list[np.ndarray]:
         """For each ω: generalized eigenvalues μ of (Ū(ω), dŪ/dω), sorted by |μ| (complex).

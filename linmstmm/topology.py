@@ -221,24 +221,28 @@ def build_topology(model: Model, root: str | None = None, cut_at=()) -> Topology
     root : boundary end label (point name) to use as the root; default: the
     end with the most fixed components, first in file order among equals.
     cut_at : connection points to cut first (loops not cut there are cut
-    where the spanning tree closes them).
+    where the spanning tree closes them); in a model with no boundary end
+    the first of them is where the structure is closed.
     """
     elements = _model_elements(model)
     boundaries = _link_points(model, elements)
     cuts: list[Cut] = []
-    _cut_connections(model, elements, cut_at, cuts)
     b = _choose_root(model, elements, boundaries, root)
+    closing_point = cut_at[0] if (b is None and cut_at) else None
+    _cut_connections(model, elements, [p for p in cut_at if p != closing_point], cuts)
     if b is not None:
         start, port = _find_port(elements, ("boundary", b))
         root_link = ("boundary", b)
-    else:  # no boundary at all: close the structure at its first connection
+    else:  # no boundary at all: close the structure at cut_at[0], else its first connection
         start, port = next((e, p) for e, el in enumerate(elements)
-                           for p, pt in enumerate(el.ports) if pt.link[0] == "element")
+                           for p, pt in enumerate(el.ports) if pt.link[0] == "element"
+                           and closing_point in (None, pt.point))
         _, f, q = elements[start].ports[port].link
+        c = len(cuts)
         cuts.append(Cut(elements[start].ports[port].point, ((start, port), (f, q)), closing=True))
-        elements[start].ports[port].link = ("cut", 0, 0)
-        elements[f].ports[q].link = ("cut", 0, 1)
-        root_link = ("cut", 0)
+        elements[start].ports[port].link = ("cut", c, 0)
+        elements[f].ports[q].link = ("cut", c, 1)
+        root_link = ("cut", c)
     elements[start].output = port
     order = _grow_tree(elements, start, cuts)
     unreached = [el.name for e, el in enumerate(elements) if e not in set(order)]

@@ -51,3 +51,21 @@ def single_beam_model(left=None, right=None, length=2.0, **beam_options) -> Mode
     boundary = {p: mask for p, mask in (("a", left), ("b", right)) if mask is not None}
     return Model("beam", points, beams=(make_beam("beam", "a", "b", points, **beam_options),),
                  boundary=boundary)
+
+
+def spring_mass_chain(k=1000.0, m=2.0, damping=None) -> Model:
+    """fixed–k–3m–k–m–k–fixed along x; rotations locked by rigid rotational springs.
+
+    Every translation direction repeats the 1-D chain: ω² = (4 ∓ √7)/3 · k/m, three times each.
+    damping : the model's (alpha, beta), or None.
+    """
+    points = {name: np.array([x, 0.0, 0.0]) for name, x in
+              [("g0", 0.0), ("a1", 0.0), ("b1", 1.0), ("a2", 1.0), ("b2", 2.0), ("g3", 2.0)]}
+    stiff = [k, k, k, np.inf, np.inf, np.inf]
+    return Model(
+        "spring-mass chain", points,
+        rigids=(make_rigid("m1", ["a1", "b1"], 3 * m, [0.5, 0, 0]),
+                make_rigid("m2", ["a2", "b2"], m, [1.5, 0, 0])),
+        springs=(make_spring("k1", "g0", "a1", stiff), make_spring("k2", "b1", "a2", stiff),
+                 make_spring("k3", "b2", "g3", stiff)),
+        boundary={"g0": fixed(), "g3": fixed()}, damping=damping)

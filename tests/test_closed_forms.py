@@ -9,7 +9,7 @@ from __future__ import annotations
 import mpmath as mp
 import numpy as np
 import pytest
-from builders import fixed, make_rigid, make_spring, single_beam_model
+from builders import fixed, make_rigid, single_beam_model, spring_mass_chain
 
 from linmstmm.model import Model
 from linmstmm.solve import natural_frequencies
@@ -100,23 +100,6 @@ def test_cantilever_with_tip_mass_ratio_one():
     scale = np.sqrt(beam.E * beam.Iz / (beam.rho * beam.A * L**4)) / (2 * np.pi)
     got = natural_frequencies(model, fmax=lambdas[-1] ** 2 * scale * 1.0001, count=None)
     np.testing.assert_allclose(got.frequencies_hz[:3], lambdas**2 * scale, rtol=1e-9)
-
-
-def spring_mass_chain(k=1000.0, m=2.0):
-    """fixed–k–3m–k–m–k–fixed along x; rotations locked by rigid rotational springs.
-
-    Every translation direction repeats the 1-D chain: ω² = (4 ∓ √7)/3 · k/m, three times each.
-    """
-    points = {name: np.array([x, 0.0, 0.0]) for name, x in
-              [("g0", 0.0), ("a1", 0.0), ("b1", 1.0), ("a2", 1.0), ("b2", 2.0), ("g3", 2.0)]}
-    stiff = [k, k, k, np.inf, np.inf, np.inf]
-    return Model(
-        "spring-mass chain", points,
-        rigids=(make_rigid("m1", ["a1", "b1"], 3 * m, [0.5, 0, 0]),
-                make_rigid("m2", ["a2", "b2"], m, [1.5, 0, 0])),
-        springs=(make_spring("k1", "g0", "a1", stiff), make_spring("k2", "b1", "a2", stiff),
-                 make_spring("k3", "b2", "g3", stiff)),
-        boundary={"g0": fixed(), "g3": fixed()})
 
 
 @pytest.mark.parametrize("root", ["g0", "g3"])

@@ -218,13 +218,19 @@ def test_quadrature_is_converged():
                                fine.orthogonality_stiffness / fine.omega[-1] ** 2, atol=1e-12)
 
 
+def tree_modes_both_routes(count):
+    """(model, MSTMM modes, FE model, FE eigenvalues, FE modes) of :func:`tree`, 24 elements per beam."""
+    from linmstmm.fe import assemble, fe_modes
+
+    model = tree()
+    fe = assemble(model, 24)
+    lam, X, _ = fe_modes(fe, count)
+    return model, mode_shapes(model, count=count), fe, lam, X
+
+
 def test_shapes_match_the_finite_element_route():
     """MAC > 0.9999 per mode against the FE route (Hermite beams, 24 elements per beam)."""
-    fe_module = pytest.importorskip("linmstmm.fe")
-    model = tree()
-    modes = mode_shapes(model, count=8)
-    fe = fe_module.assemble(model, 24)
-    lam, X, _ = fe_module.fe_modes(fe, 8)
+    model, modes, fe, lam, X = tree_modes_both_routes(8)
     full = fe.T @ X
     points = list(model.points)
     fe_shapes = np.stack([np.concatenate([full[fe.dof_index.point(p), k] for p in points])

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.linalg
-from builders import fixed, make_rigid, make_spring
+from builders import fixed, make_rigid, make_spring, spring_mass_chain
 
 from linmstmm.model import Model, ModelError
 from linmstmm.modes import mode_shapes
@@ -126,16 +126,7 @@ K_HAND = K_CHAIN * np.array([[2.0, -1.0], [-1.0, 2.0]])
 
 def chain():
     """fixed–k–3m–k–m–k–fixed along x; every translation direction is this 2-DOF chain."""
-    points = {name: np.array([x, 0.0, 0.0]) for name, x in
-              [("g0", 0.0), ("a1", 0.0), ("b1", 1.0), ("a2", 1.0), ("b2", 2.0), ("g3", 2.0)]}
-    stiff = [K_CHAIN] * 3 + [np.inf] * 3
-    return Model(
-        "chain", points,
-        rigids=(make_rigid("m1", ["a1", "b1"], 3 * M_CHAIN, [0.5, 0, 0]),
-                make_rigid("m2", ["a2", "b2"], M_CHAIN, [1.5, 0, 0])),
-        springs=(make_spring("k1", "g0", "a1", stiff), make_spring("k2", "b1", "a2", stiff),
-                 make_spring("k3", "b2", "g3", stiff)),
-        boundary={"g0": fixed(), "g3": fixed()}, damping=DAMPING)
+    return spring_mass_chain(K_CHAIN, M_CHAIN, DAMPING)
 
 
 def test_frf_matches_direct_harmonic_solve():
@@ -226,13 +217,9 @@ def test_load_file_errors_name_load_and_key(tmp_path, edit, key, words):
 
 def test_frf_matches_the_finite_element_modal_sum():
     """Same truncation (12 modes) on both routes: the modal data agree, not just the frequencies."""
-    fe_module = pytest.importorskip("linmstmm.fe")
-    from test_modes import tree
+    from test_modes import tree_modes_both_routes
 
-    model = tree()
-    modes = mode_shapes(model, count=12)
-    fe = fe_module.assemble(model, 24)
-    lam, X, _ = fe_module.fe_modes(fe, 12)
+    model, modes, fe, lam, X = tree_modes_both_routes(12)
     vector, damping = np.r_[0.0, 0.3, 1.0, 0.0, 0.0, 0.0], (0.5, 1e-4)
     frequencies = np.array([5.0, 20.0, 40.0, 75.0])
     points = list(model.points)

@@ -391,6 +391,16 @@ class RootFinder:
                 return below[:count]
         return self.find(count, None)
 
+    @staticmethod
+    def _next_top(lo: float, roots: list[float], count: int | None) -> float:
+        """Top of the next segment: four times ``lo``, or less if the roots found so
+        far say ``count`` is reached sooner (a beam's ω_n grows like n², a
+        chain's like n: the n² guess overshoots, which costs less than a miss)."""
+        if count is None or len(roots) < 2:
+            return 4 * lo
+        guess = roots[-1] * ((count + 2) / len(roots)) ** 2
+        return min(4 * lo, max(1.25 * lo, guess))
+
     def find(self, count: int | None, omega_max: float | None,
              omega_start: float = 2 * np.pi) -> list[float]:
         """Elastic roots (rad/s) ascending, each repeated per multiplicity.
@@ -417,7 +427,9 @@ class RootFinder:
             done_by_range = omega_max is not None and hi >= omega_max
             if done_by_count or done_by_range or hi >= OMEGA_CEILING:
                 break
-            lo, hi = hi, hi * 4 if omega_max is None else min(hi * 4, omega_max)
+            lo, hi = hi, self._next_top(hi, roots, count)
+            if omega_max is not None:
+                hi = min(hi, omega_max)
         return roots[:count] if count is not None else roots
 
 

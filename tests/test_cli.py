@@ -35,7 +35,8 @@ def test_freqs_fmax_and_count_stop_at_whichever_comes_first():
     assert len(by_fmax["frequencies_hz"]) == 4 and max(by_fmax["frequencies_hz"]) <= 100
     both = json.loads(run("freqs", "models/cantilever_tip_mass.toml", "--json", "--fmax", "100",
                           "--count", "3").stdout)
-    assert both["frequencies_hz"] == by_fmax["frequencies_hz"][:3]
+    # the same roots, reached from different search segments: equal to rounding
+    np.testing.assert_allclose(both["frequencies_hz"], by_fmax["frequencies_hz"][:3], rtol=1e-13)
 
 
 def test_freqs_table_is_readable():

@@ -259,6 +259,9 @@ def _combine(terms):
 
     A is (12, 12), (6, 12) or a stack (n, ., 12). Returns (columns, (n, rows, k)).
     """
+    if len(terms) == 1:  # one input (most elements): no union to form
+        A, state = terms[0]
+        return state.columns, A @ state.matrix
     columns = np.unique(np.concatenate([state.columns for _, state in terms]))
     first = terms[0][0]
     n = max(np.shape(state.matrix)[0] for _, state in terms)

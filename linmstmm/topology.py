@@ -245,7 +245,8 @@ def build_topology(model: Model, root: str | None = None, cut_at=()) -> Topology
         root_link = ("cut", c)
     elements[start].output = port
     order = _grow_tree(elements, start, cuts)
-    unreached = [el.name for e, el in enumerate(elements) if e not in set(order)]
+    reached = set(order)
+    unreached = [el.name for e, el in enumerate(elements) if e not in reached]
     if unreached:
         raise ModelError(model.source or model.name,
                          f"the model is not connected: {', '.join(unreached)} "

@@ -15,6 +15,9 @@ import scipy.linalg
 
 #: Grid points per octave of the scan.
 POINTS_PER_OCTAVE = 32
+#: Loosest Newton tolerance (relative) RootFinder accepts: roots are told apart
+#: down to SPLIT = 1e-4, so the polishing must be much tighter than that.
+MAX_XTOL = 1e-6
 #: Lowest scanned circular frequency, rad/s.
 OMEGA_FLOOR = 1e-3
 #: The scan for ``count`` roots gives up above this circular frequency, rad/s.
@@ -135,6 +138,9 @@ class RootFinder:
 
     def __init__(self, log_det, matrix, xtol: float = 1e-14,
                  points_per_octave: int = POINTS_PER_OCTAVE, points_per_root: int = 6):
+        if not 0 < xtol <= MAX_XTOL:
+            raise ValueError(f"xtol must be in (0, {MAX_XTOL:g}], got {xtol:g}: looser Newton "
+                             "tolerances blur distinct roots into one")
         self.log_det = log_det
         self.matrix = matrix
         self.xtol = xtol

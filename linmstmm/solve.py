@@ -103,8 +103,9 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     if wanted:
         chosen = omegas if digits and digits > FLOAT64_DIGITS else [w for w in omegas if w in uncertain]
         refined = dict(zip(chosen, refine_roots(deduction, model, list(chosen), wanted)))
-        text = [mpmath.nstr(refined[w] / (2 * mpmath.pi), wanted) if w in refined else repr(w / (2 * np.pi))
-                for w in omegas]
+        with mpmath.workdps(wanted + 10):  # 2π and the division at the refined precision
+            text = [mpmath.nstr(refined[w] / (2 * mpmath.pi), wanted) if w in refined
+                    else repr(w / (2 * np.pi)) for w in omegas]
         omegas = np.array([float(refined.get(w, w)) for w in omegas])
         precision = f"mpmath:{wanted}" + ("" if len(chosen) == len(omegas) else f" ({len(set(chosen))} roots)")
     note = ""

@@ -117,3 +117,16 @@ def test_a_misleading_guess_falls_back_to_the_full_search():
     cold = natural_frequencies(model, count=6)
     warm = natural_frequencies(model, count=6, guess_hz=[cold.frequencies_hz[-1]])
     np.testing.assert_allclose(warm.frequencies_hz, cold.frequencies_hz, rtol=1e-12)
+
+
+def test_thirty_digits_match_the_frequency_equation():
+    """--digits 30: the mpmath path against the cantilever equation solved at 40 digits."""
+    model = single_beam_model(fixed(), None, Iz=2e-7, Iy=7e-7, axial=False, torsion=False)
+    beam = model.beams[0]
+    got = natural_frequencies(model, count=2, digits=30)
+    assert got.precision == "mpmath:30"
+    with mp.workdps(40):
+        lam = mp.findroot(lambda x: mp.cos(x) * mp.cosh(x) + 1, 1.875)
+        stiffness = mp.mpf(beam.E) * mp.mpf(beam.Iz) / (mp.mpf(beam.rho) * mp.mpf(beam.A) * mp.mpf(beam.length) ** 4)
+        want = lam**2 * mp.sqrt(stiffness) / (2 * mp.pi)
+        assert abs(mp.mpf(got.frequencies_text[0]) / want - 1) < mp.mpf(10) ** -28

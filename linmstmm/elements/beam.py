@@ -98,7 +98,7 @@ def rod_transfer(stiffness, inertia, L, omega, rigid=False) -> np.ndarray:
         out[:, 0, 0] = out[:, 1, 1] = 1
         out[:, 1, 0] = inertia * omega**2 * L
         return out
-    kL = omega * L * math.sqrt(inertia / stiffness)
+    kL = omega * L * (mpmath.sqrt(inertia / stiffness) if is_mp(omega) else math.sqrt(inertia / stiffness))
     sinc = sin_over(kL)
     out[:, 0, 0] = out[:, 1, 1] = cos(kL)
     out[:, 0, 1] = -L / stiffness * sinc
@@ -112,17 +112,20 @@ def beam_local_transfer(beam, omega, length=None) -> np.ndarray:
     length : m, a piece of the beam (default: the whole beam).
     """
     omega = frequencies(omega)
-    L = beam.length if length is None else length
-    rhoA = beam.rho * beam.A
+    # In mpmath, products of the section properties are formed at the working
+    # precision too (the inputs are exact binary floats).
+    exact = mpmath.mpf if is_mp(omega) else float
+    E, G, rho, A, Iy, Iz, J, Ip = (exact(getattr(beam, name))
+                                   for name in ("E", "G", "rho", "A", "Iy", "Iz", "J", "Ip"))
+    L = exact(beam.length if length is None else length)
     n = omega.size
     out = zeros_like_stack(omega, (12, 12))
-    out[np.ix_(range(n), _BENDING_XY, _BENDING_XY)] = bending_transfer(beam.E * beam.Iz, rhoA, L, omega)
-    xz = bending_transfer(beam.E * beam.Iy, rhoA, L, omega)
+    out[np.ix_(range(n), _BENDING_XY, _BENDING_XY)] = bending_transfer(E * Iz, rho * A, L, omega)
+    xz = bending_transfer(E * Iy, rho * A, L, omega)
     out[np.ix_(range(n), _BENDING_XZ, _BENDING_XZ)] = _XZ_SIGNS[:, None] * xz * _XZ_SIGNS[None, :]
-    out[np.ix_(range(n), _AXIAL, _AXIAL)] = rod_transfer(
-        beam.E * beam.A, rhoA, L, omega, rigid=not beam.axial)
-    out[np.ix_(range(n), _TORSION, _TORSION)] = rod_transfer(
-        beam.G * beam.J, beam.rho * beam.Ip, L, omega, rigid=not beam.torsion)
+    out[np.ix_(range(n), _AXIAL, _AXIAL)] = rod_transfer(E * A, rho * A, L, omega, rigid=not beam.axial)
+    out[np.ix_(range(n), _TORSION, _TORSION)] = rod_transfer(G * J, rho * Ip, L, omega,
+                                                             rigid=not beam.torsion)
     return out
 
 

@@ -1,12 +1,24 @@
-"""Roots of det Ū_all(ω): scan, bracket, refine, multiplicity.
+"""Roots of det Ū_all(ω): count, scan, bracket, refine, multiplicity.
 
-The determinant is handled as (sign, log|det|) so it never overflows. A
-frequency grid is scanned in octaves; a sign change brackets a root of odd
-multiplicity and Brent's method refines it; a sharp local minimum of
-log|det| without a sign change is a candidate even-multiplicity root
-(two bending planes of a round tube, symmetric structures) and is refined by
-minimisation. Every candidate is confirmed, and its multiplicity measured, by
-the numerical null-space dimension of the equilibrated Ū_all.
+Nothing is missed because every interval's roots are counted before they are
+looked for: det Ū_all is an entire function of ω (no inverse is taken), real
+on the real axis, whose zeros are the natural frequencies with their
+multiplicities, so the argument principle on a half-ellipse counts them
+(:func:`count_zeros`). The search then works segment by segment upwards:
+
+1. a scan of (sign, log|det|) on a geometric grid of at least
+   ``points_per_root`` points per counted root;
+2. sign changes are bisected to 1e-4 and local minima of log|det| without a
+   sign change (even multiplicity, close pairs) are taken as starts;
+3. Newton on the local linearisation (:meth:`RootFinder.polish`, all starts
+   at once) converges to machine precision on simple and semisimple multiple
+   roots alike; the multiplicity comes from the linearised pencil's
+   near-zero offsets, confirmed by a count over a small circle;
+4. bisection on the count finds whatever the scan missed, or raises an
+   honest error if float64 cannot separate the roots.
+
+Everything works on (sign, log|det|), so nothing overflows; the evaluation
+itself is the stable (orthonormalised) one of :mod:`linmstmm.deduction`.
 """
 from __future__ import annotations
 
@@ -24,8 +36,6 @@ OMEGA_FLOOR = 1e-3
 OMEGA_CEILING = 1e9
 #: A singular value below this fraction of the largest counts as zero.
 NULL_TOLERANCE = 1e-8
-#: The same, at a root polished to machine precision (multiplicity).
-MULTIPLICITY_TOLERANCE = 1e-9
 
 
 def equilibration(matrix: np.ndarray, sweeps: int = 4):

@@ -84,16 +84,30 @@ def count_zeros(log_det, a: float, b: float, max_points: int = 20000) -> int:
     their multiplicities (a null vector of Ū_all is a mode and vice versa;
     no inverse is ever taken, so there are no poles). The winding number of
     det along an ellipse through a and b counts them; by conjugate symmetry
-    the upper half-arc suffices: count = Δarg(b → a over the arc) / π. The
-    arc is refined until no phase step exceeds π/4, and the total must come
-    out an integer multiple of π.
+    the upper half-arc suffices: count = Δarg(b → a over the arc) / π.
 
     log_det : callable complex omega (n,) -> (phase factor (n,), log|det| (n,)).
     """
+    centre, radius = (a + b) / 2, (b - a) / 2
+    return _half_winding(log_det, lambda theta: centre + radius * np.cos(theta)
+                         + 0.5j * radius * np.sin(theta), f"({a:.6g}, {b:.6g}) rad/s", max_points)
+
+
+def count_in_disc(log_det, radius: float, max_points: int = 20000) -> int:
+    """Zeros of det Ū_all with |ω| < ``radius`` (rigid-body modes count twice: det ∝ ω^2r).
+
+    det is even in ω and real on the real axis, so the upper half circle,
+    from +radius to −radius, carries half the winding: count = Δarg / π.
+    """
+    return _half_winding(log_det, lambda theta: radius * np.exp(1j * theta),
+                         f"|ω| < {radius:.6g} rad/s", max_points)
+
+
+def _half_winding(log_det, path, where: str, max_points: int) -> int:
+    """Δarg det / π along ``path(θ)``, θ from 0 to π, refined until no phase step
+    exceeds π/4; the total must come out an integer."""
     def phase(theta):
-        centre, radius = (a + b) / 2, (b - a) / 2
-        omega = centre + radius * np.cos(theta) + 0.5j * radius * np.sin(theta)
-        sign, log_abs = log_det(omega)
+        sign, log_abs = log_det(path(theta))
         if not np.all(np.isfinite(log_abs)):
             raise RuntimeError("det Ū_all vanishes on the counting contour: Ū_all is singular "
                                "at every frequency (undeflated indeterminate constraint)")
@@ -107,15 +121,15 @@ def count_zeros(log_det, a: float, b: float, max_points: int = 20000) -> int:
         if not coarse.any():
             break
         if theta.size > max_points:
-            raise RuntimeError(f"cannot count the roots in ({a:.6g}, {b:.6g}) rad/s: the phase of "
-                               "det Ū_all varies too fast along the counting contour")
+            raise RuntimeError(f"cannot count the roots in {where}: the phase of det Ū_all "
+                               "varies too fast along the counting contour")
         middles = (theta[:-1][coarse] + theta[1:][coarse]) / 2
         order = np.argsort(np.r_[theta, middles])
         theta, angles = np.r_[theta, middles][order], np.r_[angles, phase(middles)][order]
     winding = steps.sum() / np.pi
     if abs(winding - round(winding)) > 0.05:
-        raise RuntimeError(f"the root count in ({a:.6g}, {b:.6g}) rad/s is not an integer "
-                           f"({winding:.3f}): det Ū_all is not accurate enough there")
+        raise RuntimeError(f"the root count in {where} is not an integer ({winding:.3f}): "
+                           "det Ū_all is not accurate enough there")
     return int(round(abs(winding)))
 
 
@@ -160,6 +174,26 @@ class RootFinder:
         self.last_step: dict[float, float] = {}
         #: why the search ended early, if it did
         self.note = ""
+
+    def divide_out_rigid_body_zeros(self, rigid: int) -> None:
+        """Count and scan det Ū_all / ω^2r instead of det Ū_all.
+
+        With r rigid-body modes det ∝ ω^2r at ω = 0: a contour that passes a
+        few 1e-3 rad/s from the origin sees the phase turn 2r times faster
+        than ω's own angle, and its sampling aliases (false counts of 2, 4,
+        6 roots below the first elastic one). Dividing by ω^2r removes that
+        known factor exactly; the roots elsewhere are unchanged. Checked
+        first: the disc |ω| < OMEGA_FLOOR must hold exactly 2r zeros.
+        """
+        if not rigid or count_in_disc(self.log_det, OMEGA_FLOOR) != 2 * rigid:
+            return
+        full = self.log_det
+
+        def reduced(omega):
+            sign, log_abs = full(omega)
+            return sign * np.exp(-2j * rigid * np.angle(omega)), log_abs - 2 * rigid * np.log(np.abs(omega))
+
+        self.log_det = reduced
 
     def rigid_body_modes(self) -> int:
         """Nullity of Ū_all at ω = 0: zero-frequency (rigid-body) modes.

@@ -92,6 +92,7 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     start = time.perf_counter()
     deduction, finder, released = frequency_finder(model, root)
     rigid = finder.rigid_body_modes()
+    finder.divide_out_rigid_body_zeros(rigid)
     omega_max = None if fmax is None else 2 * np.pi * fmax
     if guess_hz is not None and count is not None and fmax is None:
         omegas = np.array(finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count))

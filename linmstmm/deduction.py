@@ -27,12 +27,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from linmstmm.elements.beam import beam_transfer
+from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.elements.frames import FORCE_INDEX
 from linmstmm.elements.rigid import (force_extraction, position_extraction,
                                      position_incidence, rigid_transfer_parts)
 from linmstmm.elements.spring import spring_transfer
-from linmstmm.numeric import frequencies, zeros_like_stack
+from linmstmm.numeric import frequencies, power_of_two_scale, zeros_like_stack
 from linmstmm.topology import Topology
 
 #: Largest βL of one beam piece in the stable evaluation: the piece's own
@@ -207,8 +207,7 @@ class Deduction:
     def _carry_through_beam(self, element, omega, state, normaliser, rows, open_states):
         """The state carried along a beam piece by piece, orthonormalised between pieces."""
         beam = element.record
-        stiffness = beam.E * min(beam.Iy, beam.Iz)
-        beta_L = (beam.rho * beam.A * np.max(np.abs(omega)) ** 2 / stiffness) ** 0.25 * beam.length
+        beta_L = bending_wavenumber(beam, np.max(np.abs(omega))) * beam.length
         pieces = max(int(np.ceil(beta_L / _BEAM_PIECE_BETA_L)), 1)
         piece = beam_transfer(beam, omega, reverse=element.inputs[0] == 1, length=beam.length / pieces)
         for _ in range(pieces):
@@ -321,7 +320,7 @@ class _Orthonormaliser:
         if stacked.shape[1] < stacked.shape[2]:
             return state
         row_size = np.abs(stacked).max(axis=2)  # rows mix m, rad, N, N m
-        row_scale = _power_of_two_scale(np.maximum(row_size, 1e-30 * row_size.max(axis=1, keepdims=True)))
+        row_scale = power_of_two_scale(np.maximum(row_size, 1e-30 * row_size.max(axis=1, keepdims=True)))
         q, r = np.linalg.qr(stacked * row_scale[:, :, None])
         diagonal = np.diagonal(r, axis1=1, axis2=2)
         if not np.all(np.abs(diagonal) > 0):  # dependent columns (exactly at a root): keep as is
@@ -336,21 +335,15 @@ class _Orthonormaliser:
         return PortState(state.columns, q, np.abs(q).max(axis=(1, 2)))
 
 
-def _power_of_two_scale(magnitude):
-    """1 / (nearest power of two of ``magnitude``), 1 where it is 0: exact rescaling."""
-    safe = np.where(magnitude > 0, magnitude, 1.0)
-    return np.exp2(-np.round(np.log2(safe)))
-
-
 def balanced_slogdet(stack):
     """slogdet of a (n, N, N) stack after exact power-of-two row and column scaling.
 
     Ū_all mixes metres, radians, newtons and newton-metres; balancing first
     keeps LU's error relative to each row's and column's own size.
     """
-    rows = _power_of_two_scale(np.abs(stack).max(axis=2))
+    rows = power_of_two_scale(np.abs(stack).max(axis=2))
     balanced = stack * rows[:, :, None]
-    cols = _power_of_two_scale(np.abs(balanced).max(axis=1))
+    cols = power_of_two_scale(np.abs(balanced).max(axis=1))
     sign, log_abs = np.linalg.slogdet(balanced * cols[:, None, :])
     return sign, log_abs - np.log(rows).sum(axis=1) - np.log(cols).sum(axis=1)
 

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from linmstmm.deduction import Deduction
-from linmstmm.elements.beam import beam_transfer
+from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.model import Model
 from linmstmm.roots import NULL_TOLERANCE, equilibration
 from linmstmm.solve import frequency_finder
@@ -494,8 +494,7 @@ def _quadrature(beam, omega_max: float):
     q = (largest wavenumber at omega_max) × L + EXTRA_QUADRATURE_POINTS, where
     the wavenumbers are bending (ρAω²/EI)^¼, axial ω√(ρ/E), torsion ω√(ρIp/GJ).
     """
-    rhoA = beam.rho * beam.A
-    wavenumbers = [(rhoA * omega_max**2 / (beam.E * min(beam.Iy, beam.Iz))) ** 0.25,
+    wavenumbers = [bending_wavenumber(beam, omega_max),
                    omega_max * np.sqrt(beam.rho / beam.E),
                    omega_max * np.sqrt(beam.rho * beam.Ip / (beam.G * beam.J))]
     count = int(np.ceil(max(wavenumbers) * beam.length)) + EXTRA_QUADRATURE_POINTS

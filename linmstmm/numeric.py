@@ -61,6 +61,12 @@ def sin_over(x):
     return np.sinc(x / np.pi)
 
 
+def power_of_two_scale(magnitude):
+    """1 / (nearest power of two of ``magnitude``), 1 where it is 0: scaling by it is exact."""
+    safe = np.where(magnitude > 0, magnitude, 1.0)
+    return np.exp2(-np.round(np.log2(safe)))
+
+
 def zeros_like_stack(omega, shape) -> np.ndarray:
     """Zeros of shape ``(len(omega),) + shape`` in the number type of ``omega``."""
     dtype = result_dtype(omega)

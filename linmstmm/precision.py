@@ -15,16 +15,15 @@ import math
 import mpmath
 import numpy as np
 
+from linmstmm.elements.beam import bending_wavenumber
+
 #: Guard digits on top of the growth estimate.
 GUARD_DIGITS = 12
 
 
 def growth_digits(model, omega: float) -> int:
     """Decimal digits the beam functions grow by at ``omega`` (rad/s): Σ βL / ln 10."""
-    total = 0.0
-    for beam in model.beams:
-        stiffness = beam.E * min(beam.Iy, beam.Iz)
-        total += (beam.rho * beam.A * omega**2 / stiffness) ** 0.25 * beam.length
+    total = sum(bending_wavenumber(beam, omega) * beam.length for beam in model.beams)
     return int(math.ceil(total / math.log(10)))
 
 

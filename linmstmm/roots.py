@@ -25,6 +25,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
+from linmstmm.numeric import power_of_two_scale
+
 #: Grid points per octave of the scan.
 POINTS_PER_OCTAVE = 32
 #: Loosest Newton tolerance (relative) RootFinder accepts: roots are told apart
@@ -48,19 +50,9 @@ def equilibration(matrix: np.ndarray, sweeps: int = 4):
     rows = np.ones(matrix.shape[0])
     cols = np.ones(matrix.shape[1])
     for _ in range(sweeps):
-        scaled = np.abs(rows[:, None] * matrix * cols)
-        row_max = scaled.max(axis=1)
-        rows /= np.exp2(np.round(np.log2(np.where(row_max > 0, row_max, 1.0))))
-        scaled = np.abs(rows[:, None] * matrix * cols)
-        col_max = scaled.max(axis=0)
-        cols /= np.exp2(np.round(np.log2(np.where(col_max > 0, col_max, 1.0))))
+        rows *= power_of_two_scale(np.abs(rows[:, None] * matrix * cols).max(axis=1))
+        cols *= power_of_two_scale(np.abs(rows[:, None] * matrix * cols).max(axis=0))
     return rows, cols
-
-
-def equilibrate(matrix: np.ndarray) -> np.ndarray:
-    """The matrix with :func:`equilibration` applied."""
-    rows, cols = equilibration(matrix)
-    return rows[:, None] * matrix * cols
 
 
 def nullity(matrix: np.ndarray, tolerance: float = NULL_TOLERANCE, scales=None) -> int:

@@ -75,6 +75,14 @@ def krylov(w) -> np.ndarray:
     return out
 
 
+def bending_wavenumber(beam, omega) -> float:
+    """β = (ρA ω² / EI)^¼, 1/m, of the beam's softer bending plane at |omega| (rad/s).
+
+    βL is how many e-foldings the beam functions grow over the beam.
+    """
+    return (beam.rho * beam.A * abs(omega) ** 2 / (beam.E * min(beam.Iy, beam.Iz))) ** 0.25
+
+
 def bending_transfer(EI, rhoA, L, omega) -> np.ndarray:
     """(n, 4, 4) transfer of (v, θ, m, q) in the x-y form of the bending equations."""
     w = rhoA * omega**2 * L**4 / EI

@@ -8,8 +8,6 @@ with loops are solved again with other roots and other loop cuts (models
 without any boundary end: other closing points, by reordering the element
 records) and must give the same frequencies to 1e-9.
 
-Seeds the transfer matrix side gets wrong are kept, marked
-``xfail(strict=True)`` with what goes wrong, so a fix shows up as XPASS.
 To reproduce one: ``random_models.to_toml(random_model(kind, seed))`` is its
 model file.
 """
@@ -34,41 +32,17 @@ INDEPENDENCE = 1e-9
 FE_CONVERGED = 1e-8
 
 #: Seeds per kind. floating_loops 10 is kept from a sweep of seeds 0-11 (a cut at
-#: p0 once gave wrong f8-f10); rings 0-5 all fail, these two fail fastest.
+#: p0 once gave wrong f8-f10). Rings lost up to 5 digits (and ring 5 a root)
+#: until the closing equation was orthonormalised with the carried state.
 SEEDS = {"tree": range(8), "floating_tree": range(5), "loops": range(8),
-         "floating_loops": (*range(6), 10), "ring": (1, 5)}
+         "floating_loops": (*range(6), 10), "ring": range(6)}
 #: The fmax count is checked on every third seed (an extra solve each way).
 FMAX_SEEDS = {kind: [s for s in SEEDS[kind] if s % 3 == 0]
               for kind in ("tree", "floating_tree", "loops", "floating_loops")}
 
-_CLOSED = ("no boundary end: Ū_all = T_loop - I of the closing cut loses digits with ω "
-           "(equilibrated σ_min/σ_max 1e-8 at 100 rad/s, 1e-11..1e-16 at 500-1200 rad/s); ")
-#: (kind, seed) -> why natural_frequencies disagrees with FE.
-WRONG = {
-    ("ring", 5): _CLOSED + "RuntimeError: cannot count the roots in (937.039, 937.06) rad/s "
-                 "(FE has a root there: 149.1356 Hz)",
-}
-#: (kind, seed) -> why another root, cut or closing point changes the frequencies.
-DEPENDENT = {
-    ("loops", 5): "cut at p3: f8 off by 1.8e-9 from the default solve while its last Newton "
-                  "step claims 4e-13: digits lost and not flagged",
-    ("floating_loops", 2): _CLOSED + "closing at p2 (records rotated by 1) instead of p0: "
-                           "f10 off by 1.3e-7, f8-f9 by 5e-9",
-    ("ring", 1): _CLOSED + "closing at p1 (records rotated by 1) instead of p0: f8 off by 2e-8, "
-                 "f10 by 1.2e-8",
-    ("ring", 5): WRONG[("ring", 5)],
-}
-
-
-def cases(kinds, known=None, seeds=SEEDS):
-    """pytest params (kind, seed) for ``kinds``, xfail-marked where ``known`` says so."""
-    params = []
-    for kind in kinds:
-        for seed in seeds[kind]:
-            reason = (known or {}).get((kind, seed))
-            marks = [pytest.mark.xfail(strict=True, reason=reason)] if reason else []
-            params.append(pytest.param(kind, seed, id=f"{kind}-{seed}", marks=marks))
-    return params
+def cases(kinds, seeds=SEEDS):
+    """pytest params (kind, seed) for ``kinds``."""
+    return [pytest.param(kind, seed, id=f"{kind}-{seed}") for kind in kinds for seed in seeds[kind]]
 
 
 @lru_cache(maxsize=None)
@@ -122,7 +96,7 @@ def test_generator_makes_valid_small_models_with_every_feature(tmp_path):
     assert any(not boundary_labels(m) for _, m in seen)
 
 
-@pytest.mark.parametrize("kind, seed", cases(KINDS, WRONG))
+@pytest.mark.parametrize("kind, seed", cases(KINDS))
 def test_first_ten_frequencies_agree_with_fe(kind, seed):
     reference = fe(kind, seed)
     assert reference.error_estimate.max() <= FE_CONVERGED
@@ -146,7 +120,7 @@ def test_count_below_fmax_agrees_with_fe(kind, seed):
     assert relative(by_mstmm.frequencies_hz, by_fe.frequencies_hz) <= AGREEMENT
 
 
-@pytest.mark.parametrize("kind, seed", cases(("loops", "floating_loops", "ring"), DEPENDENT))
+@pytest.mark.parametrize("kind, seed", cases(("loops", "floating_loops", "ring")))
 def test_loops_do_not_depend_on_root_or_cut(kind, seed):
     m = model(kind, seed)
     assert len(build_topology(m).cuts) == loop_count(m) >= 1

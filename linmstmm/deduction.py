@@ -32,7 +32,7 @@ from linmstmm.elements.frames import FORCE_INDEX
 from linmstmm.elements.rigid import (force_extraction, position_extraction,
                                      position_incidence, rigid_transfer_parts)
 from linmstmm.elements.spring import spring_transfer
-from linmstmm.numeric import frequencies, power_of_two_scale, zeros_like_stack
+from linmstmm.numeric import frequencies, power_of_two_scale, size_estimate, zeros_like_stack
 from linmstmm.topology import Topology
 
 #: Largest βL of one beam piece in the stable evaluation: the piece's own
@@ -46,8 +46,10 @@ _CUT_SIGN = np.diag(np.r_[np.ones(6), -np.ones(6)])
 class PortState:
     """``Z_port = matrix @ z̄[columns]``; matrix (n, 12, len(columns)).
 
-    reference : (n,) max |matrix| when its columns were last orthonormalised
-    (None: never, or merged since), to tell how much it has grown.
+    reference : (n,) max |matrix| when its columns were last orthonormalised,
+    to tell how much it has grown: 1 at a tip (its selection is orthonormal),
+    the largest of the inputs' at a merge (their columns are disjoint, except a
+    cut's two sides); None: unknown, orthonormalise at the next chance.
     """
 
     columns: np.ndarray
@@ -135,7 +137,8 @@ class Deduction:
             columns = self._cut_columns[c]
             selection = np.eye(12) if (side == 0 or self.topology.cuts[c].closing) else _CUT_SIGN
         kept = ~np.isin(columns, self.released_columns)
-        return PortState(columns[kept], np.broadcast_to(selection[:, kept], (n, 12, int(kept.sum()))))
+        return PortState(columns[kept], np.broadcast_to(selection[:, kept], (n, 12, int(kept.sum()))),
+                         np.ones(n))
 
     def release(self, columns, rows) -> None:
         """Drop statically indeterminate unknowns and the as many dependent rows.
@@ -204,7 +207,7 @@ class Deduction:
                 rows.append([f"{element.name} input {element.ports[p].point}",
                              *_combine([(-position_extraction(), inputs[0]),
                                         (position_incidence(first_position, position), state)])])
-            state = PortState(*_combine(terms), reference=inputs[0].reference if len(inputs) == 1 else None)
+            state = PortState(*_combine(terms), reference=_largest([state.reference for state in inputs]))
             if stable:
                 state = normaliser.apply(state, rows, open_states)
             outputs[e] = open_states[e] = state
@@ -254,7 +257,8 @@ class Deduction:
         for _, columns, block in rows:
             ubar[:, start:start + block.shape[1], columns] += block
             start += block.shape[1]
-        ubar = np.delete(np.delete(ubar, self.released_rows, axis=1), self.released_columns, axis=2)
+        if self.released_columns.size:
+            ubar = np.delete(np.delete(ubar, self.released_rows, axis=1), self.released_columns, axis=2)
         return (ubar, scale) if stable else ubar
 
     def log_det(self, omega, stable: bool = True):
@@ -264,6 +268,13 @@ class Deduction:
         ubar, log_scale = self.matrix(omega, stable=True)
         sign, log_abs = balanced_slogdet(ubar)
         return sign, log_abs + log_scale
+
+
+def _largest(references):
+    """Elementwise largest of the inputs' references, None if any is None."""
+    if any(reference is None for reference in references):
+        return None
+    return references[0] if len(references) == 1 else np.max(references, axis=0)
 
 
 def _combine(terms):
@@ -336,7 +347,7 @@ class _Orthonormaliser:
         open_states : the other states not yet consumed downstream.
         """
         if state.reference is not None:
-            growth = np.abs(state.matrix).max(axis=(1, 2)) / state.reference
+            growth = size_estimate(state.matrix).max(axis=(1, 2)) / state.reference
             if np.all((growth < self.GROWTH) & (growth > 1 / self.GROWTH)):
                 return state
         columns = set(int(c) for c in state.columns)
@@ -363,7 +374,7 @@ class _Orthonormaliser:
             row[1], row[2] = state.columns, q[:, offset:offset + row[2].shape[1]]
             offset += row[2].shape[1]
         q = q[:, offset:]
-        return PortState(state.columns, q, np.abs(q).max(axis=(1, 2)))
+        return PortState(state.columns, q, size_estimate(q).max(axis=(1, 2)))
 
 
 def balanced_slogdet(stack):
@@ -372,10 +383,10 @@ def balanced_slogdet(stack):
     Ū_all mixes metres, radians, newtons and newton-metres; balancing first
     keeps LU's error relative to each row's and column's own size.
     """
-    rows = power_of_two_scale(np.abs(stack).max(axis=2))
-    balanced = stack * rows[:, :, None]
-    cols = power_of_two_scale(np.abs(balanced).max(axis=1))
-    sign, log_abs = np.linalg.slogdet(balanced * cols[:, None, :])
+    size = size_estimate(stack)
+    rows = power_of_two_scale(size.max(axis=2))
+    cols = power_of_two_scale((size * rows[:, :, None]).max(axis=1))
+    sign, log_abs = np.linalg.slogdet(stack * rows[:, :, None] * cols[:, None, :])
     return sign, log_abs - np.log(rows).sum(axis=1) - np.log(cols).sum(axis=1)
 
 

@@ -54,6 +54,12 @@ def magnitude(x) -> np.ndarray:
     return np.abs(x.astype(complex)) if is_mp(x) else np.abs(x)
 
 
+def size_estimate(x: np.ndarray) -> np.ndarray:
+    """|Re x| + |Im x| of a float or complex array: within √2 of |x| and cheaper,
+    for scalings and growth tests."""
+    return np.abs(x.real) + np.abs(x.imag) if np.iscomplexobj(x) else np.abs(x)
+
+
 def sin_over(x):
     """sin(x)/x with the value 1 at 0."""
     if is_mp(x):

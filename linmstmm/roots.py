@@ -200,16 +200,18 @@ class RootFinder:
     def _offsets(self, omegas) -> list[np.ndarray]:
         """For each ω: generalized eigenvalues μ of (Ū(ω), dŪ/dω), sorted by |μ| (complex).
 
-        One evaluation of Ū for all ω and their ±1e-6 neighbours (the
-        derivative is a central difference); empty where Ū is not finite.
+        One evaluation of Ū for all ω and their neighbours ω(1 + 1e-7) (the
+        derivative is a forward difference: its 1e-7 relative error only slows
+        Newton's last step by that factor, for a third fewer evaluations than
+        a central one); empty where Ū is not finite.
         """
         omegas = np.asarray(omegas, dtype=float)
         n = omegas.size
-        steps = 1e-6 * omegas
-        stack = self.matrix(np.concatenate([omegas, omegas + steps, omegas - steps]))
+        steps = 1e-7 * omegas
+        stack = self.matrix(np.concatenate([omegas, omegas + steps]))
         offsets = []
         for i in range(n):
-            A, derivative = stack[i], (stack[n + i] - stack[2 * n + i]) / (2 * steps[i])
+            A, derivative = stack[i], (stack[n + i] - stack[i]) / steps[i]
             if not (omegas[i] > 0 and np.all(np.isfinite(A)) and np.all(np.isfinite(derivative))):
                 offsets.append(np.zeros(0))
                 continue
@@ -317,6 +319,21 @@ class RootFinder:
             sign_lo = np.where(left, sign_lo, sign_middle)
         return (lo + hi) / 2
 
+    def _bracketed(self, lo, hi, log_ratio) -> list[list[float]]:
+        """The cluster of the root in each sign-change bracket (lo_i, hi_i].
+
+        Newton starts where the straight line through |det| at the two ends
+        (log_ratio = log|det(hi)| − log|det(lo)|) crosses zero; a bracket
+        whose Newton lands outside it is bisected to 1e-4 and tried again
+        (a root it reached instead is kept: it is a root too).
+        """
+        starts = lo + (hi - lo) / (1 + np.exp(np.clip(log_ratio, -700, 700)))
+        groups = self.clusters(starts)
+        missed = [i for i, group in enumerate(groups) if not any(lo[i] < r <= hi[i] for r in group)]
+        if missed:
+            groups += self.clusters(self.shrink_brackets(lo[missed], hi[missed]))
+        return groups
+
     def _roots_in(self, grid, expected: int) -> list[float]:
         """Roots inside (grid[0], grid[-1]) reached from the scan, up to ``expected`` of them.
 
@@ -328,7 +345,8 @@ class RootFinder:
         sign, log_abs = self.log_det(grid)
         found: list[float] = []
         brackets = np.flatnonzero(sign[:-1] * sign[1:] < 0)
-        for members in self.clusters(self.shrink_brackets(grid[brackets], grid[brackets + 1])):
+        for members in self._bracketed(grid[brackets], grid[brackets + 1],
+                                       log_abs[brackets + 1] - log_abs[brackets]):
             self._merge(found, members, grid[0], grid[-1])
         inner = np.arange(1, len(grid) - 1)
         minima = inner[(log_abs[inner] < log_abs[inner - 1]) & (log_abs[inner] < log_abs[inner + 1])

@@ -148,14 +148,6 @@ K, M = 2.0e4, 3.0
 EXACT_HZ = np.full(2, np.sqrt(3 * K / M) / (2 * np.pi))
 #: The floating ring drawn along a direction that is not an inertial axis.
 SKEW = (0.48, -0.6, 0.64)
-SKEW_FAILS = pytest.mark.xfail(
-    strict=True, raises=RuntimeError,
-    reason="double root ω² = 3k/m of the floating skew ring closed at in1 (records rotated by "
-           "1), float64 without escalation: the pencil (Ū, dŪ/dω) of the rigid-in-five-directions "
-           "loop keeps four offsets below 3e-6·ω at the root, so Newton from 1e-3 away is lost "
-           "and the count cannot separate 2 roots in (141.421356192, 141.421356313) rad/s")
-
-
 @pytest.mark.parametrize("direction, guided, rigid", [
     pytest.param((1, 0, 0), True, 1, id="x-guided"),
     pytest.param((1, 0, 0), False, 6, id="x-floating"),
@@ -177,7 +169,7 @@ def test_figure_11_7_guided_does_not_depend_on_root_or_cut(root, cut):
 
 
 @pytest.mark.parametrize("direction", [pytest.param((1, 0, 0), id="x"),
-                                       pytest.param(SKEW, id="skew", marks=SKEW_FAILS)])
+                                       pytest.param(SKEW, id="skew")])
 def test_figure_11_7_floating_does_not_depend_on_the_closing_point(direction):
     """No boundary end: the loop is closed at the first connection in record
     order; rotating the records moves it round the ring."""

@@ -100,15 +100,20 @@ class Deduction:
                                  f"{self.order} unknowns")
 
     # -- element transfer matrices ------------------------------------------------
-    def transfer(self, e: int, omega) -> np.ndarray:
-        """(n, 12, 12) U_j of element e from its first input to its output."""
+    def carried(self, e: int, omega, matrix) -> np.ndarray:
+        """U_j @ matrix: (n, 12, k) carried by element e from its first input to its output.
+
+        A rigid body, spring or junction applies U0 @ S + ω² (U2 @ S) without
+        forming the stack U_j(ω) (most of a chain's cost was that stack).
+        """
         element = self.topology.elements[e]
         if element.kind == "beam":
-            return beam_transfer(element.record, omega, reverse=element.inputs[0] == 1)
+            return beam_transfer(element.record, omega, reverse=element.inputs[0] == 1) @ matrix
         kinematic, inertial = self._polynomial_parts(e)
-        if inertial is None:
-            return np.broadcast_to(kinematic, (np.size(omega), 12, 12))
-        return kinematic + np.reshape(omega, (-1, 1, 1)) ** 2 * inertial
+        product = kinematic @ matrix
+        if inertial is not None:
+            product = product + np.reshape(omega, (-1, 1, 1)) ** 2 * (inertial @ matrix)
+        return product
 
     def _polynomial_parts(self, e: int):
         """(U0, U2) with U_j = U0 + ω² U2 for a rigid body, spring or junction (U2 None
@@ -198,15 +203,16 @@ class Deduction:
             first_position = element.ports[element.inputs[0]].position
             if stable and element.kind == "beam":
                 inputs[0] = self._carry_through_beam(element, omega, inputs[0], normaliser, rows, open_states)
-                terms = [(np.eye(12), inputs[0])]
+                terms = [(inputs[0].columns, inputs[0].matrix)]
             else:
-                terms = [(self.transfer(e, omega), inputs[0])]
+                terms = [(inputs[0].columns, self.carried(e, omega, inputs[0].matrix))]
             for p, state in zip(element.inputs[1:], inputs[1:]):
                 position = element.ports[p].position
-                terms.append((force_extraction(position, out_position), state))
+                terms.append((state.columns, force_extraction(position, out_position) @ state.matrix))
                 rows.append([f"{element.name} input {element.ports[p].point}",
-                             *_combine([(-position_extraction(), inputs[0]),
-                                        (position_incidence(first_position, position), state)])])
+                             *_combine([(inputs[0].columns, -position_extraction() @ inputs[0].matrix),
+                                        (state.columns, position_incidence(first_position, position)
+                                         @ state.matrix)])])
             state = PortState(*_combine(terms), reference=_largest([state.reference for state in inputs]))
             if stable:
                 state = normaliser.apply(state, rows, open_states)
@@ -278,20 +284,16 @@ def _largest(references):
 
 
 def _combine(terms):
-    """Sum of ``A @ S`` over (A, PortState) terms, on the union of their columns.
-
-    A is (12, 12), (6, 12) or a stack (n, ., 12). Returns (columns, (n, rows, k)).
-    """
+    """Sum of the (n, rows, k_i) ``products`` of (columns_i, products) terms, on the
+    union of their columns. Returns (columns, (n, rows, k))."""
     if len(terms) == 1:  # one input (most elements): no union to form
-        A, state = terms[0]
-        return state.columns, A @ state.matrix
-    columns = np.unique(np.concatenate([state.columns for _, state in terms]))
-    first = terms[0][0]
-    n = max(np.shape(state.matrix)[0] for _, state in terms)
-    dtype = np.result_type(*[A for A, _ in terms], *[state.matrix for _, state in terms])
-    total = np.zeros((n, np.shape(first)[-2], columns.size), dtype=dtype)
-    for A, state in terms:
-        total[:, :, np.searchsorted(columns, state.columns)] += A @ state.matrix
+        return terms[0]
+    columns = np.unique(np.concatenate([c for c, _ in terms]))
+    n = max(product.shape[0] for _, product in terms)
+    dtype = np.result_type(*[product for _, product in terms])
+    total = np.zeros((n, terms[0][1].shape[1], columns.size), dtype=dtype)
+    for c, product in terms:
+        total[:, :, np.searchsorted(columns, c)] += product
     return columns, total
 
 

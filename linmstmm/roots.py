@@ -32,6 +32,8 @@ POINTS_PER_OCTAVE = 32
 #: Loosest Newton tolerance (relative) RootFinder accepts: roots are told apart
 #: down to SPLIT = 1e-4, so the polishing must be much tighter than that.
 MAX_XTOL = 1e-6
+#: Widest segment scanned in one grid, octaves (wider ones are split by a count).
+SCAN_OCTAVES = 4
 #: Lowest scanned circular frequency, rad/s.
 OMEGA_FLOOR = 1e-3
 #: The scan for ``count`` roots gives up above this circular frequency, rad/s.
@@ -79,10 +81,24 @@ def count_zeros(log_det, a: float, b: float, max_points: int = 20000) -> int:
     the upper half-arc suffices: count = Δarg(b → a over the arc) / π.
 
     log_det : callable complex omega (n,) -> (phase factor (n,), log|det| (n,)).
+    Raises RuntimeError if the count cannot be made.
     """
-    centre, radius = (a + b) / 2, (b - a) / 2
-    return _half_winding(log_det, lambda theta: centre + radius * np.cos(theta)
-                         + 0.5j * radius * np.sin(theta), f"({a:.6g}, {b:.6g}) rad/s", max_points)
+    count = count_zeros_many(log_det, [(a, b)], max_points)[0]
+    if isinstance(count, RuntimeError):
+        raise count
+    return count
+
+
+def count_zeros_many(log_det, intervals, max_points: int = 20000, initial_points: int = 65) -> list:
+    """:func:`count_zeros` for several intervals (a, b) with one evaluation of det
+    per refinement round for all of them; each entry is an int or the
+    RuntimeError that interval's count raised. ``initial_points`` per half-ellipse
+    before refinement."""
+    def ellipse(a, b):
+        centre, radius = (a + b) / 2, (b - a) / 2
+        return lambda theta: centre + radius * np.cos(theta) + 0.5j * radius * np.sin(theta)
+    return _half_windings(log_det, [ellipse(a, b) for a, b in intervals],
+                          [f"({a:.6g}, {b:.6g}) rad/s" for a, b in intervals], max_points, initial_points)
 
 
 def count_in_disc(log_det, radius: float, max_points: int = 20000) -> int:
@@ -91,38 +107,57 @@ def count_in_disc(log_det, radius: float, max_points: int = 20000) -> int:
     det is even in ω and real on the real axis, so the upper half circle,
     from +radius to −radius, carries half the winding: count = Δarg / π.
     """
-    return _half_winding(log_det, lambda theta: radius * np.exp(1j * theta),
-                         f"|ω| < {radius:.6g} rad/s", max_points)
+    count = _half_windings(log_det, [lambda theta: radius * np.exp(1j * theta)],
+                           [f"|ω| < {radius:.6g} rad/s"], max_points)[0]
+    if isinstance(count, RuntimeError):
+        raise count
+    return count
 
 
-def _half_winding(log_det, path, where: str, max_points: int) -> int:
-    """Δarg det / π along ``path(θ)``, θ from 0 to π, refined until no phase step
-    exceeds π/4; the total must come out an integer."""
-    def phase(theta):
-        sign, log_abs = log_det(path(theta))
-        if not np.all(np.isfinite(log_abs)):
-            raise RuntimeError("det Ū_all vanishes on the counting contour: Ū_all is singular "
-                               "at every frequency (undeflated indeterminate constraint)")
-        return np.angle(sign)
+def _half_windings(log_det, paths, wheres, max_points: int, initial_points: int = 65) -> list:
+    """Δarg det / π along each ``path(θ)``, θ from 0 to π, refined until no phase
+    step exceeds π/4; each total must come out an integer. All paths' points go
+    to ``log_det`` together. Returns an int or a RuntimeError per path."""
+    def phases(pieces):
+        """Angles of det at path_i(θ_i) for the (i, θ_i) pieces, one evaluation."""
+        omega = np.concatenate([paths[i](theta) for i, theta in pieces])
+        sign, log_abs = log_det(omega)
+        angles = np.split(np.angle(sign), np.cumsum([theta.size for _, theta in pieces])[:-1])
+        finite = np.split(np.isfinite(log_abs), np.cumsum([theta.size for _, theta in pieces])[:-1])
+        return angles, [bool(ok.all()) for ok in finite]
 
-    theta = np.linspace(0.0, np.pi, 65)
-    angles = phase(theta)
+    thetas = [np.linspace(0.0, np.pi, initial_points) for _ in paths]
+    angles, finite = phases(list(enumerate(thetas)))
+    results: list = [None] * len(paths)
     while True:
-        steps = np.angle(np.exp(1j * np.diff(angles)))  # wrapped into (−π, π]
-        coarse = np.abs(steps) > np.pi / 4
-        if not coarse.any():
-            break
-        if theta.size > max_points:
-            raise RuntimeError(f"cannot count the roots in {where}: the phase of det Ū_all "
-                               "varies too fast along the counting contour")
-        middles = (theta[:-1][coarse] + theta[1:][coarse]) / 2
-        order = np.argsort(np.r_[theta, middles])
-        theta, angles = np.r_[theta, middles][order], np.r_[angles, phase(middles)][order]
-    winding = steps.sum() / np.pi
-    if abs(winding - round(winding)) > 0.05:
-        raise RuntimeError(f"the root count in {where} is not an integer ({winding:.3f}): "
-                           "det Ū_all is not accurate enough there")
-    return int(round(abs(winding)))
+        pieces = []
+        for i, theta in enumerate(thetas):
+            if results[i] is not None:
+                continue
+            if not finite[i]:
+                results[i] = RuntimeError("det Ū_all vanishes on the counting contour: Ū_all is "
+                                          "singular at every frequency (undeflated indeterminate "
+                                          "constraint)")
+                continue
+            steps = np.angle(np.exp(1j * np.diff(angles[i])))  # wrapped into (−π, π]
+            coarse = np.abs(steps) > np.pi / 4
+            if not coarse.any():
+                winding = steps.sum() / np.pi
+                results[i] = (int(round(abs(winding))) if abs(winding - round(winding)) <= 0.05 else
+                              RuntimeError(f"the root count in {wheres[i]} is not an integer "
+                                           f"({winding:.3f}): det Ū_all is not accurate enough there"))
+            elif theta.size > max_points:
+                results[i] = RuntimeError(f"cannot count the roots in {wheres[i]}: the phase of "
+                                          "det Ū_all varies too fast along the counting contour")
+            else:
+                pieces.append((i, (theta[:-1][coarse] + theta[1:][coarse]) / 2))
+        if not pieces:
+            return results
+        new_angles, new_finite = phases(pieces)
+        for (i, middles), more, ok in zip(pieces, new_angles, new_finite):
+            order = np.argsort(np.r_[thetas[i], middles])
+            thetas[i], angles[i] = np.r_[thetas[i], middles][order], np.r_[angles[i], more][order]
+            finite[i] = finite[i] and ok
 
 
 class RootFinder:
@@ -260,46 +295,66 @@ class RootFinder:
     def clusters(self, starts) -> list[list[float]]:
         """For each start, every root in the cluster around the root nearest it, ascending.
 
-        The multiplicity of a polished root comes from :meth:`_multiplicity`
+        The multiplicity of a polished root comes from :meth:`_multiplicities`
         (the offsets μ of the linearised pencil, confirmed by a root count;
         the singular values of a 60×60 Ū_all are too spread to count on);
         the other small real offsets are polished in turn and kept when they
         reach another root (farther than SPLIT: closer ones are the same,
-        possibly multiple, root).
+        possibly multiple, root, and their offsets seen from it may show a
+        higher multiplicity than the first arrival's did: a double root of a
+        loop rigid in five directions showed its second offset only within
+        1e-13 of the root).
         """
         polished = self.polish(starts)
         groups, members_from = [], []
-        for centre, mu in polished:
+        for (centre, mu), multiplicity in zip(polished, self._multiplicities(polished)):
             if centre is None:
                 groups.append([])
                 continue
-            groups.append([centre] * self._multiplicity(centre, mu))
+            groups.append([centre] * multiplicity)
             real = mu[np.abs(mu.imag) <= 1e-6 * np.abs(mu)].real
             near = real[(np.abs(real) < self.CLUSTER_WINDOW * centre) & (np.abs(real) >= self.SPLIT * centre)]
             members_from += [(len(groups) - 1, centre - offset) for offset in near]
         if members_from:
-            for (g, _), (member, _) in zip(members_from, self.polish([s for _, s in members_from])):
-                if member is not None and all(abs(member - r) > self.SPLIT * r for r in groups[g]):
+            returned = []  # members that came back to a root of their group: more evidence
+            for (g, _), result in zip(members_from, self.polish([s for _, s in members_from])):
+                member = result[0]
+                if member is None:
+                    continue
+                if all(abs(member - r) > self.SPLIT * r for r in groups[g]):
                     groups[g].append(member)
+                else:
+                    returned.append((g, min(groups[g], key=lambda r: abs(r - member)), result))
+            for (g, root, _), multiplicity in zip(returned, self._multiplicities([r for *_, r in returned])):
+                groups[g] += [root] * (multiplicity - groups[g].count(root))
         return [sorted(group) for group in groups]
 
-    def _multiplicity(self, centre: float, mu: np.ndarray) -> int:
-        """How many roots sit at ``centre``, given the pencil offsets ``mu`` there.
+    def _multiplicities(self, polished) -> list[int]:
+        """How many roots sit at each polished centre, given its pencil offsets mu.
 
         A root of multiplicity m leaves m offsets near zero, split by rounding
         to about √eps and not always real (7 arms of NAFEMS FV2: up to 6e-5).
-        When more than one offset is below SPLIT·ω, a root count over a circle
-        of radius SPLIT·ω (less, if another root is nearer) decides.
+        Where more than one offset is below SPLIT·ω, a root count over a circle
+        of radius SPLIT·ω (less, if another root is nearer) decides; all those
+        counts share one evaluation per refinement round. The circle holds one
+        root (of some multiplicity m) at its centre and no other within twice
+        its radius, so the phase turns smoothly by mπ over the half circle and
+        17 starting points (refined where a step exceeds π/4) suffice.
         """
-        size = np.abs(mu)
-        if np.sum(size < self.SPLIT * centre) <= 1:
-            return 1
-        farther = size[size >= self.SPLIT * centre]
-        radius = min(self.SPLIT * centre, farther.min() / 2 if farther.size else np.inf)
-        try:
-            return max(count_zeros(self.log_det, centre - radius, centre + radius), 1)
-        except RuntimeError:
-            return 1
+        multiplicities = [1] * len(polished)
+        asked, intervals = [], []
+        for i, (centre, mu) in enumerate(polished):
+            size = np.abs(mu)
+            if centre is None or np.sum(size < self.SPLIT * centre) <= 1:
+                continue
+            farther = size[size >= self.SPLIT * centre]
+            radius = min(self.SPLIT * centre, farther.min() / 2 if farther.size else np.inf)
+            asked.append(i)
+            intervals.append((centre - radius, centre + radius))
+        counts = count_zeros_many(self.log_det, intervals, initial_points=17) if asked else []
+        for i, count in zip(asked, counts):
+            multiplicities[i] = 1 if isinstance(count, RuntimeError) else max(count, 1)
+        return multiplicities
 
     def cluster(self, omega: float) -> list[float]:
         """Every root in the cluster around the root nearest ``omega`` (see :meth:`clusters`)."""
@@ -365,7 +420,7 @@ class RootFinder:
 
         Equal entries of ``members`` are one root's multiplicity and go in
         together; a root within SPLIT of one already found is that root (its
-        multiplicity was settled by :meth:`_multiplicity`).
+        multiplicity was settled by :meth:`_multiplicities`).
         """
         for value in sorted(set(m for m in members if lo < m <= hi)):
             if not any(abs(value - r) <= self.SPLIT * r for r in found):
@@ -406,12 +461,18 @@ class RootFinder:
 
         The argument-principle count says how many there are; a scan with at
         least ``points_per_root`` points per counted root finds them; bisection
-        on the count finds any the scan missed.
+        on the count finds any the scan missed. A segment wider than
+        SCAN_OCTAVES (the first one starts at OMEGA_FLOOR) is split by a count
+        first, so an empty bottom is not scanned point by point.
         """
         if expected is None:
             expected = count_zeros(self.log_det, lo, hi)
         if expected == 0:
             return []
+        if hi / lo > 2.0 ** SCAN_OCTAVES:
+            middle = hi / 2.0 ** SCAN_OCTAVES
+            below = count_zeros(self.log_det, lo, middle)
+            return self.segment(lo, middle, below) + self.segment(middle, hi, expected - below)
         octaves = max(np.log2(hi / lo), 1.0)
         points = max(octaves * self.points_per_octave, self.points_per_root * expected)
         grid = np.geomspace(lo, hi, int(np.ceil(points)) + 1)

@@ -338,10 +338,12 @@ class _Orthonormaliser:
         forces must keep its columns independent where its displacements alone
         would not).
         """
-        squares = np.abs(stacked) ** 2
+        peak = size_estimate(stacked).max(axis=(1, 2))
+        peak = np.where(peak > 0, peak, 1.0)[:, None, None]
+        squares = np.abs(stacked / peak) ** 2  # relative to the peak: no overflow
         size = np.stack([np.sqrt(squares[:, kinds == kind].sum(axis=(1, 2))) for kind in range(4)], axis=1)
         size = np.where(size > 0, size, 1.0)
-        return 1 / size[:, kinds]
+        return 1 / (size[:, kinds] * peak[:, :, 0])
 
     def apply(self, state: PortState, rows, open_states) -> PortState:
         """The state on orthonormalised columns (or unchanged if they are shared).

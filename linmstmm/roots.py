@@ -32,6 +32,8 @@ POINTS_PER_OCTAVE = 32
 #: Loosest Newton tolerance (relative) RootFinder accepts: roots are told apart
 #: down to SPLIT = 1e-4, so the polishing must be much tighter than that.
 MAX_XTOL = 1e-6
+#: Grid points per octave of the fast path's coarse scan (above 1 rad/s).
+QUICK_POINTS_PER_OCTAVE = 24
 #: Widest segment scanned in one grid, octaves (wider ones are split by a count).
 SCAN_OCTAVES = 4
 #: Lowest scanned circular frequency, rad/s.
@@ -499,18 +501,94 @@ class RootFinder:
         (OMEGA_FLOOR, just above the count-th root) confirms that none was
         missed. Otherwise the full search runs.
         """
-        found: list[float] = []
-        for members in self.clusters(guesses):
+        found = self._confirmed(self._polished(guesses, []), count)
+        return found if found is not None else self._search(count, None)
+
+    def _polished(self, starts, found: list[float]) -> list[float]:
+        """``found`` with the roots (and their clusters) Newton reaches from ``starts``."""
+        found = list(found)
+        for members in self.clusters(starts):
             self._merge(found, members, OMEGA_FLOOR, np.inf)
-        found = sorted(found)
-        if len(found) >= count:
-            top = found[count - 1]
-            above = [r for r in found if r > top * (1 + self.SAME_ROOT)]
-            upper = (top + above[0]) / 2 if above else top * 1.01
-            below = [r for r in found if r <= upper]
-            if count_zeros(self.log_det, OMEGA_FLOOR, upper) == len(below):
-                return below[:count]
-        return self.find(count, None)
+        return sorted(found)
+
+    def _confirmed(self, found: list[float], count: int | None, omega_max: float | None = None):
+        """The lowest ``count`` of ``found`` (or all up to omega_max) if one count from
+        OMEGA_FLOOR says there are no others below them; None otherwise."""
+        if omega_max is not None:
+            below = [r for r in found if r < omega_max]
+            return below if count_zeros(self.log_det, OMEGA_FLOOR, omega_max) == len(below) else None
+        if len(found) < count:
+            return None
+        top = found[count - 1]
+        above = [r for r in found if r > top * (1 + self.SAME_ROOT)]
+        upper = (top + above[0]) / 2 if above else top * 1.01
+        below = [r for r in found if r <= upper]
+        return below[:count] if count_zeros(self.log_det, OMEGA_FLOOR, upper) == len(below) else None
+
+    def _scan_ahead(self, count: int | None, omega_max: float | None):
+        """Guess, polish, confirm: the fast path of :meth:`find`, or None.
+
+        A coarse scan (QUICK_POINTS_PER_OCTAVE above 1 rad/s, a quarter of it
+        below) goes up in chunks of two octaves until it has seen ``count``
+        + 1 candidates (sign changes, and minima of log|det| without one) or
+        reached ``omega_max``; all are polished at once (more chunks if their
+        multiplicities leave fewer than ``count`` roots) and one count from
+        OMEGA_FLOOR must agree. Far fewer evaluations than the segment
+        search when it works; when it does not (a root between two
+        candidates, a chain of clusters), :meth:`find` falls back.
+        """
+        found: list[float] = []
+        brackets, minima = [], []  # (lo, hi, log|det(hi)| − log|det(lo)|) and grid points
+        lo, hi = OMEGA_FLOOR, 16.0
+        while True:
+            if omega_max is not None:
+                hi = min(hi, omega_max)
+            grid = self._quick_grid(lo, hi)
+            sign, log_abs = self.log_det(grid)
+            change = np.flatnonzero(sign[:-1] * sign[1:] < 0)
+            brackets += zip(grid[change], grid[change + 1], log_abs[change + 1] - log_abs[change])
+            inner = np.arange(1, grid.size - 1)
+            minima += list(grid[inner[(log_abs[inner] < log_abs[inner - 1]) & (log_abs[inner] < log_abs[inner + 1])
+                                      & (sign[inner - 1] == sign[inner]) & (sign[inner] == sign[inner + 1])]])
+            if omega_max is not None and hi >= omega_max or omega_max is None and len(found) + len(brackets) + len(minima) >= count:
+                if count is not None:  # only the lowest candidates matter
+                    keep = sorted([(b[0], b) for b in brackets] + [(m, None) for m in minima])[:count - len(found)]
+                    brackets = [b for _, b in keep if b is not None]
+                    minima = [m for m, b in keep if b is None]
+                found = self._polished(minima, found)
+                if brackets:
+                    for members in self._bracketed(*map(np.array, zip(*brackets))):
+                        self._merge(found, members, OMEGA_FLOOR, np.inf)
+                    found.sort()
+                brackets, minima = [], []
+                if omega_max is not None or len(found) >= count:
+                    return self._confirmed(found, count, omega_max)
+            seen = found + [b[0] for b in brackets] + minima
+            if hi >= OMEGA_CEILING or (seen and hi > 1e3 * max(seen)):  # fewer roots than count
+                return None
+            lo, hi = hi, 4 * hi
+
+    @staticmethod
+    def _quick_grid(lo: float, hi: float) -> np.ndarray:
+        """The fast path's scan of [lo, hi]: QUICK_POINTS_PER_OCTAVE above 1 rad/s, a quarter below."""
+        def geometric(a, b, per_octave):
+            return np.geomspace(a, b, 1 + int(np.ceil(per_octave * np.log2(b / a)))) if b > a else np.zeros(0)
+        return np.unique(np.r_[geometric(lo, min(hi, 1.0), QUICK_POINTS_PER_OCTAVE / 4),
+                               geometric(max(lo, 1.0), hi, QUICK_POINTS_PER_OCTAVE)])
+
+    def find(self, count: int | None, omega_max: float | None,
+             omega_start: float = 2 * np.pi) -> list[float]:
+        """Elastic roots (rad/s) ascending, each repeated per multiplicity.
+
+        The lowest ``count``, or all up to ``omega_max``, with none missed:
+        the fast path (:meth:`_scan_ahead`) when one count confirms it, else
+        the segment search (:meth:`_search`).
+        """
+        if count is not None or omega_max is not None:
+            found = self._scan_ahead(count, omega_max)
+            if found is not None:
+                return found[:count] if count is not None else found
+        return self._search(count, omega_max, omega_start)
 
     @staticmethod
     def _next_top(lo: float, roots: list[float], count: int | None) -> float:
@@ -522,8 +600,8 @@ class RootFinder:
         guess = roots[-1] * ((count + 2) / len(roots)) ** 2
         return min(4 * lo, max(1.25 * lo, guess))
 
-    def find(self, count: int | None, omega_max: float | None,
-             omega_start: float = 2 * np.pi) -> list[float]:
+    def _search(self, count: int | None, omega_max: float | None,
+                omega_start: float = 2 * np.pi) -> list[float]:
         """Elastic roots (rad/s) ascending, each repeated per multiplicity.
 
         The lowest ``count``, or all up to ``omega_max``, with none missed:

@@ -294,7 +294,7 @@ class RootFinder:
             active = still
         return results
 
-    def clusters(self, starts) -> list[list[float]]:
+    def clusters(self, starts, confirm: bool = True) -> list[list[float]]:
         """For each start, every root in the cluster around the root nearest it, ascending.
 
         The multiplicity of a polished root comes from :meth:`_multiplicities`
@@ -305,11 +305,11 @@ class RootFinder:
         possibly multiple, root, and their offsets seen from it may show a
         higher multiplicity than the first arrival's did: a double root of a
         loop rigid in five directions showed its second offset only within
-        1e-13 of the root).
+        1e-13 of the root). ``confirm``: see :meth:`_multiplicities`.
         """
         polished = self.polish(starts)
         groups, members_from = [], []
-        for (centre, mu), multiplicity in zip(polished, self._multiplicities(polished)):
+        for (centre, mu), multiplicity in zip(polished, self._multiplicities(polished, confirm)):
             if centre is None:
                 groups.append([])
                 continue
@@ -327,11 +327,12 @@ class RootFinder:
                     groups[g].append(member)
                 else:
                     returned.append((g, min(groups[g], key=lambda r: abs(r - member)), result))
-            for (g, root, _), multiplicity in zip(returned, self._multiplicities([r for *_, r in returned])):
+            for (g, root, _), multiplicity in zip(returned, self._multiplicities([r for *_, r in returned],
+                                                                                confirm)):
                 groups[g] += [root] * (multiplicity - groups[g].count(root))
         return [sorted(group) for group in groups]
 
-    def _multiplicities(self, polished) -> list[int]:
+    def _multiplicities(self, polished, confirm: bool = True) -> list[int]:
         """How many roots sit at each polished centre, given its pencil offsets mu.
 
         A root of multiplicity m leaves m offsets near zero, split by rounding
@@ -342,7 +343,12 @@ class RootFinder:
         root (of some multiplicity m) at its centre and no other within twice
         its radius, so the phase turns smoothly by mπ over the half circle and
         17 starting points (refined where a step exceeds π/4) suffice.
+        Without ``confirm`` the number of offsets below SPLIT·ω is taken as it
+        is: for a caller that counts all its roots at the end anyway.
         """
+        if not confirm:
+            return [1 if centre is None else max(int(np.sum(np.abs(mu) < self.SPLIT * centre)), 1)
+                    for centre, mu in polished]
         multiplicities = [1] * len(polished)
         asked, intervals = [], []
         for i, (centre, mu) in enumerate(polished):
@@ -376,7 +382,7 @@ class RootFinder:
             sign_lo = np.where(left, sign_lo, sign_middle)
         return (lo + hi) / 2
 
-    def _bracketed(self, lo, hi, log_ratio) -> list[list[float]]:
+    def _bracketed(self, lo, hi, log_ratio, confirm: bool = True) -> list[list[float]]:
         """The cluster of the root in each sign-change bracket (lo_i, hi_i].
 
         Newton starts where the straight line through |det| at the two ends
@@ -385,10 +391,10 @@ class RootFinder:
         (a root it reached instead is kept: it is a root too).
         """
         starts = lo + (hi - lo) / (1 + np.exp(np.clip(log_ratio, -700, 700)))
-        groups = self.clusters(starts)
+        groups = self.clusters(starts, confirm)
         missed = [i for i, group in enumerate(groups) if not any(lo[i] < r <= hi[i] for r in group)]
         if missed:
-            groups += self.clusters(self.shrink_brackets(lo[missed], hi[missed]))
+            groups += self.clusters(self.shrink_brackets(lo[missed], hi[missed]), confirm)
         return groups
 
     def _roots_in(self, grid, expected: int) -> list[float]:
@@ -504,10 +510,10 @@ class RootFinder:
         found = self._confirmed(self._polished(guesses, []), count)
         return found if found is not None else self._search(count, None)
 
-    def _polished(self, starts, found: list[float]) -> list[float]:
+    def _polished(self, starts, found: list[float], confirm: bool = True) -> list[float]:
         """``found`` with the roots (and their clusters) Newton reaches from ``starts``."""
         found = list(found)
-        for members in self.clusters(starts):
+        for members in self.clusters(starts, confirm):
             self._merge(found, members, OMEGA_FLOOR, np.inf)
         return sorted(found)
 
@@ -533,7 +539,9 @@ class RootFinder:
         + 1 candidates (sign changes, and minima of log|det| without one) or
         reached ``omega_max``; all are polished at once (more chunks if their
         multiplicities leave fewer than ``count`` roots) and one count from
-        OMEGA_FLOOR must agree. Far fewer evaluations than the segment
+        OMEGA_FLOOR must agree. Multiplicities are read from the pencil
+        offsets without a count each: a wrong one changes the total, which
+        that count sees (unless an opposite error elsewhere cancels it). Far fewer evaluations than the segment
         search when it works; when it does not (a root between two
         candidates, a chain of clusters), :meth:`find` falls back.
         """
@@ -555,9 +563,9 @@ class RootFinder:
                     keep = sorted([(b[0], b) for b in brackets] + [(m, None) for m in minima])[:count - len(found)]
                     brackets = [b for _, b in keep if b is not None]
                     minima = [m for m, b in keep if b is None]
-                found = self._polished(minima, found)
+                found = self._polished(minima, found, confirm=False)
                 if brackets:
-                    for members in self._bracketed(*map(np.array, zip(*brackets))):
+                    for members in self._bracketed(*map(np.array, zip(*brackets)), confirm=False):
                         self._merge(found, members, OMEGA_FLOOR, np.inf)
                     found.sort()
                 brackets, minima = [], []

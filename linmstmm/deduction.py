@@ -80,6 +80,7 @@ class Deduction:
     def __init__(self, topology: Topology):
         self.topology = topology
         self._parts: dict[int, tuple] = {}
+        self._inputs: dict[int, list] = {}
         self._boundary_columns = {}
         self._cut_columns = {}
         labels = []
@@ -130,6 +131,19 @@ class Deduction:
             else:  # junction: a massless rigid body whose ports coincide
                 self._parts[e] = (np.eye(12), None)
         return self._parts[e]
+
+    def _other_inputs(self, e: int) -> list:
+        """(row label, U_{j,Ik} (12, 12), H_{j,Ik} (6, 12)) for each input k >= 2 of
+        element e; built once."""
+        if e not in self._inputs:
+            element = self.topology.elements[e]
+            out = element.ports[element.output].position
+            first = element.ports[element.inputs[0]].position
+            self._inputs[e] = [(f"{element.name} input {element.ports[p].point}",
+                                force_extraction(element.ports[p].position, out),
+                                position_incidence(first, element.ports[p].position))
+                               for p in element.inputs[1:]]
+        return self._inputs[e]
 
     # -- boundary states ------------------------------------------------------------
     def tip_state(self, link, n) -> PortState:
@@ -199,20 +213,15 @@ class Deduction:
                 inputs.append(open_states.pop(link[1]) if link[0] == "element" else self.tip_state(link, n))
                 if stable and link[0] == "cut":
                     normaliser.consume_cut_side(link[1], self._cut_columns[link[1]])
-            out_position = element.ports[element.output].position
-            first_position = element.ports[element.inputs[0]].position
             if stable and element.kind == "beam":
                 inputs[0] = self._carry_through_beam(element, omega, inputs[0], normaliser, rows, open_states)
                 terms = [(inputs[0].columns, inputs[0].matrix)]
             else:
                 terms = [(inputs[0].columns, self.carried(e, omega, inputs[0].matrix))]
-            for p, state in zip(element.inputs[1:], inputs[1:]):
-                position = element.ports[p].position
-                terms.append((state.columns, force_extraction(position, out_position) @ state.matrix))
-                rows.append([f"{element.name} input {element.ports[p].point}",
-                             *_combine([(inputs[0].columns, -position_extraction() @ inputs[0].matrix),
-                                        (state.columns, position_incidence(first_position, position)
-                                         @ state.matrix)])])
+            for (label, forces, incidence), state in zip(self._other_inputs(e), inputs[1:]):
+                terms.append((state.columns, forces @ state.matrix))
+                rows.append([label, *_combine([(inputs[0].columns, -position_extraction() @ inputs[0].matrix),
+                                               (state.columns, incidence @ state.matrix)])])
             state = PortState(*_combine(terms), reference=_largest([state.reference for state in inputs]))
             if stable:
                 state = normaliser.apply(state, rows, open_states)

@@ -47,15 +47,17 @@ NULL_TOLERANCE = 1e-8
 def equilibration(matrix: np.ndarray, sweeps: int = 4):
     """Row and column scales (powers of two) giving every row and column max |a| ~ 1.
 
-    Returns (rows (N,), cols (N,)) with ``rows[:, None] * matrix * cols`` balanced.
+    matrix : (N, M) or a stack (n, N, M). Returns (rows (…, N), cols (…, M))
+    with ``rows[..., :, None] * matrix * cols[..., None, :]`` balanced.
     Keeps the null space (up to column scaling) and makes singular values
     comparable across the mixed units of Ū_all (m, rad, N, N m).
     """
-    rows = np.ones(matrix.shape[0])
-    cols = np.ones(matrix.shape[1])
+    size = np.abs(matrix)
+    rows = np.ones(matrix.shape[:-1])
+    cols = np.ones(matrix.shape[:-2] + matrix.shape[-1:])
     for _ in range(sweeps):
-        rows *= power_of_two_scale(np.abs(rows[:, None] * matrix * cols).max(axis=1))
-        cols *= power_of_two_scale(np.abs(rows[:, None] * matrix * cols).max(axis=0))
+        rows *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-1))
+        cols *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-2))
     return rows, cols
 
 
@@ -240,21 +242,30 @@ class RootFinder:
         One evaluation of Ū for all ω and their neighbours ω(1 + 1e-7) (the
         derivative is a forward difference: its 1e-7 relative error only slows
         Newton's last step by that factor, for a third fewer evaluations than
-        a central one); empty where Ū is not finite.
+        a central one); empty where Ū is not finite. μ = 1/ν with ν the
+        eigenvalues of Ū⁻¹ dŪ/dω, all ω in one batched solve and eig (dŪ/dω
+        is singular: Ū has rows that do not depend on ω; the small μ that
+        Newton needs are the large, well-resolved ν). QZ on the pencil is
+        the fallback where Ū is exactly singular.
         """
         omegas = np.asarray(omegas, dtype=float)
         n = omegas.size
         steps = 1e-7 * omegas
         stack = self.matrix(np.concatenate([omegas, omegas + steps]))
-        offsets = []
-        for i in range(n):
-            A, derivative = stack[i], (stack[n + i] - stack[i]) / steps[i]
-            if not (omegas[i] > 0 and np.all(np.isfinite(A)) and np.all(np.isfinite(derivative))):
-                offsets.append(np.zeros(0))
-                continue
-            rows, cols = equilibration(A)
-            scale = rows[:, None] * cols[None, :]
-            mu = scipy.linalg.eigvals(A * scale, derivative * scale)
+        A, derivative = stack[:n], (stack[n:] - stack[:n]) / steps[:, None, None]
+        usable = (omegas > 0) & np.isfinite(A).all(axis=(1, 2)) & np.isfinite(derivative).all(axis=(1, 2))
+        rows, cols = equilibration(A[usable])
+        A = rows[..., :, None] * A[usable] * cols[..., None, :]
+        derivative = rows[..., :, None] * derivative[usable] * cols[..., None, :]
+        try:
+            nu = np.linalg.eigvals(np.linalg.solve(A, derivative))
+            with np.errstate(divide="ignore"):
+                pencil = [1 / v[v != 0] for v in nu]
+        except np.linalg.LinAlgError:
+            pencil = [scipy.linalg.eigvals(a, d) for a, d in zip(A, derivative)]
+        offsets, usable_offsets = [], iter(pencil)
+        for ok in usable:
+            mu = next(usable_offsets) if ok else np.zeros(0)
             mu = mu[np.isfinite(mu)]
             offsets.append(mu[np.argsort(np.abs(mu))])
         return offsets
@@ -534,7 +545,7 @@ class RootFinder:
     def _scan_ahead(self, count: int | None, omega_max: float | None):
         """Guess, polish, confirm: the fast path of :meth:`find`, or None.
 
-        A coarse scan (QUICK_POINTS_PER_OCTAVE above 1 rad/s, a quarter of it
+        A coarse scan (QUICK_POINTS_PER_OCTAVE above 1 rad/s, an eighth of it
         below) goes up in chunks of two octaves until it has seen ``count``
         + 1 candidates (sign changes, and minima of log|det| without one) or
         reached ``omega_max``; all are polished at once (more chunks if their
@@ -578,10 +589,10 @@ class RootFinder:
 
     @staticmethod
     def _quick_grid(lo: float, hi: float) -> np.ndarray:
-        """The fast path's scan of [lo, hi]: QUICK_POINTS_PER_OCTAVE above 1 rad/s, a quarter below."""
+        """The fast path's scan of [lo, hi]: QUICK_POINTS_PER_OCTAVE above 1 rad/s, an eighth below."""
         def geometric(a, b, per_octave):
             return np.geomspace(a, b, 1 + int(np.ceil(per_octave * np.log2(b / a)))) if b > a else np.zeros(0)
-        return np.unique(np.r_[geometric(lo, min(hi, 1.0), QUICK_POINTS_PER_OCTAVE / 4),
+        return np.unique(np.r_[geometric(lo, min(hi, 1.0), QUICK_POINTS_PER_OCTAVE / 8),
                                geometric(max(lo, 1.0), hi, QUICK_POINTS_PER_OCTAVE)])
 
     def find(self, count: int | None, omega_max: float | None,

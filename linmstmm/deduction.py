@@ -112,8 +112,9 @@ class Deduction:
             return beam_transfer(element.record, omega, reverse=element.inputs[0] == 1) @ matrix
         kinematic, inertial = self._polynomial_parts(e)
         product = kinematic @ matrix
-        if inertial is not None:
-            product = product + np.reshape(omega, (-1, 1, 1)) ** 2 * (inertial @ matrix)
+        if inertial is not None:  # only forces and moments from displacements and rotations
+            product = product.astype(np.result_type(product, omega), copy=False)
+            product[:, 6:] += np.reshape(omega, (-1, 1, 1)) ** 2 * (inertial[6:, :6] @ matrix[:, :6])
         return product
 
     def _polynomial_parts(self, e: int):
@@ -267,10 +268,10 @@ class Deduction:
         outputs, rows, scale = self._carry(omega, stable)
         root = self.root_state(outputs)
         ubar = zeros_like_stack(omega, (self.full_order, self.full_order))
-        ubar[:, :12, root.columns] += root.matrix
+        ubar[:, :12, _index(root.columns)] += root.matrix
         start = 0
         for _, columns, block in rows:
-            ubar[:, start:start + block.shape[1], columns] += block
+            ubar[:, start:start + block.shape[1], _index(columns)] += block
             start += block.shape[1]
         if self.released_columns.size:
             ubar = np.delete(np.delete(ubar, self.released_rows, axis=1), self.released_columns, axis=2)
@@ -283,6 +284,13 @@ class Deduction:
         ubar, log_scale = self.matrix(omega, stable=True)
         sign, log_abs = balanced_slogdet(ubar)
         return sign, log_abs + log_scale
+
+
+def _index(columns):
+    """``columns`` (sorted) as a slice when they are consecutive: a view, not a gather."""
+    if columns.size and columns[-1] - columns[0] == columns.size - 1:
+        return slice(int(columns[0]), int(columns[-1]) + 1)
+    return columns
 
 
 def _largest(references):

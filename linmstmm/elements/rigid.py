@@ -22,7 +22,9 @@ from linmstmm.numeric import frequencies
 
 
 def rigid_transfer_parts(mass, com, inertia, inp, out) -> tuple[np.ndarray, np.ndarray]:
-    """(kinematic, inertial), each (12, 12): ``U(ω) = kinematic + ω² inertial``.
+    """(kinematic, inertial), each (12, 12): ``U(ω) = kinematic + ω² inertial``;
+    only the block inertial[6:, :6] (forces and moments from displacements and
+    rotations) is non-zero.
 
     mass : kg. com, inp, out : (3,) positions, m. inertia : (3, 3) about the
     mass centre, kg m².

@@ -125,7 +125,7 @@ def mstmm_solve(model: Model, count: int, **options) -> np.ndarray:
     RootFinder options (xtol, points_per_octave, points_per_root) given
     explicitly, and no mpmath escalation: a loose ``xtol`` would otherwise
     send every root to mpmath (natural_frequencies refines every root whose
-    last Newton step exceeds CERTIFIED_STEP = 1e-11), which is the opposite
+    last Newton step exceeds CERTIFIED_STEP = 1e-9), which is the opposite
     of what a user loosening the tolerance asks for.
     """
     try:

@@ -27,13 +27,12 @@ import scipy.linalg
 
 from linmstmm.numeric import power_of_two_scale
 
-#: Grid points per octave of the scan.
-POINTS_PER_OCTAVE = 32
+#: Grid points per octave of the scans (the fast path's above 1 rad/s, an
+#: eighth of it below; every segment's).
+POINTS_PER_OCTAVE = 24
 #: Loosest Newton tolerance (relative) RootFinder accepts: roots are told apart
 #: down to SPLIT = 1e-4, so the polishing must be much tighter than that.
 MAX_XTOL = 1e-6
-#: Grid points per octave of the fast path's coarse scan (above 1 rad/s).
-QUICK_POINTS_PER_OCTAVE = 24
 #: Widest segment scanned in one grid, octaves (wider ones are split by a count).
 SCAN_OCTAVES = 4
 #: Lowest scanned circular frequency, rad/s.
@@ -545,7 +544,7 @@ class RootFinder:
     def _scan_ahead(self, count: int | None, omega_max: float | None):
         """Guess, polish, confirm: the fast path of :meth:`find`, or None.
 
-        A coarse scan (QUICK_POINTS_PER_OCTAVE above 1 rad/s, an eighth of it
+        A coarse scan (``points_per_octave`` above 1 rad/s, an eighth of it
         below) goes up in chunks of two octaves until it has seen ``count``
         + 1 candidates (sign changes, and minima of log|det| without one) or
         reached ``omega_max``; all are polished at once (more chunks if their
@@ -587,13 +586,12 @@ class RootFinder:
                 return None
             lo, hi = hi, 4 * hi
 
-    @staticmethod
-    def _quick_grid(lo: float, hi: float) -> np.ndarray:
-        """The fast path's scan of [lo, hi]: QUICK_POINTS_PER_OCTAVE above 1 rad/s, an eighth below."""
+    def _quick_grid(self, lo: float, hi: float) -> np.ndarray:
+        """The fast path's scan of [lo, hi]: points_per_octave above 1 rad/s, an eighth below."""
         def geometric(a, b, per_octave):
             return np.geomspace(a, b, 1 + int(np.ceil(per_octave * np.log2(b / a)))) if b > a else np.zeros(0)
-        return np.unique(np.r_[geometric(lo, min(hi, 1.0), QUICK_POINTS_PER_OCTAVE / 8),
-                               geometric(max(lo, 1.0), hi, QUICK_POINTS_PER_OCTAVE)])
+        return np.unique(np.r_[geometric(lo, min(hi, 1.0), self.points_per_octave / 8),
+                               geometric(max(lo, 1.0), hi, self.points_per_octave)])
 
     def find(self, count: int | None, omega_max: float | None,
              omega_start: float = 2 * np.pi) -> list[float]:

@@ -189,6 +189,9 @@ class RootFinder:
     SPLIT = 1e-4
     #: Offsets |μ|/ω below this are polished as members of the same cluster.
     CLUSTER_WINDOW = 2e-3
+    #: After a Newton step below this (relative), the next one is likely the last:
+    #: compute all the offsets there, not only the smallest.
+    LAST_STEPS = 1e-8
 
     def __init__(self, log_det, matrix, xtol: float = 1e-14,
                  points_per_octave: int = POINTS_PER_OCTAVE, points_per_root: int = 6):
@@ -235,8 +238,13 @@ class RootFinder:
         at_zero, generic = self.matrix(np.array([0.0, 1.0]))
         return nullity(at_zero, scales=equilibration(generic))
 
-    def _offsets(self, omegas) -> list[np.ndarray]:
+    def _offsets(self, omegas, full=True) -> list[np.ndarray]:
         """For each ω: generalized eigenvalues μ of (Ū(ω), dŪ/dω), sorted by |μ| (complex).
+
+        full : (n,) bool or bool; where False, only the smallest μ is wanted
+        (a Newton step short of convergence): it comes from a few power
+        iterations on Ū⁻¹ dŪ/dω, and the full eigenvalues only where those do
+        not settle (a complex or nearly tied dominant pair).
 
         One evaluation of Ū for all ω and their neighbours ω(1 + 1e-7) (the
         derivative is a forward difference: its 1e-7 relative error only slows
@@ -257,9 +265,7 @@ class RootFinder:
         A = rows[..., :, None] * A[usable] * cols[..., None, :]
         derivative = rows[..., :, None] * derivative[usable] * cols[..., None, :]
         try:
-            nu = np.linalg.eigvals(np.linalg.solve(A, derivative))
-            with np.errstate(divide="ignore"):
-                pencil = [1 / v[v != 0] for v in nu]
+            pencil = _inverse_eigenvalues(np.linalg.solve(A, derivative), np.broadcast_to(full, n)[usable])
         except np.linalg.LinAlgError:
             pencil = [scipy.linalg.eigvals(a, d) for a, d in zip(A, derivative)]
         offsets, usable_offsets = [], iter(pencil)
@@ -287,13 +293,19 @@ class RootFinder:
             if not active:
                 break
             still = []
-            for i, mu in zip(active, self._offsets(omega[active])):
+            # all offsets only where this step is likely the last (the result keeps them)
+            full = previous[active] <= self.LAST_STEPS * omega[active]
+            for i, mu, complete in zip(active, self._offsets(omega[active], full), full):
                 if mu.size == 0:
                     continue
                 step = abs(mu[0])
                 omega[i] -= mu[0].real
                 settled = step > previous[i] / 2  # no longer shrinking: the rounding floor
-                if step <= self.xtol * omega[i] or (settled and step <= self.UNCERTAIN * omega[i]):
+                converged = step <= self.xtol * omega[i] or (settled and step <= self.UNCERTAIN * omega[i])
+                if converged and not complete and mu.size == 1:  # its offsets are wanted too
+                    previous[i] = step
+                    still.append(i)
+                elif converged:
                     self.last_step[omega[i]] = step / omega[i]
                     results[i] = (omega[i], mu - mu[0].real)  # offsets seen from the new ω
                 else:
@@ -647,6 +659,27 @@ class RootFinder:
             if omega_max is not None:
                 hi = min(hi, omega_max)
         return roots[:count] if count is not None else roots
+
+
+def _inverse_eigenvalues(stack, full, iterations: int = 6) -> list[np.ndarray]:
+    """μ = 1/ν for the eigenvalues ν of each (N, N) matrix of ``stack``: all of them
+    where ``full``, else only the dominant ν by power iteration (one-element
+    array), falling back to all where it has not settled to 1e-6."""
+    n = len(stack)
+    vector = np.ones((n, stack.shape[1], 1))
+    for _ in range(iterations):
+        vector = stack @ vector
+        vector /= np.linalg.norm(vector, axis=1, keepdims=True)
+    image = stack @ vector
+    nu = (vector.conj().transpose(0, 2, 1) @ image)[:, 0, 0]
+    settled = np.linalg.norm(image[:, :, 0] - nu[:, None] * vector[:, :, 0], axis=1) <= 1e-6 * np.abs(nu)
+    out = [np.array([1 / nu[i]]) if (settled[i] and not full[i] and nu[i] != 0) else None for i in range(n)]
+    rest = [i for i in range(n) if out[i] is None]
+    if rest:
+        with np.errstate(divide="ignore"):
+            for i, values in zip(rest, np.linalg.eigvals(stack[rest])):
+                out[i] = 1 / values[values != 0]
+    return out
 
 
 def release_indeterminate(deduction, probe=(0.7310, 1.9137, 5.3)) -> int:

@@ -32,6 +32,7 @@ from linmstmm.elements.frames import FORCE_INDEX
 from linmstmm.elements.rigid import (force_extraction, position_extraction,
                                      position_incidence, rigid_transfer_parts)
 from linmstmm.elements.spring import spring_transfer
+from linmstmm.periodic import carry_run, find_runs
 from linmstmm.numeric import frequencies, power_of_two_scale, size_estimate, zeros_like_stack
 from linmstmm.topology import Topology
 
@@ -81,6 +82,7 @@ class Deduction:
         self.topology = topology
         self._parts: dict[int, tuple] = {}
         self._inputs: dict[int, list] = {}
+        self._runs = None
         self._boundary_columns = {}
         self._cut_columns = {}
         labels = []
@@ -206,7 +208,11 @@ class Deduction:
         given = self.root_given(n)
         rows = [["root", given.columns, -given.matrix]]
         normaliser = _Orthonormaliser(omega, self._shared_columns(), len(self.topology.cuts)) if stable else None
-        for e in self.topology.order:
+        order = self.topology.order
+        runs = {run.start: run for run in self.periodic_runs()} if stable else {}
+        position = 0
+        while position < len(order):
+            e = order[position]
             element = elements[e]
             inputs = []
             for p in element.inputs:
@@ -214,6 +220,16 @@ class Deduction:
                 inputs.append(open_states.pop(link[1]) if link[0] == "element" else self.tip_state(link, n))
                 if stable and link[0] == "cut":
                     normaliser.consume_cut_side(link[1], self._cut_columns[link[1]])
+            run = runs.get(position)
+            carried = None if run is None else carry_run(
+                self._cell_matrix(run, omega), run.repetitions, inputs[0].matrix,
+                lambda matrix: normaliser.apply(PortState(inputs[0].columns, matrix), rows, open_states).matrix)
+            if carried is not None:
+                last = order[run.stop - 1]
+                outputs[last] = open_states[last] = PortState(inputs[0].columns, carried)
+                position = run.stop
+                continue
+            position += 1
             if stable and element.kind == "beam":
                 inputs[0] = self._carry_through_beam(element, omega, inputs[0], normaliser, rows, open_states)
                 terms = [(inputs[0].columns, inputs[0].matrix)]
@@ -229,6 +245,19 @@ class Deduction:
             outputs[e] = open_states[e] = state
         log_scale = normaliser.log_scale if stable else np.zeros(n)
         return outputs, rows, log_scale
+
+    def periodic_runs(self) -> list:
+        """Runs of a repeated cell in the carry order (:mod:`linmstmm.periodic`); found once."""
+        if self._runs is None:
+            self._runs = find_runs(self.topology, self._polynomial_parts)
+        return self._runs
+
+    def _cell_matrix(self, run, omega) -> np.ndarray:
+        """(n, 12, 12) transfer matrix of one cell of ``run``: U_p ⋯ U_1."""
+        cell = np.broadcast_to(np.eye(12), (omega.size, 12, 12))
+        for e in run.cell:
+            cell = self.carried(e, omega, cell)
+        return cell
 
     def _carry_through_beam(self, element, omega, state, normaliser, rows, open_states):
         """The state carried along a beam piece by piece, orthonormalised between pieces."""
@@ -266,6 +295,11 @@ class Deduction:
         """
         omega = frequencies(omega)
         outputs, rows, scale = self._carry(omega, stable)
+        ubar = self._assemble(omega, outputs, rows)
+        return (ubar, scale) if stable else ubar
+
+    def _assemble(self, omega, outputs, rows) -> np.ndarray:
+        """Ū_all (n, N, N) from the carried root state and the rows, less released ones."""
         root = self.root_state(outputs)
         ubar = zeros_like_stack(omega, (self.full_order, self.full_order))
         ubar[:, :12, _index(root.columns)] += root.matrix
@@ -275,7 +309,7 @@ class Deduction:
             start += block.shape[1]
         if self.released_columns.size:
             ubar = np.delete(np.delete(ubar, self.released_rows, axis=1), self.released_columns, axis=2)
-        return (ubar, scale) if stable else ubar
+        return ubar
 
     def log_det(self, omega, stable: bool = True):
         """(sign or phase, log|det Ū_all|) over the frequency stack, each shape (n,)."""
@@ -328,6 +362,9 @@ class _Orthonormaliser:
 
     #: Orthonormalise once a state has grown (or shrunk) by this factor since the last time.
     GROWTH = 1e2
+    #: Entries beyond this (or below its inverse) after a QR are scaled back by a
+    #: power of two (a chain of 300 cells above its cutoff grows ×400 per cell).
+    FAR = 1e100
 
     def __init__(self, omega, shared_columns, n_cuts: int):
         self.shared = shared_columns
@@ -359,7 +396,7 @@ class _Orthonormaliser:
         peak = np.where(peak > 0, peak, 1.0)[:, None, None]
         squares = np.abs(stacked / peak) ** 2  # relative to the peak: no overflow
         size = np.stack([np.sqrt(squares[:, kinds == kind].sum(axis=(1, 2))) for kind in range(4)], axis=1)
-        size = np.where(size > 0, size, 1.0)
+        size = np.where(size > 0, size, size.max(axis=1, keepdims=True))
         return 1 / (size[:, kinds] * peak[:, :, 0])
 
     def apply(self, state: PortState, rows, open_states) -> PortState:
@@ -390,6 +427,14 @@ class _Orthonormaliser:
             return state
         q = q * (diagonal / np.abs(diagonal))[:, None, :] / row_scale[:, :, None]
         self.log_scale += np.log(np.abs(diagonal)).sum(axis=1)
+        # The new columns keep each kind's size, growth included; past FAR a
+        # common power of two goes into the log-scale instead (no overflow).
+        peak = size_estimate(q).max(axis=(1, 2))
+        far = (peak > self.FAR) | (peak < 1 / self.FAR)
+        if far.any():
+            common = np.where(far, power_of_two_scale(peak), 1.0)
+            q = q * common[:, None, None]
+            self.log_scale -= np.log(common) * q.shape[2]
         offset = 0
         for row in touching:
             row[1], row[2] = state.columns, q[:, offset:offset + row[2].shape[1]]

@@ -1,0 +1,132 @@
+"""Repeated cells: a run of identical elements carried by powers of its cell matrix.
+
+A chain of N identical links (a spring–mass chain, a row of equal bays)
+repeats the same p elements R times. Carrying the state through them one
+element at a time costs R·p steps per evaluation; the cell's transfer
+matrix C(ω) = U_p ⋯ U_1 raised by repeated squaring needs about log2 R
+products, and the state takes one product per set bit of R.
+
+Squaring forms C^(2^j) without the orthonormalisation that keeps decaying
+solutions alive in the element-by-element carry, so a power is used only
+while that is harmless. Transfer matrices of conservative elements are
+symplectic, Pᵀ J P = J (J the energy pairing of the state), and the pairing
+growth max (|P|ᵀ |J| |P|) over the paired entries of J says how much
+cancellation that identity needs: relative rounding errors ε in P's entries
+become errors ε·growth in it. It is 1 for the identity and for a pure
+stretch diag(λ, 1/λ) (which loses nothing), and grows like λ² where growing
+and decaying solutions mix, as they do when decaying digits are lost.
+Powers beyond PAIRING_LIMIT are not formed; if the cell itself exceeds it,
+the run is carried element by element as before.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from linmstmm.elements.frames import FORCE_INDEX, SYMPLECTIC_FORM
+
+#: Largest pairing growth of a power used: at most four digits of the
+#: decaying solutions, as GROWTH² does in the element-by-element carry.
+PAIRING_LIMIT = 1e4
+#: Shortest run (repetitions of its cell) worth powering.
+MIN_REPETITIONS = 8
+#: Longest cell looked for, elements.
+MAX_PERIOD = 4
+
+
+@dataclass(frozen=True)
+class Run:
+    """``repetitions`` copies of the elements ``cell`` (topology ids, in carry
+    order) starting at position ``start`` of the carry order."""
+
+    start: int
+    cell: tuple
+    repetitions: int
+
+    @property
+    def stop(self) -> int:
+        """Position in the carry order just after the run."""
+        return self.start + len(self.cell) * self.repetitions
+
+
+def find_runs(topology, parts) -> list[Run]:
+    """Runs of a repeated cell of single-input rigid bodies, springs and junctions.
+
+    parts : callable element id -> (kinematic, inertial or None), the element's
+    U = kinematic + ω² inertial. Inside a run every element's only input is the
+    previous element's output; equal cells have equal parts to 1e-14.
+    """
+    order = topology.order
+    elements = topology.elements
+    size = len(order)
+    chained = np.array([elements[e].kind != "beam" and len(elements[e].inputs) == 1 for e in order])
+    follows = np.array([i > 0 and elements[order[i]].ports[elements[order[i]].inputs[0]].link[:2]
+                        == ("element", order[i - 1]) for i in range(size)])
+    stacked = [parts(e) if ok else (np.full((12, 12), np.nan), None) for e, ok in zip(order, chained)]
+    kinematic = np.array([k for k, _ in stacked])
+    inertial = np.array([np.zeros((12, 12)) if i is None else i for _, i in stacked])
+    has_inertial = np.array([i is not None for _, i in stacked])
+    streaks = {}
+    for period in range(1, min(MAX_PERIOD, size - 1) + 1):
+        # good[j]: element j + period repeats element j and is chained to its predecessor
+        good = (_close(kinematic[:-period], kinematic[period:]) & _close(inertial[:-period], inertial[period:])
+                & (has_inertial[:-period] == has_inertial[period:]) & chained[period:] & follows[period:])
+        streak = np.zeros(size + 1, dtype=int)  # consecutive good from j on
+        for j in range(len(good) - 1, -1, -1):
+            streak[j] = streak[j + 1] + 1 if good[j] else 0
+        streaks[period] = streak
+    runs, i = [], 0
+    while i < size:
+        best = None
+        for period, streak in streaks.items():
+            if i + period > size or not chained[i:i + period].all() or not follows[i + 1:i + period].all():
+                continue
+            repetitions = 1 + streak[i] // period
+            if repetitions >= MIN_REPETITIONS and (best is None or repetitions * period
+                                                   > best.repetitions * len(best.cell)):
+                best = Run(i, tuple(order[i:i + period]), int(repetitions))
+        if best is None:
+            i += 1
+        else:
+            runs.append(best)
+            i = best.stop
+    return runs
+
+
+def _close(a, b) -> np.ndarray:
+    """(m,) whether each pair of (12, 12) matrices agrees to 1e-14 of its size."""
+    scale = np.maximum(np.abs(a).max(axis=(1, 2)), np.abs(b).max(axis=(1, 2)))
+    return np.all(np.abs(a - b) <= 1e-14 * scale[:, None, None], axis=(1, 2))
+
+
+def pairing_growth(power: np.ndarray) -> np.ndarray:
+    """(n,) max over the paired entries (a, FORCE_INDEX[a]) of |P|ᵀ |J| |P|, for a
+    stack (n, 12, 12) of symplectic matrices (dimensionless: each term pairs a
+    displacement with a force)."""
+    size = np.abs(power)
+    pairing = np.swapaxes(size, 1, 2) @ np.abs(SYMPLECTIC_FORM) @ size
+    return pairing[:, np.arange(6), FORCE_INDEX].max(axis=1)
+
+
+def carry_run(cell_matrix: np.ndarray, repetitions: int, matrix: np.ndarray, settle):
+    """State (n, 12, k) carried through ``repetitions`` cells, or None if the cell
+    itself is too ill-conditioned to power (carry element by element then).
+
+    cell_matrix : (n, 12, 12) C(ω). settle : callable (n, 12, k) -> (n, 12, k),
+    applied after each product (the carry's growth check and orthonormalisation).
+    """
+    if np.max(pairing_growth(cell_matrix)) > PAIRING_LIMIT:
+        return None
+    powers = [cell_matrix]
+    while 2 ** len(powers) <= repetitions:
+        square = powers[-1] @ powers[-1]
+        if np.max(pairing_growth(square)) > PAIRING_LIMIT:
+            break
+        powers.append(square)
+    remaining = repetitions
+    for j in range(len(powers) - 1, -1, -1):
+        while remaining >= 2 ** j:
+            matrix = settle(powers[j] @ matrix)
+            remaining -= 2 ** j
+    return matrix

@@ -238,6 +238,12 @@ class RootFinder:
         at_zero, generic = self.matrix(np.array([0.0, 1.0]))
         return nullity(at_zero, scales=equilibration(generic))
 
+    def _pencil(self, omegas, step: float = 1e-7):
+        """(Ū(ω), dŪ/dω), the derivative a forward difference of ``matrix``."""
+        steps = step * omegas
+        stack = self.matrix(np.concatenate([omegas, omegas + steps]))
+        return stack[:omegas.size], (stack[omegas.size:] - stack[:omegas.size]) / steps[:, None, None]
+
     def _offsets(self, omegas, full=True) -> list[np.ndarray]:
         """For each ω: generalized eigenvalues μ of (Ū(ω), dŪ/dω), sorted by |μ| (complex).
 
@@ -257,9 +263,7 @@ class RootFinder:
         """
         omegas = np.asarray(omegas, dtype=float)
         n = omegas.size
-        steps = 1e-7 * omegas
-        stack = self.matrix(np.concatenate([omegas, omegas + steps]))
-        A, derivative = stack[:n], (stack[n:] - stack[:n]) / steps[:, None, None]
+        A, derivative = self._pencil(omegas)
         usable = (omegas > 0) & np.isfinite(A).all(axis=(1, 2)) & np.isfinite(derivative).all(axis=(1, 2))
         rows, cols = equilibration(A[usable])
         A = rows[..., :, None] * A[usable] * cols[..., None, :]
@@ -327,7 +331,9 @@ class RootFinder:
         possibly multiple, root, and their offsets seen from it may show a
         higher multiplicity than the first arrival's did: a double root of a
         loop rigid in five directions showed its second offset only within
-        1e-13 of the root). ``confirm``: see :meth:`_multiplicities`.
+        1e-13 of the root). Without ``confirm`` (see :meth:`_multiplicities`)
+        members are not polished either: the caller's closing count would see
+        one missed.
         """
         polished = self.polish(starts)
         groups, members_from = [], []
@@ -338,7 +344,8 @@ class RootFinder:
             groups.append([centre] * multiplicity)
             real = mu[np.abs(mu.imag) <= 1e-6 * np.abs(mu)].real
             near = real[(np.abs(real) < self.CLUSTER_WINDOW * centre) & (np.abs(real) >= self.SPLIT * centre)]
-            members_from += [(len(groups) - 1, centre - offset) for offset in near]
+            if confirm:  # (a caller that counts everything at the end finds a missed member there)
+                members_from += [(len(groups) - 1, centre - offset) for offset in near]
         if members_from:
             returned = []  # members that came back to a root of their group: more evidence
             for (g, _), result in zip(members_from, self.polish([s for _, s in members_from])):

@@ -1,15 +1,21 @@
 """Roots of det Ū_all(ω): count, scan, bracket, refine, multiplicity.
 
-Nothing is missed because every interval's roots are counted before they are
-looked for: det Ū_all is an entire function of ω (no inverse is taken), real
-on the real axis, whose zeros are the natural frequencies with their
+Nothing is missed because every root found is checked against a count:
+det Ū_all is an entire function of ω (no inverse is taken), real on the
+real axis, whose zeros are the natural frequencies with their
 multiplicities, so the argument principle on a half-ellipse counts them
-(:func:`count_zeros`). The search then works segment by segment upwards:
+(:func:`count_zeros`).
 
-1. a scan of (sign, log|det|) on a geometric grid of at least
-   ``points_per_root`` points per counted root;
-2. sign changes are bisected to 1e-4 and local minima of log|det| without a
-   sign change (even multiplicity, close pairs) are taken as starts;
+The fast path (:meth:`RootFinder._scan_ahead`) scans (sign, log|det|)
+upwards until it has seen enough candidates, polishes them all at once and
+keeps the result only if one count from OMEGA_FLOOR agrees. Otherwise the
+search works segment by segment upwards:
+
+1. a count, then a scan on a geometric grid of at least ``points_per_root``
+   points per counted root;
+2. Newton starts where the line through |det| crosses zero in each sign
+   change, and at local minima of log|det| without a sign change (even
+   multiplicity, close pairs);
 3. Newton on the local linearisation (:meth:`RootFinder.polish`, all starts
    at once) converges to machine precision on simple and semisimple multiple
    roots alike; the multiplicity comes from the linearised pencil's

@@ -18,8 +18,9 @@ boundary conditions already applied:
   ``−H_j S_I1 + H_{j,Ik} S_Ik = 0``.
 
 Only the columns of the tips upstream of a port are stored with it, so the
-cost of one evaluation is linear in the number of elements. Everything is
-vectorised over a stack of frequencies.
+cost of one evaluation is linear in the number of elements (a run of
+identical cells costs the logarithm of its length: :mod:`linmstmm.periodic`).
+Everything is vectorised over a stack of frequencies.
 """
 from __future__ import annotations
 
@@ -221,12 +222,10 @@ class Deduction:
                 if stable and link[0] == "cut":
                     normaliser.consume_cut_side(link[1], self._cut_columns[link[1]])
             run = runs.get(position)
-            carried = None if run is None else carry_run(
-                self._cell_matrix(run, omega), run.repetitions, inputs[0].matrix,
-                lambda matrix: normaliser.apply(PortState(inputs[0].columns, matrix), rows, open_states).matrix)
-            if carried is not None:
+            powered = None if run is None else self._carry_run(run, omega, inputs[0], normaliser, rows, open_states)
+            if powered is not None:
                 last = order[run.stop - 1]
-                outputs[last] = open_states[last] = PortState(inputs[0].columns, carried)
+                outputs[last] = open_states[last] = powered
                 position = run.stop
                 continue
             position += 1
@@ -251,6 +250,14 @@ class Deduction:
         if self._runs is None:
             self._runs = find_runs(self.topology, self._polynomial_parts)
         return self._runs
+
+    def _carry_run(self, run, omega, state, normaliser, rows, open_states):
+        """The state after all of ``run``'s cells (powers of the cell matrix,
+        orthonormalised after each product), or None if the cell is too
+        ill-conditioned to power."""
+        matrix = carry_run(self._cell_matrix(run, omega), run.repetitions, state.matrix,
+                           lambda m: normaliser.apply(PortState(state.columns, m), rows, open_states).matrix)
+        return None if matrix is None else PortState(state.columns, matrix)
 
     def _cell_matrix(self, run, omega) -> np.ndarray:
         """(n, 12, 12) transfer matrix of one cell of ``run``: U_p ⋯ U_1."""

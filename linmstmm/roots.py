@@ -92,10 +92,7 @@ def count_zeros(log_det, a: float, b: float, max_points: int = 20000) -> int:
     log_det : callable complex omega (n,) -> (phase factor (n,), log|det| (n,)).
     Raises RuntimeError if the count cannot be made.
     """
-    count = count_zeros_many(log_det, [(a, b)], max_points)[0]
-    if isinstance(count, RuntimeError):
-        raise count
-    return count
+    return _raised(count_zeros_many(log_det, [(a, b)], max_points)[0])
 
 
 def count_zeros_many(log_det, intervals, max_points: int = 20000, initial_points: int = 65) -> list:
@@ -116,8 +113,12 @@ def count_in_disc(log_det, radius: float, max_points: int = 20000) -> int:
     det is even in ω and real on the real axis, so the upper half circle,
     from +radius to −radius, carries half the winding: count = Δarg / π.
     """
-    count = _half_windings(log_det, [lambda theta: radius * np.exp(1j * theta)],
-                           [f"|ω| < {radius:.6g} rad/s"], max_points)[0]
+    return _raised(_half_windings(log_det, [lambda theta: radius * np.exp(1j * theta)],
+                                  [f"|ω| < {radius:.6g} rad/s"], max_points)[0])
+
+
+def _raised(count):
+    """``count``, or raise it if it is the RuntimeError a count came back with."""
     if isinstance(count, RuntimeError):
         raise count
     return count
@@ -129,11 +130,9 @@ def _half_windings(log_det, paths, wheres, max_points: int, initial_points: int 
     to ``log_det`` together. Returns an int or a RuntimeError per path."""
     def phases(pieces):
         """Angles of det at path_i(θ_i) for the (i, θ_i) pieces, one evaluation."""
-        omega = np.concatenate([paths[i](theta) for i, theta in pieces])
-        sign, log_abs = log_det(omega)
-        angles = np.split(np.angle(sign), np.cumsum([theta.size for _, theta in pieces])[:-1])
-        finite = np.split(np.isfinite(log_abs), np.cumsum([theta.size for _, theta in pieces])[:-1])
-        return angles, [bool(ok.all()) for ok in finite]
+        sign, log_abs = log_det(np.concatenate([paths[i](theta) for i, theta in pieces]))
+        edges = np.cumsum([theta.size for _, theta in pieces])[:-1]
+        return np.split(np.angle(sign), edges), [bool(ok.all()) for ok in np.split(np.isfinite(log_abs), edges)]
 
     thetas = [np.linspace(0.0, np.pi, initial_points) for _ in paths]
     angles, finite = phases(list(enumerate(thetas)))

@@ -87,6 +87,8 @@ def _print_frequency_table(title, result):
     for index, f in enumerate(result["frequencies_hz"], start=1):
         print(f"  {index:>4}  {f:>20.12g}  {2 * 3.141592653589793 * f:>20.12g}")
     print(f"  solve time: {result['seconds'] * 1e3:.2f} ms")
+    if result.get("note"):
+        print(f"  note: {result['note']}")
 
 
 def _run_freqs(args):

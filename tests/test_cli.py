@@ -29,6 +29,15 @@ def test_freqs_json_follows_the_contract():
     np.testing.assert_allclose(data["frequencies_hz"], expected, rtol=1e-12)
 
 
+def test_freqs_says_when_fewer_modes_exist_than_asked_for():
+    """6 degrees of freedom, 10 asked: the table and the JSON both carry the note."""
+    table = run("freqs", "models/spring_mass_chain.toml", "--count", "10")
+    assert table.returncode == 0, table.stderr
+    assert "note: only 6 elastic natural frequencies exist" in table.stdout
+    data = json.loads(run("freqs", "models/spring_mass_chain.toml", "--count", "10", "--json").stdout)
+    assert len(data["frequencies_hz"]) == 6 and data["note"].startswith("only 6 elastic")
+
+
 def test_freqs_fmax_and_count_stop_at_whichever_comes_first():
     by_fmax = json.loads(run("freqs", "models/cantilever_tip_mass.toml", "--json", "--fmax", "100").stdout)
     assert by_fmax["frequencies_hz"] == sorted(by_fmax["frequencies_hz"])

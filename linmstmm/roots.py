@@ -434,8 +434,8 @@ class RootFinder:
     def _roots_in(self, grid, expected: int) -> list[float]:
         """Roots inside (grid[0], grid[-1]) reached from the scan, up to ``expected`` of them.
 
-        Polishing starts from every sign change bisected to 1e-4 (roots of
-        odd multiplicity; Newton from there does not wander off), then from local minima of log|det| without a sign
+        Polishing starts in every sign change (roots of odd multiplicity; see
+        :meth:`_bracketed`), then from local minima of log|det| without a sign
         change (roots of even multiplicity, close pairs), deepest first, as
         many as the count says are still missing.
         """
@@ -445,9 +445,7 @@ class RootFinder:
         for members in self._bracketed(grid[brackets], grid[brackets + 1],
                                        log_abs[brackets + 1] - log_abs[brackets]):
             self._merge(found, members, grid[0], grid[-1])
-        inner = np.arange(1, len(grid) - 1)
-        minima = inner[(log_abs[inner] < log_abs[inner - 1]) & (log_abs[inner] < log_abs[inner + 1])
-                       & (sign[inner - 1] == sign[inner]) & (sign[inner] == sign[inner + 1])]
+        minima = _quiet_minima(sign, log_abs)
         minima = [i for i in minima[np.argsort(log_abs[minima] - np.maximum(log_abs[minima - 1],
                                                                             log_abs[minima + 1]))]
                   if not any(grid[i - 1] < r < grid[i + 1] for r in found)]
@@ -589,9 +587,7 @@ class RootFinder:
             sign, log_abs = self.log_det(grid)
             change = np.flatnonzero(sign[:-1] * sign[1:] < 0)
             brackets += zip(grid[change], grid[change + 1], log_abs[change + 1] - log_abs[change])
-            inner = np.arange(1, grid.size - 1)
-            minima += list(grid[inner[(log_abs[inner] < log_abs[inner - 1]) & (log_abs[inner] < log_abs[inner + 1])
-                                      & (sign[inner - 1] == sign[inner]) & (sign[inner] == sign[inner + 1])]])
+            minima += list(grid[_quiet_minima(sign, log_abs)])
             if omega_max is not None and hi >= omega_max or omega_max is None and len(found) + len(brackets) + len(minima) >= count:
                 if count is not None:  # only the lowest candidates matter
                     keep = sorted([(b[0], b) for b in brackets] + [(m, None) for m in minima])[:count - len(found)]
@@ -692,6 +688,14 @@ def _inverse_eigenvalues(stack, full, iterations: int = 6) -> list[np.ndarray]:
             for i, values in zip(rest, np.linalg.eigvals(stack[rest])):
                 out[i] = 1 / values[values != 0]
     return out
+
+
+def _quiet_minima(sign, log_abs) -> np.ndarray:
+    """Indices of a scan's interior local minima of log|det| with no sign change on
+    either side: where a root of even multiplicity or a close pair may hide."""
+    inner = np.arange(1, len(sign) - 1)
+    return inner[(log_abs[inner] < log_abs[inner - 1]) & (log_abs[inner] < log_abs[inner + 1])
+                 & (sign[inner - 1] == sign[inner]) & (sign[inner] == sign[inner + 1])]
 
 
 def release_indeterminate(deduction, probe=(0.7310, 1.9137, 5.3)) -> int:

@@ -212,6 +212,7 @@ class RootFinder:
         self.last_step: dict[float, float] = {}
         #: why the search ended early, if it did
         self.note = ""
+        self._rigid: int | None = None
 
     def divide_out_rigid_body_zeros(self, rigid: int) -> None:
         """Count and scan det Ū_all / ω^2r instead of det Ū_all.
@@ -234,14 +235,16 @@ class RootFinder:
         self.log_det = reduced
 
     def rigid_body_modes(self) -> int:
-        """Nullity of Ū_all at ω = 0: zero-frequency (rigid-body) modes.
+        """Nullity of Ū_all at ω = 0: zero-frequency (rigid-body) modes (computed once).
 
         Balanced with the scales of a generic frequency (1 rad/s): at ω = 0
         itself, columns that vanish there (a closed ring's T − I) would be
         blown up and hide the null vectors.
         """
-        at_zero, generic = self.matrix(np.array([0.0, 1.0]))
-        return nullity(at_zero, scales=equilibration(generic))
+        if self._rigid is None:
+            at_zero, generic = self.matrix(np.array([0.0, 1.0]))
+            self._rigid = nullity(at_zero, scales=equilibration(generic))
+        return self._rigid
 
     def _pencil(self, omegas, step: float = 1e-7):
         """(Ū(ω), dŪ/dω), the derivative a forward difference of ``matrix``."""
@@ -403,32 +406,67 @@ class RootFinder:
         return self.clusters([omega])[0]
 
     def shrink_brackets(self, lo, hi, width: float = 1e-4) -> np.ndarray:
-        """Midpoints of sign-change brackets (lo_i, hi_i) bisected to ``width``·hi, all at once."""
+        """Midpoints of sign-change brackets (lo_i, hi_i) narrowed to ``width``·hi (:meth:`_narrowed`)."""
+        lo, hi = self._narrowed(lo, hi, width)
+        return (lo + hi) / 2
+
+    def _narrowed(self, lo, hi, width: float):
+        """Sign-change brackets (lo_i, hi_i) narrowed to ``width``·hi, all at once: (lo, hi).
+
+        Regula falsi on det itself (the point where the line through ±|det| at
+        the ends crosses zero, from log|det| so nothing overflows), with the
+        Illinois rule: an end kept twice in a row has its |det| halved, so
+        both ends move and convergence is superlinear; a bracket that keeps
+        one end three times in a row is bisected once.
+        """
         lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
         if lo.size == 0:
-            return lo
-        sign_lo = self.log_det(lo)[0]
-        while np.any(hi - lo > width * hi):
-            middle = (lo + hi) / 2
-            sign_middle = self.log_det(middle)[0]
-            left = sign_middle * sign_lo < 0
-            hi, lo = np.where(left, middle, hi), np.where(left, lo, middle)
-            sign_lo = np.where(left, sign_lo, sign_middle)
-        return (lo + hi) / 2
+            return lo, hi
+        sign, log_abs = self.log_det(np.r_[lo, hi])
+        sign_lo, log_lo, log_hi = sign[:lo.size], log_abs[:lo.size], log_abs[lo.size:]
+        kept = np.zeros(lo.size)  # +k: lo kept k times in a row, −k: hi
+        width = max(width, 4 * np.finfo(float).eps)
+        while True:
+            active = np.flatnonzero(hi - lo > width * hi)
+            if active.size == 0:
+                return lo, hi
+            a, b = lo[active], hi[active]
+            fraction = 1 / (1 + np.exp(np.clip(log_hi[active] - log_lo[active], -700, 700)))
+            fraction = np.where(np.abs(kept[active]) >= 3, 0.5, fraction)
+            x = np.clip(a + (b - a) * fraction, a + (b - a) * 1e-3, b - (b - a) * 1e-3)
+            sign_x, log_x = self.log_det(x)
+            left = sign_x * sign_lo[active] < 0  # the root is in (lo, x]: hi moves, lo is kept
+            kept[active] = np.where(left, np.maximum(kept[active], 0) + 1, np.minimum(kept[active], 0) - 1)
+            halve = np.log(2.0) * (np.abs(kept[active]) >= 2)
+            hi[active], lo[active] = np.where(left, x, b), np.where(left, a, x)
+            log_hi[active] = np.where(left, log_x, log_hi[active] - halve)
+            log_lo[active] = np.where(left, log_lo[active] - halve, log_x)
+            sign_lo[active] = np.where(left, sign_lo[active], sign_x)
 
     def _bracketed(self, lo, hi, log_ratio, confirm: bool = True) -> list[list[float]]:
         """The cluster of the root in each sign-change bracket (lo_i, hi_i].
 
         Newton starts where the straight line through |det| at the two ends
         (log_ratio = log|det(hi)| − log|det(lo)|) crosses zero; a bracket
-        whose Newton lands outside it is bisected to 1e-4 and tried again
-        (a root it reached instead is kept: it is a root too).
+        whose Newton lands outside it is narrowed to 1e-4 and tried again
+        (a root it reached instead is kept: it is a root too). A root Newton
+        still cannot reach (the orthonormalised basis can absorb a root whose
+        column is all but one small component, e.g. a weak torsion mode next to
+        stiff bending, so that the pencil does not show it) is taken from the
+        bracket narrowed to ``xtol`` by regula falsi on det itself, as a
+        simple root (a sign change: odd multiplicity; a count sees a triple one).
         """
         starts = lo + (hi - lo) / (1 + np.exp(np.clip(log_ratio, -700, 700)))
         groups = self.clusters(starts, confirm)
         missed = [i for i, group in enumerate(groups) if not any(lo[i] < r <= hi[i] for r in group)]
         if missed:
             groups += self.clusters(self.shrink_brackets(lo[missed], hi[missed]), confirm)
+            missed = [i for i in missed if not any(lo[i] < r <= hi[i] for group in groups for r in group)]
+        if missed:
+            a, b = self._narrowed(lo[missed], hi[missed], self.xtol)
+            for root, uncertainty in zip((a + b) / 2, (b - a) / b):
+                self.last_step[root] = uncertainty
+                groups.append([root])
         return groups
 
     def _roots_in(self, grid, expected: int) -> list[float]:
@@ -601,8 +639,10 @@ class RootFinder:
                 brackets, minima = [], []
                 if omega_max is not None or len(found) >= count:
                     return self._confirmed(found, count, omega_max)
-            seen = found + [b[0] for b in brackets] + minima
-            if hi >= OMEGA_CEILING or (seen and hi > 1e3 * max(seen)):  # fewer roots than count
+            # fewer roots than count? (sign changes only: a shallow quiet minimum far
+            # below the first root is no evidence that the roots have run out)
+            seen = found + [b[0] for b in brackets]
+            if omega_max is None and (hi >= OMEGA_CEILING or (seen and hi > 1e3 * max(seen))):
                 return None
             lo, hi = hi, 4 * hi
 

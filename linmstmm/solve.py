@@ -68,11 +68,15 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), **options
 
     root, cut_at : see :func:`linmstmm.topology.build_topology`. options go to
     :class:`linmstmm.roots.RootFinder` (xtol, points_per_octave, points_per_root).
+    The finder has counted the rigid-body modes and divides their zeros out of
+    det Ū_all (:meth:`~linmstmm.roots.RootFinder.divide_out_rigid_body_zeros`),
+    so every caller's counts see the elastic roots only.
     Returns (deduction, finder, number of indeterminate unknowns released).
     """
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
     released = release_indeterminate(deduction)
     finder = RootFinder(deduction.log_det, lambda omega: deduction.matrix(omega, stable=True)[0], **options)
+    finder.divide_out_rigid_body_zeros(finder.rigid_body_modes())
     return deduction, finder, released
 
 
@@ -92,7 +96,6 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     start = time.perf_counter()
     deduction, finder, released = frequency_finder(model, root)
     rigid = finder.rigid_body_modes()
-    finder.divide_out_rigid_body_zeros(rigid)
     omega_max = None if fmax is None else 2 * np.pi * fmax
     if guess_hz is not None and count is not None and fmax is None:
         omegas = np.array(finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count))

@@ -25,10 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from builders import make_beam, make_rigid, make_spring
-from linmstmm.deduction import Deduction
 from linmstmm.model import Model
-from linmstmm.roots import RootFinder, release_indeterminate
-from linmstmm.topology import build_topology
+from linmstmm.solve import frequency_finder
 
 KINDS = ("tree", "floating_tree", "loops", "floating_loops", "ring")
 _COMPONENTS = ("x", "y", "z", "rx", "ry", "rz")
@@ -373,9 +371,7 @@ def mstmm_frequencies(model: Model, count: int = 10, root: str | None = None,
                       cut_at=()) -> np.ndarray:
     """Elastic frequencies (Hz) as ``natural_frequencies`` finds them, but with
     ``root`` and the loop cuts ``cut_at`` chosen (no mpmath escalation)."""
-    deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
-    release_indeterminate(deduction)
-    finder = RootFinder(deduction.log_det, lambda omega: deduction.matrix(omega, stable=True)[0])
+    _, finder, _ = frequency_finder(model, root=root, cut_at=cut_at)
     return np.array(finder.find(count, None)) / (2 * np.pi)
 
 

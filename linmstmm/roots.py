@@ -339,9 +339,8 @@ class RootFinder:
         possibly multiple, root, and their offsets seen from it may show a
         higher multiplicity than the first arrival's did: a double root of a
         loop rigid in five directions showed its second offset only within
-        1e-13 of the root). Without ``confirm`` (see :meth:`_multiplicities`)
-        members are not polished either: the caller's closing count would see
-        one missed.
+        1e-13 of the root). Without ``confirm`` the multiplicities are read
+        from the offsets alone (see :meth:`_multiplicities`).
         """
         polished = self.polish(starts)
         groups, members_from = [], []
@@ -352,8 +351,7 @@ class RootFinder:
             groups.append([centre] * multiplicity)
             real = mu[np.abs(mu.imag) <= 1e-6 * np.abs(mu)].real
             near = real[(np.abs(real) < self.CLUSTER_WINDOW * centre) & (np.abs(real) >= self.SPLIT * centre)]
-            if confirm:  # (a caller that counts everything at the end finds a missed member there)
-                members_from += [(len(groups) - 1, centre - offset) for offset in near]
+            members_from += [(len(groups) - 1, centre - offset) for offset in near]
         if members_from:
             returned = []  # members that came back to a root of their group: more evidence
             for (g, _), result in zip(members_from, self.polish([s for _, s in members_from])):

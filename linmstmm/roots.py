@@ -213,6 +213,8 @@ class RootFinder:
         #: why the search ended early, if it did
         self.note = ""
         self._rigid: int | None = None
+        #: starts of cluster members not yet polished (see :meth:`clusters`)
+        self.deferred_members: list[float] = []
 
     def divide_out_rigid_body_zeros(self, rigid: int) -> None:
         """Count and scan det Ū_all / ω^2r instead of det Ū_all.
@@ -340,7 +342,9 @@ class RootFinder:
         higher multiplicity than the first arrival's did: a double root of a
         loop rigid in five directions showed its second offset only within
         1e-13 of the root). Without ``confirm`` the multiplicities are read
-        from the offsets alone (see :meth:`_multiplicities`).
+        from the offsets alone (see :meth:`_multiplicities`) and the member
+        starts go to :attr:`deferred_members` (a simple root's pencil can show
+        a spurious near offset: polishing every one cost MLRS 6 ms).
         """
         polished = self.polish(starts)
         groups, members_from = [], []
@@ -351,7 +355,10 @@ class RootFinder:
             groups.append([centre] * multiplicity)
             real = mu[np.abs(mu.imag) <= 1e-6 * np.abs(mu)].real
             near = real[(np.abs(real) < self.CLUSTER_WINDOW * centre) & (np.abs(real) >= self.SPLIT * centre)]
-            members_from += [(len(groups) - 1, centre - offset) for offset in near]
+            if confirm:
+                members_from += [(len(groups) - 1, centre - offset) for offset in near]
+            else:  # polished only if the caller's closing count finds one missing
+                self.deferred_members += [centre - offset for offset in near]
         if members_from:
             returned = []  # members that came back to a root of their group: more evidence
             for (g, _), result in zip(members_from, self.polish([s for _, s in members_from])):
@@ -603,17 +610,22 @@ class RootFinder:
         """Guess, polish, confirm: the fast path of :meth:`find`, or None.
 
         A coarse scan (``points_per_octave`` above 1 rad/s, an eighth of it
-        below) goes up in chunks of two octaves until it has seen ``count``
-        + 1 candidates (sign changes, and minima of log|det| without one) or
-        reached ``omega_max``; all are polished at once (more chunks if their
-        multiplicities leave fewer than ``count`` roots) and one count from
-        OMEGA_FLOOR must agree. Multiplicities are read from the pencil
-        offsets without a count each: a wrong one changes the total, which
-        that count sees (unless an opposite error elsewhere cancels it). Far fewer evaluations than the segment
-        search when it works; when it does not (a root between two
-        candidates, a chain of clusters), :meth:`find` falls back.
+        below) goes up in chunks (to 16 rad/s, then up to ×4 each, less where
+        the candidates so far extrapolate to ``count`` sooner: :meth:`_next_top`)
+        until it has seen ``count`` candidates (sign changes, and minima of
+        log|det| without one) or reached ``omega_max``; all are polished at
+        once (more chunks if their multiplicities leave fewer than ``count``
+        roots) and one count from OMEGA_FLOOR must agree. Multiplicities are
+        read from the pencil offsets without a count each: a wrong one changes
+        the total, which that count sees (unless an opposite error elsewhere
+        cancels it). If the count finds more, the deferred cluster members
+        (:meth:`clusters`) are polished and the count repeated once. Far fewer
+        evaluations than the segment search when it works; when it does not
+        (a root between two candidates, a chain of clusters), :meth:`find`
+        falls back.
         """
         found: list[float] = []
+        self.deferred_members = []
         brackets, minima = [], []  # (lo, hi, log|det(hi)| − log|det(lo)|) and grid points
         lo, hi = OMEGA_FLOOR, 16.0
         while True:
@@ -636,13 +648,17 @@ class RootFinder:
                     found.sort()
                 brackets, minima = [], []
                 if omega_max is not None or len(found) >= count:
-                    return self._confirmed(found, count, omega_max)
+                    confirmed = self._confirmed(found, count, omega_max)
+                    if confirmed is None and self.deferred_members:  # a close pair's other member?
+                        found = self._polished(self.deferred_members, found, confirm=False)
+                        confirmed = self._confirmed(found, count, omega_max)
+                    return confirmed
             # fewer roots than count? (sign changes only: a shallow quiet minimum far
             # below the first root is no evidence that the roots have run out)
             seen = found + [b[0] for b in brackets]
             if omega_max is None and (hi >= OMEGA_CEILING or (seen and hi > 1e3 * max(seen))):
                 return None
-            lo, hi = hi, 4 * hi
+            lo, hi = hi, self._next_top(hi, sorted(found + [b[0] for b in brackets] + minima), count)
 
     def _quick_grid(self, lo: float, hi: float) -> np.ndarray:
         """The fast path's scan of [lo, hi]: points_per_octave above 1 rad/s, an eighth below."""

@@ -451,16 +451,16 @@ class _Orthonormaliser:
 
 
 def balanced_slogdet(stack):
-    """slogdet of a (n, N, N) stack after exact power-of-two row and column scaling.
+    """slogdet of a (n, N, N) stack after exact power-of-two row scaling.
 
-    Ū_all mixes metres, radians, newtons and newton-metres; balancing first
-    keeps LU's error relative to each row's and column's own size.
+    Ū_all mixes metres, radians, newtons and newton-metres; scaling every row
+    to max |a| ~ 1 first lets partial pivoting compare like with like, so LU's
+    error stays relative to each row's own size. (Column scaling would change
+    nothing: LU with partial pivoting commutes with it exactly.)
     """
-    size = size_estimate(stack)
-    rows = power_of_two_scale(size.max(axis=2))
-    cols = power_of_two_scale((size * rows[:, :, None]).max(axis=1))
-    sign, log_abs = np.linalg.slogdet(stack * rows[:, :, None] * cols[:, None, :])
-    return sign, log_abs - np.log(rows).sum(axis=1) - np.log(cols).sum(axis=1)
+    rows = power_of_two_scale(size_estimate(stack).max(axis=2))
+    sign, log_abs = np.linalg.slogdet(stack * rows[:, :, None])
+    return sign, log_abs - np.log(rows).sum(axis=1)
 
 
 def _embed(columns, block, onto):

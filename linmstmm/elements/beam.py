@@ -16,6 +16,7 @@ cancellation: all terms positive) and by cosh/cos, sinh/sin otherwise.
 """
 from __future__ import annotations
 
+import functools
 import math
 
 import mpmath
@@ -33,10 +34,10 @@ _SERIES_COEFFS = np.array([[1.0 / math.factorial(4 * j + r) for j in range(_SERI
                            for r in range(4)])
 
 # Local state indices of each deformation: (displacement, rotation, moment, force).
-_BENDING_XY = [1, 5, 8, 10]
-_BENDING_XZ = [2, 4, 7, 11]
-_AXIAL = [0, 9]
-_TORSION = [3, 6]
+_BENDING_XY = np.array([1, 5, 8, 10])
+_BENDING_XZ = np.array([2, 4, 7, 11])
+_AXIAL = np.array([0, 9])
+_TORSION = np.array([3, 6])
 #: (w, θy, my, qz) = D (v, θ, m, q) maps the x-z plane onto the x-y form.
 _XZ_SIGNS = np.array([1.0, -1.0, -1.0, 1.0])
 
@@ -83,15 +84,27 @@ def bending_wavenumber(beam, omega) -> float:
     return (beam.rho * beam.A * abs(omega) ** 2 / (beam.E * min(beam.Iy, beam.Iz))) ** 0.25
 
 
-def bending_transfer(EI, rhoA, L, omega) -> np.ndarray:
-    """(n, 4, 4) transfer of (v, θ, m, q) in the x-y form of the bending equations."""
-    w = rhoA * omega**2 * L**4 / EI
-    F0, F1, F2, F3 = krylov(w)
-    out = zeros_like_stack(omega, (4, 4))
-    out[:, 0] = np.stack([F0, L * F1, -L**2 * F2 / EI, L**3 * F3 / EI], axis=-1)
-    out[:, 1] = np.stack([w * F3 / L, F0, -L * F1 / EI, L**2 * F2 / EI], axis=-1)
-    out[:, 2] = np.stack([-EI * w * F2 / L**2, -EI * w * F3 / L, F0, -L * F1], axis=-1)
-    out[:, 3] = np.stack([EI * w * F1 / L**3, EI * w * F2 / L**2, -w * F3 / L, F0], axis=-1)
+#: Entry (i, j) of the bending transfer of (v, θ, m, q) is
+#: SIGN · L^L_POWER · EI^EI_POWER · w^W_POWER · F_r(w) with r = KRYLOV_INDEX.
+_KRYLOV_INDEX = (np.arange(4)[None, :] - np.arange(4)[:, None]) % 4
+_L_POWER = np.arange(4)[None, :] - np.arange(4)[:, None]
+_EI_POWER = (np.arange(4)[:, None] >= 2).astype(int) - (np.arange(4)[None, :] >= 2).astype(int)
+_W_POWER = np.arange(4)[:, None] > np.arange(4)[None, :]
+_SIGN = np.outer([1, 1, -1, 1], [1, 1, -1, 1])
+
+
+def bending_transfers(EIs, rhoA, L, omega) -> list[np.ndarray]:
+    """(n, 4, 4) transfer of (v, θ, m, q) in the x-y form of the bending equations,
+    one per bending stiffness in ``EIs`` (one Krylov evaluation for all)."""
+    w = np.concatenate([rhoA * omega**2 * L**4 / EI for EI in EIs])
+    functions = np.moveaxis(krylov(w)[_KRYLOV_INDEX], -1, 0)  # (len(EIs)·n, 4, 4)
+    powers = np.where(_W_POWER, w[:, None, None], 1)
+    out = []
+    for k, EI in enumerate(EIs):
+        constants = np.array([[int(_SIGN[i, j]) * L ** int(_L_POWER[i, j]) * EI ** int(_EI_POWER[i, j])
+                               for j in range(4)] for i in range(4)])
+        part = slice(k * omega.size, (k + 1) * omega.size)
+        out.append(constants * powers[part] * functions[part])
     return out
 
 
@@ -126,24 +139,23 @@ def beam_local_transfer(beam, omega, length=None) -> np.ndarray:
     E, G, rho, A, Iy, Iz, J, Ip = (exact(getattr(beam, name))
                                    for name in ("E", "G", "rho", "A", "Iy", "Iz", "J", "Ip"))
     L = exact(beam.length if length is None else length)
-    n = omega.size
     out = zeros_like_stack(omega, (12, 12))
-    out[np.ix_(range(n), _BENDING_XY, _BENDING_XY)] = bending_transfer(E * Iz, rho * A, L, omega)
-    xz = bending_transfer(E * Iy, rho * A, L, omega)
-    out[np.ix_(range(n), _BENDING_XZ, _BENDING_XZ)] = _XZ_SIGNS[:, None] * xz * _XZ_SIGNS[None, :]
-    out[np.ix_(range(n), _AXIAL, _AXIAL)] = rod_transfer(E * A, rho * A, L, omega, rigid=not beam.axial)
-    out[np.ix_(range(n), _TORSION, _TORSION)] = rod_transfer(G * J, rho * Ip, L, omega,
-                                                             rigid=not beam.torsion)
+    xy, xz = bending_transfers((E * Iz, E * Iy), rho * A, L, omega)
+    out[:, _BENDING_XY[:, None], _BENDING_XY] = xy
+    out[:, _BENDING_XZ[:, None], _BENDING_XZ] = _XZ_SIGNS[:, None] * xz * _XZ_SIGNS[None, :]
+    out[:, _AXIAL[:, None], _AXIAL] = rod_transfer(E * A, rho * A, L, omega, rigid=not beam.axial)
+    out[:, _TORSION[:, None], _TORSION] = rod_transfer(G * J, rho * Ip, L, omega, rigid=not beam.torsion)
     return out
 
 
-def traversal_axes(beam, reverse=False) -> np.ndarray:
-    """(3, 3) local axes for transfer from ends[0] to ends[1] (or back if ``reverse``).
+def traversal_axes(axes, reverse=False) -> np.ndarray:
+    """(3, 3) local axes for transfer from ends[0] to ends[1] (or back if ``reverse``),
+    from a beam's ``axes``.
 
     Reversing turns local x and z around and keeps y: the section (Iy, Iz)
     and the equations are unchanged.
     """
-    axes = np.asarray(beam.axes, dtype=float)
+    axes = np.asarray(axes, dtype=float)
     return axes * np.array([[-1.0], [1.0], [-1.0]]) if reverse else axes
 
 
@@ -153,5 +165,14 @@ def beam_transfer(beam, omega, reverse=False, length=None) -> np.ndarray:
     reverse : transfer from ends[1] to ends[0].
     length : m, the piece starting at the input end (default: whole beam).
     """
-    rotation = state_rotation(traversal_axes(beam, reverse))
+    rotation = _state_rotation(tuple(np.ravel(beam.axes)), reverse)
     return rotation @ beam_local_transfer(beam, omega, length) @ rotation.T
+
+
+@functools.lru_cache(maxsize=256)
+def _state_rotation(axes: tuple, reverse: bool) -> np.ndarray:
+    """:func:`state_rotation` of :func:`traversal_axes`, built once per beam and direction
+    (``axes``: the beam's axes, flattened)."""
+    rotation = state_rotation(traversal_axes(np.reshape(axes, (3, 3)), reverse))
+    rotation.flags.writeable = False  # shared by every caller
+    return rotation

@@ -30,8 +30,7 @@ import numpy as np
 
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.elements.frames import FORCE_INDEX
-from linmstmm.elements.rigid import (force_extraction, position_extraction,
-                                     position_incidence, rigid_transfer_parts)
+from linmstmm.elements.rigid import force_extraction, position_incidence, rigid_transfer_parts
 from linmstmm.elements.spring import spring_transfer
 from linmstmm.periodic import carry_run, find_runs
 from linmstmm.numeric import frequencies, power_of_two_scale, size_estimate, zeros_like_stack
@@ -84,6 +83,8 @@ class Deduction:
         self._parts: dict[int, tuple] = {}
         self._inputs: dict[int, list] = {}
         self._runs = None
+        self._tips: dict[tuple, tuple] = {}  # link -> (columns, selection (12, k)), less released ones
+        self._layouts: dict[tuple, tuple] = {}  # see _combined
         self._boundary_columns = {}
         self._cut_columns = {}
         labels = []
@@ -149,6 +150,25 @@ class Deduction:
                                for p in element.inputs[1:]]
         return self._inputs[e]
 
+    def _combined(self, key, terms):
+        """Sum of the (n, rows, k_i) products of (columns_i, product_i) ``terms`` on the
+        union of their columns: (columns, (n, rows, k)). Which columns meet where is
+        fixed by the topology, so the union and each term's place in it are found
+        once per ``key``: (element,) for its output, (element, k) for the geometric
+        row of its input k + 2."""
+        if len(terms) == 1:  # one input (most elements): no union to form
+            return terms[0]
+        if key not in self._layouts:
+            columns = np.unique(np.concatenate([c for c, _ in terms]))
+            self._layouts[key] = columns, [_index(np.searchsorted(columns, c)) for c, _ in terms]
+        columns, places = self._layouts[key]
+        n = max(product.shape[0] for _, product in terms)
+        dtype = np.result_type(*[product for _, product in terms])
+        total = np.zeros((n, terms[0][1].shape[1], columns.size), dtype=dtype)
+        for place, (_, product) in zip(places, terms):
+            total[:, :, place] += product
+        return columns, total
+
     # -- boundary states ------------------------------------------------------------
     def tip_state(self, link, n) -> PortState:
         """State of a boundary end or cut side in terms of its unknowns (less released ones)."""
@@ -159,9 +179,11 @@ class Deduction:
             _, c, side = link
             columns = self._cut_columns[c]
             selection = np.eye(12) if (side == 0 or self.topology.cuts[c].closing) else _CUT_SIGN
-        kept = ~np.isin(columns, self.released_columns)
-        return PortState(columns[kept], np.broadcast_to(selection[:, kept], (n, 12, int(kept.sum()))),
-                         np.ones(n))
+        if link not in self._tips:
+            kept = ~np.isin(columns, self.released_columns)
+            self._tips[link] = (columns[kept], selection[:, kept])
+        columns, selection = self._tips[link]
+        return PortState(columns, np.broadcast_to(selection, (n,) + selection.shape), np.ones(n))
 
     def release(self, columns, rows) -> None:
         """Drop statically indeterminate unknowns and the as many dependent rows.
@@ -175,6 +197,8 @@ class Deduction:
         """
         self.released_columns = np.asarray(sorted(columns), dtype=int)
         self.released_rows = np.asarray(sorted(rows), dtype=int)
+        self._tips.clear()
+        self._layouts.clear()
         self.order = self.full_order - len(self.released_columns)
 
     # -- the theorem ----------------------------------------------------------------
@@ -234,11 +258,11 @@ class Deduction:
                 terms = [(inputs[0].columns, inputs[0].matrix)]
             else:
                 terms = [(inputs[0].columns, self.carried(e, omega, inputs[0].matrix))]
-            for (label, forces, incidence), state in zip(self._other_inputs(e), inputs[1:]):
+            for k, ((label, forces, incidence), state) in enumerate(zip(self._other_inputs(e), inputs[1:])):
                 terms.append((state.columns, forces @ state.matrix))
-                rows.append([label, *_combine([(inputs[0].columns, -position_extraction() @ inputs[0].matrix),
-                                               (state.columns, incidence @ state.matrix)])])
-            state = PortState(*_combine(terms), reference=_largest([state.reference for state in inputs]))
+                rows.append([label, *self._combined((e, k), [(inputs[0].columns, -inputs[0].matrix[:, :6]),
+                                                             (state.columns, incidence @ state.matrix)])])
+            state = PortState(*self._combined((e,), terms), reference=_largest([state.reference for state in inputs]))
             if stable:
                 state = normaliser.apply(state, rows, open_states)
             outputs[e] = open_states[e] = state
@@ -341,18 +365,6 @@ def _largest(references):
     return references[0] if len(references) == 1 else np.max(references, axis=0)
 
 
-def _combine(terms):
-    """Sum of the (n, rows, k_i) ``products`` of (columns_i, products) terms, on the
-    union of their columns. Returns (columns, (n, rows, k))."""
-    if len(terms) == 1:  # one input (most elements): no union to form
-        return terms[0]
-    columns = np.unique(np.concatenate([c for c, _ in terms]))
-    n = max(product.shape[0] for _, product in terms)
-    dtype = np.result_type(*[product for _, product in terms])
-    total = np.zeros((n, terms[0][1].shape[1], columns.size), dtype=dtype)
-    for c, product in terms:
-        total[:, :, np.searchsorted(columns, c)] += product
-    return columns, total
 
 
 class _Orthonormaliser:

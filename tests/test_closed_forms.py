@@ -12,7 +12,8 @@ import pytest
 from builders import fixed, make_rigid, single_beam_model, spring_mass_chain
 
 from linmstmm.model import Model
-from linmstmm.solve import natural_frequencies
+from linmstmm.roots import count_zeros, deflated
+from linmstmm.solve import frequency_finder, natural_frequencies
 
 mp.mp.dps = 30
 FREQUENCY_EQUATIONS = {
@@ -109,6 +110,20 @@ def test_spring_mass_chain_exact(root):
     omega2 = np.array([(4 - np.sqrt(7)) / 3, (4 + np.sqrt(7)) / 3]) * k / m
     np.testing.assert_allclose(got.frequencies_hz, np.repeat(np.sqrt(omega2) / (2 * np.pi), 3), rtol=1e-12)
     assert got.ubar_order == 12
+
+
+def test_count_with_known_roots_divided_out_sees_a_missing_or_a_false_one():
+    """The fast path's closing count (det with the found roots divided out) against
+    the closed form ω² = (4 ∓ √7)/3 · k/m (each triple) of the spring–mass chain."""
+    k, m = 1000.0, 2.0
+    _, finder, _ = frequency_finder(spring_mass_chain(k, m))
+    exact = list(np.repeat(np.sqrt(np.array([(4 - np.sqrt(7)) / 3, (4 + np.sqrt(7)) / 3]) * k / m), 3))
+    upper = 1.5 * exact[-1]
+    assert finder._no_other_zeros(exact, upper)
+    assert not finder._no_other_zeros(exact[:-1], upper)  # one of the triple root missing
+    assert not finder._no_other_zeros(exact[:3], upper)  # the upper triple missing
+    assert not finder._no_other_zeros(exact + [0.5 * exact[0]], upper)  # a root that is not one
+    assert count_zeros(deflated(finder.log_det, exact[:3]), 1e-3, upper) == 3
 
 
 def test_a_misleading_guess_falls_back_to_the_full_search():

@@ -654,13 +654,14 @@ class RootFinder:
         found: list[float] = []
         self.deferred_members = []
         brackets, minima = [], []  # (lo, hi, log|det(hi)| − log|det(lo)|) and grid points
-        lo, hi = OMEGA_FLOOR, 16.0
+        lo, hi = OMEGA_FLOOR, 8.0
+        scan = (np.zeros(0),) * 3
         while True:
             if omega_max is not None:
                 hi = min(hi, omega_max)
-            grid = self._quick_grid(lo, hi)
-            sign, log_abs = self.log_det(grid)
+            grid, sign, log_abs = scan = self._scanned(lo, hi, scan)
             change = np.flatnonzero(sign[:-1] * sign[1:] < 0)
+            change = change[grid[change + 1] > lo]  # (the lower chunk's own were taken there)
             brackets += zip(grid[change], grid[change + 1], log_abs[change + 1] - log_abs[change])
             minima += list(grid[_quiet_minima(sign, log_abs)])
             if omega_max is not None and hi >= omega_max or omega_max is None and len(found) + len(brackets) + len(minima) >= count:
@@ -676,8 +677,9 @@ class RootFinder:
                 brackets, minima = [], []
                 if omega_max is not None or len(found) >= count:
                     confirmed = self._confirmed(found, count, omega_max)
-                    if confirmed is None and self.deferred_members:  # a close pair's other member?
-                        found = self._polished(self.deferred_members, found, confirm=False)
+                    if confirmed is None and (self.deferred_members or len(set(found)) < len(found)):
+                        # a close pair's other member, or a multiplicity misread from the offsets?
+                        found = self._recounted(self._polished(self.deferred_members, found, confirm=False))
                         confirmed = self._confirmed(found, count, omega_max)
                     return confirmed
             # fewer roots than count? (sign changes only: a shallow quiet minimum far
@@ -686,6 +688,44 @@ class RootFinder:
             if omega_max is None and (hi >= OMEGA_CEILING or (seen and hi > 1e3 * max(seen))):
                 return None
             lo, hi = hi, self._next_top(hi, sorted(found + [b[0] for b in brackets] + minima), count)
+
+    def _recounted(self, found: list[float]) -> list[float]:
+        """``found`` with the multiplicity of each repeated root counted over a small
+        circle (all circles in one count; see :meth:`_multiplicities`) instead of
+        read from its pencil offsets, which can show spurious near-zero ones."""
+        distinct = sorted(set(found))
+        if len(distinct) == len(found):
+            return found
+        repeated = [r for r in distinct if found.count(r) > 1]
+        radii = [min([self.SPLIT * r] + [abs(r - other) / 2 for other in distinct if other != r])
+                 for r in repeated]
+        counts = count_zeros_many(self.log_det, [(r - radius, r + radius) for r, radius in zip(repeated, radii)],
+                                  initial_points=17)
+        counted = {r: c for r, c in zip(repeated, counts) if not isinstance(c, RuntimeError)}
+        return sorted(r for r in distinct for _ in range(max(counted.get(r, found.count(r)), 1)))
+
+    def _scanned(self, lo: float, hi: float, below) -> tuple:
+        """(grid, sign, log|det|) of the fast scan over [lo, hi], led by the last two
+        points of ``below`` (the chunk under it, same form): a sign change or a
+        quiet minimum at the edge between two chunks is seen (a double root of a
+        round tube 1 % below a chunk's top was missed), and lo is not evaluated
+        twice. The first chunk, 13 octaves from OMEGA_FLOOR that hold no root in
+        most models, is left out if a cheap count finds none there."""
+        tail = tuple(part[-2:] for part in below)
+        if lo == OMEGA_FLOOR and self._holds_no_roots(lo, hi):
+            return tail
+        grid = self._quick_grid(lo, hi)
+        grid = grid[1:] if tail[0].size and grid[0] == tail[0][-1] else grid
+        sign, log_abs = self.log_det(grid)
+        return np.r_[tail[0], grid], np.r_[tail[1], sign], np.r_[tail[2], log_abs]
+
+    def _holds_no_roots(self, lo: float, hi: float) -> bool:
+        """True if a count over (lo, hi) from DEFLATED_POINTS starting points finds
+        no root (False also when it cannot count)."""
+        try:
+            return count_zeros(self.log_det, lo, hi, initial_points=DEFLATED_POINTS) == 0
+        except RuntimeError:
+            return False
 
     def _quick_grid(self, lo: float, hi: float) -> np.ndarray:
         """The fast path's scan of [lo, hi]: points_per_octave above 1 rad/s, an eighth below."""

@@ -17,6 +17,7 @@ from builders import fixed, make_beam, make_rigid, make_spring, single_beam_mode
 
 from linmstmm.model import Model
 from linmstmm.modes import mac_matrix, mode_shapes
+from linmstmm.solve import frequency_finder
 
 CANTILEVER_ROOTS = [float(mp.findroot(lambda x: mp.cos(x) * mp.cosh(x) + 1, x0))
                     for x0 in (1.8751, 4.6941, 7.8548, 10.9955)]
@@ -138,6 +139,17 @@ def round_tube():
                  beams=(make_beam("tube", "root", "tip", points, A=8e-4, Iy=4e-7, Iz=4e-7,
                                   J=8e-7),),
                  boundary={"root": fixed()})
+
+
+def test_fast_path_sees_a_double_root_at_the_edge_between_two_scan_chunks():
+    """The round tube's first (double) root, 126.5 rad/s, lies 1 % below the top of
+    a scan chunk (128 rad/s): the chunks share their edge points, so the fast path
+    finds it as the full search does, without falling back."""
+    _, finder, _ = frequency_finder(round_tube())
+    fast = finder._scan_ahead(15, None)
+    assert fast is not None
+    np.testing.assert_allclose(fast, finder._search(15, None), rtol=1e-12)
+    assert fast[0] == fast[1] and 125 < fast[0] < 128 < fast[2]
 
 
 MODELS = {"tip body": cantilever_tip_body, "tree": tree, "loop": loop, "round tube": round_tube,

@@ -333,10 +333,11 @@ class Deduction:
         """Ū_all (n, N, N) from the carried root state and the rows, less released ones."""
         root = self.root_state(outputs)
         ubar = zeros_like_stack(omega, (self.full_order, self.full_order))
-        ubar[:, :12, _index(root.columns)] += root.matrix
-        start = 0
-        for _, columns, block in rows:
-            ubar[:, start:start + block.shape[1], _index(columns)] += block
+        ubar[:, :12, _index(root.columns)] = root.matrix
+        ubar[:, :12, _index(rows[0][1])] += rows[0][2]  # −Z_root: a ring's shares the root state's columns
+        start = 12
+        for _, columns, block in rows[1:]:  # each geometric row alone in its rows: assigned, not added
+            ubar[:, start:start + block.shape[1], _index(columns)] = block
             start += block.shape[1]
         if self.released_columns.size:
             ubar = np.delete(np.delete(ubar, self.released_rows, axis=1), self.released_columns, axis=2)

@@ -220,6 +220,11 @@ class RootFinder:
     #: After a Newton step below this (relative), the next one is likely the last:
     #: compute all the offsets there, not only the smallest.
     LAST_STEPS = 1e-8
+    #: The same where Newton may stop early (:meth:`_quadratic`): one round sooner.
+    LAST_STEPS_EARLY = 1e-4
+    #: A Newton step below this (relative) that shows quadratic convergence to a
+    #: simple root may be the last one (:meth:`_quadratic`).
+    EARLY = 1e-9
 
     def __init__(self, log_det, matrix, xtol: float = 1e-14,
                  points_per_octave: int = POINTS_PER_OCTAVE, points_per_root: int = 6):
@@ -305,15 +310,20 @@ class RootFinder:
             offsets.append(mu[np.argsort(np.abs(mu))])
         return offsets
 
-    def polish(self, starts, iterations: int = 40):
+    def polish(self, starts, iterations: int = 40, early: bool = False):
         """Converge on the root nearest each start, all starts at once.
 
         Newton for the nonlinear eigenproblem: ω ← ω − μ with μ the offset
         of smallest size. Stops at |μ| <= xtol·ω, or when the steps stop
         shrinking below UNCERTAIN·ω (the rounding floor of Ū_all); gives up
         on a start whose step twice fails to shrink above that (not near a root).
+        ``early``: also stop a round sooner where convergence to a simple root
+        is quadratic (:meth:`_quadratic`), for a caller that counts all its
+        roots at the end (a double root whose second offset shows only within
+        1e-12 of it looks simple a round early).
         Returns a list of (root or None if it did not converge, offsets).
         """
+        last_steps = self.LAST_STEPS_EARLY if early else self.LAST_STEPS
         omega = np.array(starts, dtype=float)
         previous = np.full(omega.size, np.inf)
         setbacks = np.zeros(omega.size, dtype=int)
@@ -324,14 +334,15 @@ class RootFinder:
                 break
             still = []
             # all offsets only where this step is likely the last (the result keeps them)
-            full = previous[active] <= self.LAST_STEPS * omega[active]
+            full = previous[active] <= last_steps * omega[active]
             for i, mu, complete in zip(active, self._offsets(omega[active], full), full):
                 if mu.size == 0:
                     continue
                 step = abs(mu[0])
                 omega[i] -= mu[0].real
                 settled = step > previous[i] / 2  # no longer shrinking: the rounding floor
-                converged = step <= self.xtol * omega[i] or (settled and step <= self.UNCERTAIN * omega[i])
+                converged = (step <= self.xtol * omega[i] or (settled and step <= self.UNCERTAIN * omega[i])
+                             or (early and complete and self._quadratic(step, previous[i], omega[i], mu)))
                 if converged and not complete and mu.size == 1:  # its offsets are wanted too
                     previous[i] = step
                     still.append(i)
@@ -345,6 +356,20 @@ class RootFinder:
                         still.append(i)
             active = still
         return results
+
+    def _quadratic(self, step: float, previous: float, omega: float, mu: np.ndarray) -> bool:
+        """Whether Newton, having just taken ``step`` after ``previous``, has converged on
+        a simple root without another round.
+
+        The step is below EARLY·ω and within 10× the square of the one before
+        (quadratic convergence), and the pencil shows one near-zero offset only
+        (a multiple root takes the full route). The error left is then about
+        max(1e-7 (the forward difference's relative error), 10·step/ω) × step,
+        under 1e-16·ω; one more round (a fifth of an MLRS solve) would only
+        confirm it.
+        """
+        return (step <= self.EARLY * omega and step * omega <= 10 * previous ** 2
+                and int(np.sum(np.abs(mu) < self.SPLIT * omega)) == 1)
 
     def clusters(self, starts, confirm: bool = True) -> list[list[float]]:
         """For each start, every root in the cluster around the root nearest it, ascending.
@@ -362,7 +387,7 @@ class RootFinder:
         starts go to :attr:`deferred_members` (a simple root's pencil can show
         a spurious near offset: polishing every one cost MLRS 6 ms).
         """
-        polished = self.polish(starts)
+        polished = self.polish(starts, early=not confirm)
         groups, members_from = [], []
         for (centre, mu), multiplicity in zip(polished, self._multiplicities(polished, confirm)):
             if centre is None:
@@ -677,8 +702,7 @@ class RootFinder:
                 brackets, minima = [], []
                 if omega_max is not None or len(found) >= count:
                     confirmed = self._confirmed(found, count, omega_max)
-                    if confirmed is None and (self.deferred_members or len(set(found)) < len(found)):
-                        # a close pair's other member, or a multiplicity misread from the offsets?
+                    if confirmed is None:  # a close pair's other member, or a misread multiplicity?
                         found = self._recounted(self._polished(self.deferred_members, found, confirm=False))
                         confirmed = self._confirmed(found, count, omega_max)
                     return confirmed
@@ -690,19 +714,19 @@ class RootFinder:
             lo, hi = hi, self._next_top(hi, sorted(found + [b[0] for b in brackets] + minima), count)
 
     def _recounted(self, found: list[float]) -> list[float]:
-        """``found`` with the multiplicity of each repeated root counted over a small
-        circle (all circles in one count; see :meth:`_multiplicities`) instead of
-        read from its pencil offsets, which can show spurious near-zero ones."""
+        """``found`` with the multiplicity of each root counted over a small circle
+        (all circles in one count; see :meth:`_multiplicities`) instead of read
+        from its pencil offsets, which can show spurious near-zero ones or (a
+        Newton stopped early) miss a double root's second one."""
         distinct = sorted(set(found))
-        if len(distinct) == len(found):
+        if not distinct:
             return found
-        repeated = [r for r in distinct if found.count(r) > 1]
         radii = [min([self.SPLIT * r] + [abs(r - other) / 2 for other in distinct if other != r])
-                 for r in repeated]
-        counts = count_zeros_many(self.log_det, [(r - radius, r + radius) for r, radius in zip(repeated, radii)],
+                 for r in distinct]
+        counts = count_zeros_many(self.log_det, [(r - radius, r + radius) for r, radius in zip(distinct, radii)],
                                   initial_points=17)
-        counted = {r: c for r, c in zip(repeated, counts) if not isinstance(c, RuntimeError)}
-        return sorted(r for r in distinct for _ in range(max(counted.get(r, found.count(r)), 1)))
+        return sorted(r for r, c in zip(distinct, counts)
+                      for _ in range(max(found.count(r) if isinstance(c, RuntimeError) else c, 1)))
 
     def _scanned(self, lo: float, hi: float, below) -> tuple:
         """(grid, sign, log|det|) of the fast scan over [lo, hi], led by the last two

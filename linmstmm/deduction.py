@@ -426,7 +426,7 @@ class _Orthonormaliser:
         """
         if state.reference is not None:
             growth = size_estimate(state.matrix).max(axis=(1, 2)) / state.reference
-            if np.all((growth < self.GROWTH) & (growth > 1 / self.GROWTH)):
+            if growth.max() < self.GROWTH and growth.min() > 1 / self.GROWTH:
                 return state
         columns = set(int(c) for c in state.columns)
         if columns & self.shared or any(columns & set(int(c) for c in other.columns)

@@ -87,6 +87,22 @@ def test_axial_rod_and_torsional_shaft_fixed_free():
     np.testing.assert_allclose(got.frequencies_hz, want[want <= fmax], rtol=1e-10)
 
 
+def test_a_root_hidden_from_the_newton_pencil_is_taken_from_its_bracket():
+    """Iy = Iz = 1 m^4: the torsion column's moments are 1e-4 of the bending
+    ones, the QR of the carried state puts the 2nd torsion root (3·189.3 Hz)
+    into R, and Newton from its sign change jumps to another root. Regula
+    falsi on det itself finds it; the fast path needs no fallback."""
+    L = 3.0
+    model = single_beam_model(fixed(), None, length=L, Iz=1.0, Iy=1.0, J=2e-7, Ip=4e-7)
+    beam = model.beams[0]
+    torsion = np.pi / (2 * L) * np.sqrt(beam.G * beam.J / (beam.rho * beam.Ip))  # rad/s
+    axial = np.pi / (2 * L) * np.sqrt(beam.E / beam.rho)
+    _, finder, _ = frequency_finder(model)
+    fast = finder._scan_ahead(None, 3.5 * torsion)
+    assert fast is not None
+    np.testing.assert_allclose(fast, [torsion, axial, 3 * torsion], rtol=1e-12)
+
+
 def test_cantilever_with_tip_mass_ratio_one():
     """Tip mass = beam mass: λ² = 1.557298, 16.25009, 50.89584 (Blevins table 8-8, and the
     frequency equation 1 + cos λ cosh λ + λ (cos λ sinh λ − sin λ cosh λ) = 0)."""

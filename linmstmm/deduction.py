@@ -366,8 +366,6 @@ def _largest(references):
     return references[0] if len(references) == 1 else np.max(references, axis=0)
 
 
-
-
 class _Orthonormaliser:
     """Godunov orthonormalisation of the unknowns carried by one port state.
 

@@ -462,8 +462,8 @@ class RootFinder:
         Regula falsi on det itself (the point where the line through ±|det| at
         the ends crosses zero, from log|det| so nothing overflows), with the
         Illinois rule: an end kept twice in a row has its |det| halved, so
-        both ends move and convergence is superlinear; a bracket that keeps
-        one end three times in a row is bisected once.
+        both ends move and convergence is superlinear; a bracket that has kept
+        one end three times in a row is bisected until the other end moves.
         """
         lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
         if lo.size == 0:
@@ -662,8 +662,9 @@ class RootFinder:
         """Guess, polish, confirm: the fast path of :meth:`find`, or None.
 
         A coarse scan (``points_per_octave`` above 1 rad/s, an eighth of it
-        below) goes up in chunks (to 16 rad/s, then up to ×4 each, less where
-        the candidates so far extrapolate to ``count`` sooner: :meth:`_next_top`)
+        below) goes up in chunks (to 8 rad/s, then up to ×4 each, less where
+        the candidates so far extrapolate to ``count`` sooner: :meth:`_next_top`;
+        see :meth:`_scanned`)
         until it has seen ``count`` candidates (sign changes, and minima of
         log|det| without one) or reached ``omega_max``; all are polished at
         once (more chunks if their multiplicities leave fewer than ``count``
@@ -711,7 +712,7 @@ class RootFinder:
             seen = found + [b[0] for b in brackets]
             if omega_max is None and (hi >= OMEGA_CEILING or (seen and hi > 1e3 * max(seen))):
                 return None
-            lo, hi = hi, self._next_top(hi, sorted(found + [b[0] for b in brackets] + minima), count)
+            lo, hi = hi, self._next_top(hi, sorted(seen + minima), count)
 
     def _recounted(self, found: list[float]) -> list[float]:
         """``found`` with the multiplicity of each root counted over a small circle

@@ -86,8 +86,8 @@ def bending_wavenumber(beam, omega) -> float:
 
 #: Entry (i, j) of the bending transfer of (v, θ, m, q) is
 #: SIGN · L^L_POWER · EI^EI_POWER · w^W_POWER · F_r(w) with r = KRYLOV_INDEX.
-_KRYLOV_INDEX = (np.arange(4)[None, :] - np.arange(4)[:, None]) % 4
 _L_POWER = np.arange(4)[None, :] - np.arange(4)[:, None]
+_KRYLOV_INDEX = _L_POWER % 4
 _EI_POWER = (np.arange(4)[:, None] >= 2).astype(int) - (np.arange(4)[None, :] >= 2).astype(int)
 _W_POWER = np.arange(4)[:, None] > np.arange(4)[None, :]
 _SIGN = np.outer([1, 1, -1, 1], [1, 1, -1, 1])

@@ -47,6 +47,9 @@ SCAN_OCTAVES = 4
 OMEGA_FLOOR = 1e-3
 #: The scan for ``count`` roots gives up above this circular frequency, rad/s.
 OMEGA_CEILING = 1e9
+#: A counting contour's phase step still above π/4 over a θ interval this short
+#: (radians) is a jump, not a turn: the count fails.
+PHASE_JUMP = 1e-12
 #: Starting points of a half-ellipse count with the known roots divided out.
 DEFLATED_POINTS = 17
 #: A singular value below this fraction of the largest counts as zero.
@@ -150,7 +153,10 @@ def _raised(count):
 def _half_windings(log_det, paths, wheres, max_points: int, initial_points: int = 65) -> list:
     """Δarg det / π along each ``path(θ)``, θ from 0 to π, refined until no phase
     step exceeds π/4; each total must come out an integer. All paths' points go
-    to ``log_det`` together. Returns an int or a RuntimeError per path."""
+    to ``log_det`` together. Returns an int or a RuntimeError per path: also
+    where a phase step stays coarse over a θ interval below PHASE_JUMP (a jump,
+    not a turn: det is rounding noise there, as far above a discrete model's
+    last root; halving towards it took thousands of one-point rounds)."""
     def phases(pieces):
         """Angles of det at path_i(θ_i) for the (i, θ_i) pieces, one evaluation."""
         sign, log_abs = log_det(np.concatenate([paths[i](theta) for i, theta in pieces]))
@@ -177,7 +183,7 @@ def _half_windings(log_det, paths, wheres, max_points: int, initial_points: int 
                 results[i] = (int(round(abs(winding))) if abs(winding - round(winding)) <= 0.05 else
                               RuntimeError(f"the root count in {wheres[i]} is not an integer "
                                            f"({winding:.3f}): det Ū_all is not accurate enough there"))
-            elif theta.size > max_points:
+            elif theta.size > max_points or np.min(np.diff(theta)[coarse]) < PHASE_JUMP:
                 results[i] = RuntimeError(f"cannot count the roots in {wheres[i]}: the phase of "
                                           "det Ū_all varies too fast along the counting contour")
             else:

@@ -142,6 +142,21 @@ def test_count_with_known_roots_divided_out_sees_a_missing_or_a_false_one():
     assert count_zeros(deflated(finder.log_det, exact[:3]), 1e-3, upper) == 3
 
 
+def test_a_count_across_a_phase_jump_fails_fast():
+    """Far above a discrete model's last root det is rounding noise and its phase
+    can jump; the count must say it cannot count, not bisect towards the jump
+    for thousands of rounds (a 2-mode ring asked for 4 took 4 s doing that)."""
+    calls = []
+
+    def jumping(omega):  # the phase of a zero-free function that jumps by π/2 at Re ω = 5
+        calls.append(len(omega))
+        return np.where(np.real(omega) < 5, 1.0, 1j), np.zeros(len(omega))
+
+    with pytest.raises(RuntimeError, match="varies too fast"):
+        count_zeros(jumping, 1.0, 10.0)
+    assert len(calls) < 60
+
+
 def test_a_misleading_guess_falls_back_to_the_full_search():
     """A warm start that misses roots is caught by the root count."""
     model = spring_mass_chain()

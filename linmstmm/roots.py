@@ -659,10 +659,15 @@ class RootFinder:
         The count runs on det with the known roots divided out (:func:`deflated`),
         so its phase turns only for zeros not in ``known`` (or by −π for a
         ``known`` one that is not a zero) and DEFLATED_POINTS starting points
-        suffice where counting them all took 65 and a refinement round.
+        suffice where counting them all took 65 and a refinement round. False
+        also where it cannot count: the segment search then decides (and says so
+        if it cannot either).
         """
-        return count_zeros(deflated(self.log_det, known), OMEGA_FLOOR, upper,
-                           initial_points=DEFLATED_POINTS) == 0
+        try:
+            return count_zeros(deflated(self.log_det, known), OMEGA_FLOOR, upper,
+                               initial_points=DEFLATED_POINTS) == 0
+        except RuntimeError:
+            return False
 
     def _scan_ahead(self, count: int | None, omega_max: float | None):
         """Guess, polish, confirm: the fast path of :meth:`find`, or None.

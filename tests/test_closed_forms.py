@@ -12,7 +12,7 @@ import pytest
 from builders import fixed, make_rigid, single_beam_model, spring_mass_chain
 
 from linmstmm.model import Model
-from linmstmm.roots import count_zeros, deflated
+from linmstmm.roots import RootFinder, count_zeros, deflated
 from linmstmm.solve import frequency_finder, natural_frequencies
 
 mp.mp.dps = 30
@@ -155,6 +155,8 @@ def test_a_count_across_a_phase_jump_fails_fast():
     with pytest.raises(RuntimeError, match="varies too fast"):
         count_zeros(jumping, 1.0, 10.0)
     assert len(calls) < 60
+    # the fast path's closing count then says "not confirmed" (the segment search decides)
+    assert RootFinder(jumping, matrix=None)._no_other_zeros([], 10.0) is False
 
 
 def test_a_misleading_guess_falls_back_to_the_full_search():

@@ -677,9 +677,10 @@ class RootFinder:
         the candidates so far extrapolate to ``count`` sooner: :meth:`_next_top`;
         see :meth:`_scanned`)
         until it has seen ``count`` candidates (sign changes, and minima of
-        log|det| without one) or reached ``omega_max``; all are polished at
-        once (more chunks if their multiplicities leave fewer than ``count``
-        roots) and one count from OMEGA_FLOOR must agree. Multiplicities are
+        log|det| without one), reached ``omega_max``, or scanned a chunk
+        without a new candidate; all are polished at once (more chunks if their
+        multiplicities leave fewer than ``count`` roots) and one count from
+        OMEGA_FLOOR must agree. Multiplicities are
         read from the pencil offsets without a count each: a wrong one changes
         the total, which that count sees (unless an opposite error elsewhere
         cancels it). If the count finds more, the deferred cluster members
@@ -699,9 +700,14 @@ class RootFinder:
             grid, sign, log_abs = scan = self._scanned(lo, hi, scan)
             change = np.flatnonzero(sign[:-1] * sign[1:] < 0)
             change = change[grid[change + 1] > lo]  # (the lower chunk's own were taken there)
+            waiting = len(brackets) + len(minima)
             brackets += zip(grid[change], grid[change + 1], log_abs[change + 1] - log_abs[change])
             minima += list(grid[_quiet_minima(sign, log_abs)])
-            if omega_max is not None and hi >= omega_max or omega_max is None and len(found) + len(brackets) + len(minima) >= count:
+            # A chunk with no new candidate after some: polish those, their multiplicities
+            # may make up the count (a chain's triple roots are one sign change each).
+            stalled = omega_max is None and 0 < waiting == len(brackets) + len(minima)
+            if (omega_max is not None and hi >= omega_max or stalled
+                    or omega_max is None and len(found) + len(brackets) + len(minima) >= count):
                 if count is not None:  # only the lowest candidates matter
                     keep = sorted([(b[0], b) for b in brackets] + [(m, None) for m in minima])[:count - len(found)]
                     brackets = [b for _, b in keep if b is not None]

@@ -128,6 +128,18 @@ def test_spring_mass_chain_exact(root):
     assert got.ubar_order == 12
 
 
+def test_fast_path_takes_triple_roots_at_their_multiplicity():
+    """Each frequency of the chain is triple: one sign change each, so the scan never
+    sees 6 candidates; once a scan chunk adds none, the two are polished and their
+    multiplicities make up the count (it used to fall back to the segment search)."""
+    k, m = 1000.0, 2.0
+    _, finder, _ = frequency_finder(spring_mass_chain(k, m))
+    fast = finder._scan_ahead(6, None)
+    exact = np.repeat(np.sqrt(np.array([(4 - np.sqrt(7)) / 3, (4 + np.sqrt(7)) / 3]) * k / m), 3)
+    assert fast is not None
+    np.testing.assert_allclose(fast, exact, rtol=1e-12)
+
+
 def test_count_with_known_roots_divided_out_sees_a_missing_or_a_false_one():
     """The fast path's closing count (det with the found roots divided out) against
     the closed form ω² = (4 ∓ √7)/3 · k/m (each triple) of the spring–mass chain."""

@@ -51,7 +51,7 @@ OMEGA_CEILING = 1e9
 #: (radians) is a jump, not a turn: the count fails.
 PHASE_JUMP = 1e-12
 #: Starting points of a half-ellipse count with the known roots divided out.
-DEFLATED_POINTS = 17
+DEFLATED_POINTS = 33
 #: A singular value below this fraction of the largest counts as zero.
 NULL_TOLERANCE = 1e-8
 
@@ -462,7 +462,7 @@ class RootFinder:
         lo, hi = self._narrowed(lo, hi, width)
         return (lo + hi) / 2
 
-    def _narrowed(self, lo, hi, width: float):
+    def _narrowed(self, lo, hi, width: float, log_det=None):
         """Sign-change brackets (lo_i, hi_i) narrowed to ``width``·hi, all at once: (lo, hi).
 
         Regula falsi on det itself (the point where the line through ±|det| at
@@ -470,11 +470,14 @@ class RootFinder:
         Illinois rule: an end kept twice in a row has its |det| halved, so
         both ends move and convergence is superlinear; a bracket that has kept
         one end three times in a row is bisected until the other end moves.
+        ``log_det``: of another function (default: det Ū_all's).
         """
+        log_det = self.log_det if log_det is None else log_det
         lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
         if lo.size == 0:
             return lo, hi
-        sign, log_abs = self.log_det(np.r_[lo, hi])
+        sign, log_abs = log_det(np.r_[lo, hi])
+        sign = np.real(sign)
         sign_lo, log_lo, log_hi = sign[:lo.size], log_abs[:lo.size], log_abs[lo.size:]
         kept = np.zeros(lo.size)  # +k: lo kept k times in a row, −k: hi
         width = max(width, 4 * np.finfo(float).eps)
@@ -486,7 +489,8 @@ class RootFinder:
             fraction = 1 / (1 + np.exp(np.clip(log_hi[active] - log_lo[active], -700, 700)))
             fraction = np.where(np.abs(kept[active]) >= 3, 0.5, fraction)
             x = np.clip(a + (b - a) * fraction, a + (b - a) * 1e-3, b - (b - a) * 1e-3)
-            sign_x, log_x = self.log_det(x)
+            sign_x, log_x = log_det(x)
+            sign_x = np.real(sign_x)
             left = sign_x * sign_lo[active] < 0  # the root is in (lo, x]: hi moves, lo is kept
             kept[active] = np.where(left, np.maximum(kept[active], 0) + 1, np.minimum(kept[active], 0) - 1)
             halve = np.log(2.0) * (np.abs(kept[active]) >= 2)
@@ -642,16 +646,67 @@ class RootFinder:
     def _confirmed(self, found: list[float], count: int | None, omega_max: float | None = None):
         """The lowest ``count`` of ``found`` (or all up to omega_max) if one count from
         OMEGA_FLOOR says there are no others below them; None otherwise."""
+        upper = self._count_top(found, count, omega_max)
+        if upper is None:
+            return None
+        below = [r for r in found if r < upper]
+        return below[:count] if self._no_other_zeros(below, upper) else None
+
+    def _count_top(self, found: list[float], count: int | None, omega_max: float | None):
+        """Top of the closing count: omega_max, or midway between the count-th root
+        and the next one found (1 % above it if none); None if fewer than ``count``."""
         if omega_max is not None:
-            below = [r for r in found if r < omega_max]
-            return below if self._no_other_zeros(below, omega_max) else None
+            return omega_max
         if len(found) < count:
             return None
         top = found[count - 1]
         above = [r for r in found if r > top * (1 + self.SAME_ROOT)]
-        upper = (top + above[0]) / 2 if above else top * 1.01
-        below = [r for r in found if r <= upper]
-        return below[:count] if self._no_other_zeros(below, upper) else None
+        return (top + above[0]) / 2 if above else top * 1.01
+
+    def _recovered(self, found: list[float], upper: float) -> list[float]:
+        """``found`` with the roots below ``upper`` that the closing count says are missing.
+
+        They are located by geometric bisection, down to quarter octaves, on
+        counts of det with the ``found`` roots divided out (:func:`deflated`; all
+        intervals of one level in one batched count). The quarter octaves that
+        hold some are scanned densely on the deflated det, whose sign changes
+        and quiet minima belong to the missing roots alone: a sign change is
+        narrowed to xtol by regula falsi on it (a missing root may sit in the
+        same grid step as a found one, where Newton would return to that),
+        a minimum is polished. ``found`` as it was if a count cannot be made.
+        """
+        reduced = deflated(self.log_det, [r for r in found if r < upper])
+        try:
+            missing = count_zeros(reduced, OMEGA_FLOOR, upper)
+        except RuntimeError:
+            return found
+        pending, leaves = [(OMEGA_FLOOR, upper, missing)] if missing else [], []
+        while pending:
+            leaves += [part for part in pending if part[1] / part[0] <= 2 ** 0.125]
+            wide = [part for part in pending if part[1] / part[0] > 2 ** 0.125]
+            middles = [np.sqrt(lo * hi) for lo, hi, _ in wide]
+            lower = count_zeros_many(reduced, [(lo, mid) for (lo, _, _), mid in zip(wide, middles)]) if wide else []
+            if any(isinstance(c, RuntimeError) for c in lower):
+                return found
+            pending = [part for (lo, hi, k), mid, c in zip(wide, middles, lower)
+                       for part in ((lo, mid, c), (mid, hi, k - c)) if part[2] > 0]
+        if not leaves:
+            return found
+        grids = [np.geomspace(lo, hi, 16 * k + 17) for lo, hi, k in leaves]
+        sign, log_abs = reduced(np.concatenate(grids))
+        brackets, minima = [], []
+        for grid, piece_sign, piece_log in zip(grids, *(np.split(v, np.cumsum([g.size for g in grids])[:-1])
+                                                         for v in (np.real(sign), log_abs))):
+            change = np.flatnonzero(piece_sign[:-1] * piece_sign[1:] < 0)
+            brackets += zip(grid[change], grid[change + 1])
+            minima += list(grid[_quiet_minima(piece_sign, piece_log)])
+        found = self._polished(minima, found, confirm=False)
+        if brackets:
+            a, b = self._narrowed(*map(np.array, zip(*brackets)), self.xtol, log_det=reduced)
+            for root, uncertainty in zip((a + b) / 2, (b - a) / b):
+                self.last_step[root] = uncertainty
+                self._merge(found, [root], OMEGA_FLOOR, np.inf)
+        return sorted(found)
 
     def _no_other_zeros(self, known: list[float], upper: float) -> bool:
         """True if (OMEGA_FLOOR, upper) holds no zeros of det Ū_all but ``known``.
@@ -684,7 +739,10 @@ class RootFinder:
         read from the pencil offsets without a count each: a wrong one changes
         the total, which that count sees (unless an opposite error elsewhere
         cancels it). If the count finds more, the deferred cluster members
-        (:meth:`clusters`) are polished and the count repeated once. Far fewer
+        (:meth:`clusters`) are polished and every multiplicity recounted
+        (:meth:`_recounted`), then the roots still missing are located by
+        deflated counts (:meth:`_recovered`), each followed by the closing
+        count again. Far fewer
         evaluations than the segment search when it works; when it does not
         (a root between two candidates, a chain of clusters), :meth:`find`
         falls back.
@@ -723,6 +781,9 @@ class RootFinder:
                     if confirmed is None:  # a close pair's other member, or a misread multiplicity?
                         found = self._recounted(self._polished(self.deferred_members, found, confirm=False))
                         confirmed = self._confirmed(found, count, omega_max)
+                    upper = self._count_top(found, count, omega_max)
+                    if confirmed is None and upper is not None:  # roots the scan could not see
+                        confirmed = self._confirmed(self._recovered(found, upper), count, omega_max)
                     return confirmed
             # fewer roots than count? (sign changes only: a shallow quiet minimum far
             # below the first root is no evidence that the roots have run out)

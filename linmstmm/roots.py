@@ -519,11 +519,16 @@ class RootFinder:
             groups += self.clusters(self.shrink_brackets(lo[missed], hi[missed]), confirm)
             missed = [i for i in missed if not any(lo[i] < r <= hi[i] for group in groups for r in group)]
         if missed:
-            a, b = self._narrowed(lo[missed], hi[missed], self.xtol)
-            for root, uncertainty in zip((a + b) / 2, (b - a) / b):
-                self.last_step[root] = uncertainty
-                groups.append([root])
+            groups += [[root] for root in self._bracket_roots(lo[missed], hi[missed])]
         return groups
+
+    def _bracket_roots(self, lo, hi, log_det=None) -> list[float]:
+        """One simple root in each sign-change bracket (lo_i, hi_i), the bracket narrowed
+        to xtol (:meth:`_narrowed`); its width is recorded as the root's :attr:`last_step`."""
+        a, b = self._narrowed(lo, hi, self.xtol, log_det)
+        for root, uncertainty in zip((a + b) / 2, (b - a) / b):
+            self.last_step[root] = uncertainty
+        return list((a + b) / 2)
 
     def _roots_in(self, grid, expected: int) -> list[float]:
         """Roots inside (grid[0], grid[-1]) reached from the scan, up to ``expected`` of them.
@@ -666,9 +671,9 @@ class RootFinder:
     def _recovered(self, found: list[float], upper: float) -> list[float]:
         """``found`` with the roots below ``upper`` that the closing count says are missing.
 
-        They are located by geometric bisection, down to quarter octaves, on
-        counts of det with the ``found`` roots divided out (:func:`deflated`; all
-        intervals of one level in one batched count). The quarter octaves that
+        They are located by geometric bisection, down to eighths of an octave,
+        on counts of det with the ``found`` roots divided out (:func:`deflated`;
+        all intervals of one level in one batched count). The intervals that
         hold some are scanned densely on the deflated det, whose sign changes
         and quiet minima belong to the missing roots alone: a sign change is
         narrowed to xtol by regula falsi on it (a missing root may sit in the
@@ -702,9 +707,7 @@ class RootFinder:
             minima += list(grid[_quiet_minima(piece_sign, piece_log)])
         found = self._polished(minima, found, confirm=False)
         if brackets:
-            a, b = self._narrowed(*map(np.array, zip(*brackets)), self.xtol, log_det=reduced)
-            for root, uncertainty in zip((a + b) / 2, (b - a) / b):
-                self.last_step[root] = uncertainty
+            for root in self._bracket_roots(*map(np.array, zip(*brackets)), log_det=reduced):
                 self._merge(found, [root], OMEGA_FLOOR, np.inf)
         return sorted(found)
 
@@ -781,8 +784,8 @@ class RootFinder:
                     if confirmed is None:  # a close pair's other member, or a misread multiplicity?
                         found = self._recounted(self._polished(self.deferred_members, found, confirm=False))
                         confirmed = self._confirmed(found, count, omega_max)
-                    upper = self._count_top(found, count, omega_max)
-                    if confirmed is None and upper is not None:  # roots the scan could not see
+                    upper = None if confirmed is not None else self._count_top(found, count, omega_max)
+                    if upper is not None:  # roots the scan could not see
                         confirmed = self._confirmed(self._recovered(found, upper), count, omega_max)
                     return confirmed
             # fewer roots than count? (sign changes only: a shallow quiet minimum far

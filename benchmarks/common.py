@@ -133,7 +133,7 @@ def mstmm_solve(model: Model, count: int, **options) -> np.ndarray:
         _, finder, _ = frequency_finder(model, **options)
     except ImportError:  # older tree: build it like solve.py does
         from linmstmm.deduction import Deduction
-        from linmstmm.roots import release_indeterminate
+        from linmstmm.nullspace import release_indeterminate
         from linmstmm.topology import build_topology
         deduction = Deduction(build_topology(model))
         release_indeterminate(deduction)

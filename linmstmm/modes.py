@@ -35,7 +35,7 @@ import numpy as np
 from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.model import Model
-from linmstmm.roots import NULL_TOLERANCE, equilibration
+from linmstmm.nullspace import NULL_TOLERANCE, equilibration
 from linmstmm.solve import frequency_finder
 
 #: Normalisations of the modes: unit modal mass, or unit largest translation.

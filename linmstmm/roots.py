@@ -1,15 +1,12 @@
 """Roots of det Ū_all(ω): count, scan, bracket, refine, multiplicity.
 
-Nothing is missed because every root found is checked against a count:
-det Ū_all is an entire function of ω (no inverse is taken), real on the
-real axis, whose zeros are the natural frequencies with their
-multiplicities, so the argument principle on a half-ellipse counts them
-(:func:`count_zeros`).
+Nothing is missed because every root found is checked against a count by
+the argument principle (:mod:`linmstmm.counting`).
 
 The fast path (:meth:`RootFinder._scan_ahead`) scans (sign, log|det|)
 upwards until it has seen enough candidates, polishes them all at once and
 keeps the result only if one count from OMEGA_FLOOR agrees: the count of
-det with the found roots divided out (:func:`deflated`) must be zero, which
+det with the found roots divided out (:func:`~linmstmm.counting.deflated`) must be zero, which
 a missed root or a false one would break. Otherwise the search works
 segment by segment upwards:
 
@@ -33,7 +30,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from linmstmm.numeric import power_of_two_scale
+from linmstmm.counting import count_in_disc, count_zeros, count_zeros_many, deflated
+from linmstmm.nullspace import equilibration, nullity
 
 #: Grid points per octave of the scans (the fast path's above 1 rad/s, an
 #: eighth of it below; every segment's).
@@ -47,154 +45,8 @@ SCAN_OCTAVES = 4
 OMEGA_FLOOR = 1e-3
 #: The scan for ``count`` roots gives up above this circular frequency, rad/s.
 OMEGA_CEILING = 1e9
-#: A counting contour's phase step still above π/4 over a θ interval this short
-#: (radians) is a jump, not a turn: the count fails.
-PHASE_JUMP = 1e-12
 #: Starting points of a half-ellipse count with the known roots divided out.
 DEFLATED_POINTS = 33
-#: A singular value below this fraction of the largest counts as zero.
-NULL_TOLERANCE = 1e-8
-
-
-def equilibration(matrix: np.ndarray, sweeps: int = 4):
-    """Row and column scales (powers of two) giving every row and column max |a| ~ 1.
-
-    matrix : (N, M) or a stack (n, N, M). Returns (rows (…, N), cols (…, M))
-    with ``rows[..., :, None] * matrix * cols[..., None, :]`` balanced.
-    Keeps the null space (up to column scaling) and makes singular values
-    comparable across the mixed units of Ū_all (m, rad, N, N m).
-    """
-    size = np.abs(matrix)
-    rows = np.ones(matrix.shape[:-1])
-    cols = np.ones(matrix.shape[:-2] + matrix.shape[-1:])
-    for _ in range(sweeps):
-        rows *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-1))
-        cols *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-2))
-    return rows, cols
-
-
-def nullity(matrix: np.ndarray, tolerance: float = NULL_TOLERANCE, scales=None) -> int:
-    """Number of singular values of the equilibrated matrix below ``tolerance`` × the largest.
-
-    scales : (rows, cols) to balance with; default from ``matrix`` itself. At
-    a root, take them from a nearby frequency: balancing exactly there would
-    blow up a row whose only entry vanishes at the root (cos kL of a rod)
-    and hide the singularity.
-    """
-    rows, cols = equilibration(matrix) if scales is None else scales
-    sigma = np.linalg.svd(rows[:, None] * matrix * cols, compute_uv=False)
-    return int(np.sum(sigma < tolerance * sigma[0]))
-
-
-def deflated(log_det, roots):
-    """``log_det`` of det Ū_all / ∏_r (ω² − r²) over ``roots`` (rad/s, repeated per
-    multiplicity): the same zeros less those at ±r (r = 0: a factor ω²).
-
-    Counting the deflated determinant over a contour around known roots asks
-    only whether any *other* zero is inside: its phase no longer turns by π per
-    known root, so far fewer contour points resolve it.
-    """
-    roots = np.asarray(roots, dtype=float)
-
-    def reduced(omega):
-        sign, log_abs = log_det(omega)
-        factors = np.asarray(omega)[:, None] ** 2 - roots[None, :] ** 2
-        return (sign * np.exp(-1j * np.angle(factors).sum(axis=1)),
-                log_abs - np.log(np.abs(factors)).sum(axis=1))
-
-    return reduced
-
-
-def count_zeros(log_det, a: float, b: float, max_points: int = 20000, initial_points: int = 65) -> int:
-    """Number of natural frequencies in (a, b), rad/s, with multiplicity.
-
-    Argument principle: det Ū_all(ω) is an entire function of ω, real on the
-    real axis, whose zeros are exactly the natural frequencies ±ω_k with
-    their multiplicities (a null vector of Ū_all is a mode and vice versa;
-    no inverse is ever taken, so there are no poles). The winding number of
-    det along an ellipse through a and b counts them; by conjugate symmetry
-    the upper half-arc suffices: count = Δarg(b → a over the arc) / π.
-
-    log_det : callable complex omega (n,) -> (phase factor (n,), log|det| (n,)).
-    Raises RuntimeError if the count cannot be made.
-    """
-    return _raised(count_zeros_many(log_det, [(a, b)], max_points, initial_points)[0])
-
-
-def count_zeros_many(log_det, intervals, max_points: int = 20000, initial_points: int = 65) -> list:
-    """:func:`count_zeros` for several intervals (a, b) with one evaluation of det
-    per refinement round for all of them; each entry is an int or the
-    RuntimeError that interval's count raised. ``initial_points`` per half-ellipse
-    before refinement."""
-    def ellipse(a, b):
-        centre, radius = (a + b) / 2, (b - a) / 2
-        return lambda theta: centre + radius * np.cos(theta) + 0.5j * radius * np.sin(theta)
-    return _half_windings(log_det, [ellipse(a, b) for a, b in intervals],
-                          [f"({a:.6g}, {b:.6g}) rad/s" for a, b in intervals], max_points, initial_points)
-
-
-def count_in_disc(log_det, radius: float, max_points: int = 20000) -> int:
-    """Zeros of det Ū_all with |ω| < ``radius`` (rigid-body modes count twice: det ∝ ω^2r).
-
-    det is even in ω and real on the real axis, so the upper half circle,
-    from +radius to −radius, carries half the winding: count = Δarg / π.
-    """
-    return _raised(_half_windings(log_det, [lambda theta: radius * np.exp(1j * theta)],
-                                  [f"|ω| < {radius:.6g} rad/s"], max_points)[0])
-
-
-def _raised(count):
-    """``count``, or raise it if it is the RuntimeError a count came back with."""
-    if isinstance(count, RuntimeError):
-        raise count
-    return count
-
-
-def _half_windings(log_det, paths, wheres, max_points: int, initial_points: int = 65) -> list:
-    """Δarg det / π along each ``path(θ)``, θ from 0 to π, refined until no phase
-    step exceeds π/4; each total must come out an integer. All paths' points go
-    to ``log_det`` together. Returns an int or a RuntimeError per path: also
-    where a phase step stays coarse over a θ interval below PHASE_JUMP (a jump,
-    not a turn: det is rounding noise there, as far above a discrete model's
-    last root; halving towards it took thousands of one-point rounds)."""
-    def phases(pieces):
-        """Angles of det at path_i(θ_i) for the (i, θ_i) pieces, one evaluation."""
-        sign, log_abs = log_det(np.concatenate([paths[i](theta) for i, theta in pieces]))
-        edges = np.cumsum([theta.size for _, theta in pieces])[:-1]
-        return np.split(np.angle(sign), edges), [bool(ok.all()) for ok in np.split(np.isfinite(log_abs), edges)]
-
-    thetas = [np.linspace(0.0, np.pi, initial_points) for _ in paths]
-    angles, finite = phases(list(enumerate(thetas)))
-    results: list = [None] * len(paths)
-    while True:
-        pieces = []
-        for i, theta in enumerate(thetas):
-            if results[i] is not None:
-                continue
-            if not finite[i]:
-                results[i] = RuntimeError("det Ū_all vanishes on the counting contour: Ū_all is "
-                                          "singular at every frequency (undeflated indeterminate "
-                                          "constraint)")
-                continue
-            steps = np.angle(np.exp(1j * np.diff(angles[i])))  # wrapped into (−π, π]
-            coarse = np.abs(steps) > np.pi / 4
-            if not coarse.any():
-                winding = steps.sum() / np.pi
-                results[i] = (int(round(abs(winding))) if abs(winding - round(winding)) <= 0.05 else
-                              RuntimeError(f"the root count in {wheres[i]} is not an integer "
-                                           f"({winding:.3f}): det Ū_all is not accurate enough there"))
-            elif theta.size > max_points or np.min(np.diff(theta)[coarse]) < PHASE_JUMP:
-                results[i] = RuntimeError(f"cannot count the roots in {wheres[i]}: the phase of "
-                                          "det Ū_all varies too fast along the counting contour")
-            else:
-                pieces.append((i, (theta[:-1][coarse] + theta[1:][coarse]) / 2))
-        if not pieces:
-            return results
-        new_angles, new_finite = phases(pieces)
-        for (i, middles), more, ok in zip(pieces, new_angles, new_finite):
-            order = np.argsort(np.r_[thetas[i], middles])
-            thetas[i], angles[i] = np.r_[thetas[i], middles][order], np.r_[angles[i], more][order]
-            finite[i] = finite[i] and ok
 
 
 class RootFinder:
@@ -672,7 +524,7 @@ class RootFinder:
         """``found`` with the roots below ``upper`` that the closing count says are missing.
 
         They are located by geometric bisection, down to eighths of an octave,
-        on counts of det with the ``found`` roots divided out (:func:`deflated`;
+        on counts of det with the ``found`` roots divided out (:func:`~linmstmm.counting.deflated`;
         all intervals of one level in one batched count). The intervals that
         hold some are scanned densely on the deflated det, whose sign changes
         and quiet minima belong to the missing roots alone: a sign change is
@@ -714,7 +566,7 @@ class RootFinder:
     def _no_other_zeros(self, known: list[float], upper: float) -> bool:
         """True if (OMEGA_FLOOR, upper) holds no zeros of det Ū_all but ``known``.
 
-        The count runs on det with the known roots divided out (:func:`deflated`),
+        The count runs on det with the known roots divided out (:func:`~linmstmm.counting.deflated`),
         so its phase turns only for zeros not in ``known`` (or by −π for a
         ``known`` one that is not a zero) and DEFLATED_POINTS starting points
         suffice where counting them all took 65 and a refinement round. False
@@ -923,34 +775,3 @@ def _quiet_minima(sign, log_abs) -> np.ndarray:
     inner = np.arange(1, len(sign) - 1)
     return inner[(log_abs[inner] < log_abs[inner - 1]) & (log_abs[inner] < log_abs[inner + 1])
                  & (sign[inner - 1] == sign[inner]) & (sign[inner] == sign[inner + 1])]
-
-
-def release_indeterminate(deduction, probe=(0.7310, 1.9137, 5.3)) -> int:
-    """Find and release statically indeterminate unknowns of ``deduction``.
-
-    Redundant rigid constraints (a rigid direction fixed at both ends, ``inf``
-    springs closing a loop) make Ū_all singular at every ω, with constant
-    right and left null vectors. They are found at generic frequencies
-    (after balancing) and confirmed to be constant; the unknowns and rows
-    with the largest weight in them are released (:meth:`Deduction.release`).
-    Returns the number released. Raises RuntimeError for a null space that
-    moves with ω (a mechanism).
-    """
-    samples = deduction.matrix(np.asarray(probe, dtype=float))
-    rows, cols = equilibration(samples[0])
-    samples = rows[:, None] * samples * cols
-    r = min(nullity(sample) for sample in samples)
-    if r == 0:
-        return 0
-    u, _, vt = np.linalg.svd(samples[0])
-    right_null, left_null = vt[-r:].T, u[:, -r:]
-    for sample in samples[1:]:
-        scale = np.abs(sample).max()
-        if (np.abs(sample @ right_null).max() > 1e-9 * scale
-                or np.abs(left_null.T @ sample).max() > 1e-9 * scale):
-            raise RuntimeError("Ū_all is singular at every frequency with a null space that "
-                               "moves with frequency: the model has a mechanism")
-    released_columns = scipy.linalg.qr(right_null.T, pivoting=True)[2][:r]
-    released_rows = scipy.linalg.qr(left_null.T, pivoting=True)[2][:r]
-    deduction.release(released_columns, released_rows)
-    return r

@@ -9,8 +9,9 @@ import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.model import Model
+from linmstmm.nullspace import release_indeterminate
 from linmstmm.precision import refine_roots
-from linmstmm.roots import OMEGA_CEILING, RootFinder, release_indeterminate
+from linmstmm.roots import OMEGA_CEILING, RootFinder
 from linmstmm.topology import build_topology
 
 

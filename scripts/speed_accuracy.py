@@ -749,13 +749,13 @@ def write_report(args, command, facts, loads, elapsed, beam_model, beam_referenc
     w("")
     shares = []
     for label, where, suffix in (("fast path: scan, polish, confirm (_scan_ahead)", "roots.py", "(_scan_ahead)"),
-                                 ("argument-principle counts (_half_windings)", "roots.py", "(_half_windings)"),
+                                 ("argument-principle counts (_half_windings)", "counting.py", "(_half_windings)"),
                                  ("bisection of sign changes (shrink_brackets)", "roots.py", "(shrink_brackets)"),
                                  ("Newton polishing (polish)", "roots.py", "(polish)"),
                                  ("Ū_all evaluations (Deduction.matrix)", "deduction.py", "(matrix)"),
                                  ("of which orthonormalisation (_Orthonormaliser.apply)", "deduction.py", "(apply)"),
                                  ("of which numpy QR", "_linalg.py", "(qr)"),
-                                 ("of which state bookkeeping (_combine)", "deduction.py", "(_combine)"),
+                                 ("of which state bookkeeping (_combined)", "deduction.py", "(_combined)"),
                                  ("slogdet", "_linalg.py", "(slogdet)"),
                                  ("eigenvalues of the Newton pencil (numpy eigvals)", "_linalg.py", "(eigvals)")):
         match = [e for e in profile["entries"] if e["function"].endswith(suffix) and where in e["function"]]

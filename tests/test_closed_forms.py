@@ -12,7 +12,8 @@ import pytest
 from builders import fixed, make_rigid, single_beam_model, spring_mass_chain
 
 from linmstmm.model import Model
-from linmstmm.roots import RootFinder, count_zeros, deflated
+from linmstmm.counting import count_zeros, deflated
+from linmstmm.roots import RootFinder
 from linmstmm.solve import frequency_finder, natural_frequencies
 
 mp.mp.dps = 30

@@ -1,0 +1,79 @@
+"""Balancing Ū_all and reading its null space: multiplicities and indeterminate unknowns.
+
+Ū_all mixes metres, radians, newtons and newton-metres, so its singular values
+mean something only after exact power-of-two row and column scaling
+(:func:`equilibration`). The null-space dimension at a root is the root's
+(semisimple) multiplicity (:func:`nullity`); a null space present at every
+frequency is a set of statically indeterminate unknowns, released before any
+root is sought (:func:`release_indeterminate`).
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg
+
+from linmstmm.numeric import power_of_two_scale
+
+#: A singular value below this fraction of the largest counts as zero.
+NULL_TOLERANCE = 1e-8
+
+
+def equilibration(matrix: np.ndarray, sweeps: int = 4):
+    """Row and column scales (powers of two) giving every row and column max |a| ~ 1.
+
+    matrix : (N, M) or a stack (n, N, M). Returns (rows (…, N), cols (…, M))
+    with ``rows[..., :, None] * matrix * cols[..., None, :]`` balanced.
+    Keeps the null space (up to column scaling) and makes singular values
+    comparable across the mixed units of Ū_all (m, rad, N, N m).
+    """
+    size = np.abs(matrix)
+    rows = np.ones(matrix.shape[:-1])
+    cols = np.ones(matrix.shape[:-2] + matrix.shape[-1:])
+    for _ in range(sweeps):
+        rows *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-1))
+        cols *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-2))
+    return rows, cols
+
+
+def nullity(matrix: np.ndarray, tolerance: float = NULL_TOLERANCE, scales=None) -> int:
+    """Number of singular values of the equilibrated matrix below ``tolerance`` × the largest.
+
+    scales : (rows, cols) to balance with; default from ``matrix`` itself. At
+    a root, take them from a nearby frequency: balancing exactly there would
+    blow up a row whose only entry vanishes at the root (cos kL of a rod)
+    and hide the singularity.
+    """
+    rows, cols = equilibration(matrix) if scales is None else scales
+    sigma = np.linalg.svd(rows[:, None] * matrix * cols, compute_uv=False)
+    return int(np.sum(sigma < tolerance * sigma[0]))
+
+
+def release_indeterminate(deduction, probe=(0.7310, 1.9137, 5.3)) -> int:
+    """Find and release statically indeterminate unknowns of ``deduction``.
+
+    Redundant rigid constraints (a rigid direction fixed at both ends, ``inf``
+    springs closing a loop) make Ū_all singular at every ω, with constant
+    right and left null vectors. They are found at generic frequencies
+    (after balancing) and confirmed to be constant; the unknowns and rows
+    with the largest weight in them are released (:meth:`Deduction.release`).
+    Returns the number released. Raises RuntimeError for a null space that
+    moves with ω (a mechanism).
+    """
+    samples = deduction.matrix(np.asarray(probe, dtype=float))
+    rows, cols = equilibration(samples[0])
+    samples = rows[:, None] * samples * cols
+    r = min(nullity(sample) for sample in samples)
+    if r == 0:
+        return 0
+    u, _, vt = np.linalg.svd(samples[0])
+    right_null, left_null = vt[-r:].T, u[:, -r:]
+    for sample in samples[1:]:
+        scale = np.abs(sample).max()
+        if (np.abs(sample @ right_null).max() > 1e-9 * scale
+                or np.abs(left_null.T @ sample).max() > 1e-9 * scale):
+            raise RuntimeError("Ū_all is singular at every frequency with a null space that "
+                               "moves with frequency: the model has a mechanism")
+    released_columns = scipy.linalg.qr(right_null.T, pivoting=True)[2][:r]
+    released_rows = scipy.linalg.qr(left_null.T, pivoting=True)[2][:r]
+    deduction.release(released_columns, released_rows)
+    return r

@@ -33,12 +33,17 @@ def deflated(log_det, roots):
     roots = np.asarray(roots, dtype=float)
 
     def reduced(omega):
-        sign, log_abs = log_det(omega)
-        factors = np.asarray(omega)[:, None] ** 2 - roots[None, :] ** 2
-        return (sign * np.exp(-1j * np.angle(factors).sum(axis=1)),
-                log_abs - np.log(np.abs(factors)).sum(axis=1))
+        return divided_out(omega, *log_det(omega), roots)
 
     return reduced
+
+
+def divided_out(omega, sign, log_abs, roots):
+    """(phase, log|·|) of det / ∏_r (ω² − r²), given det's (``sign``, ``log_abs``) at
+    ``omega`` (n,): values already computed need no new evaluation of det."""
+    factors = np.asarray(omega)[:, None] ** 2 - np.asarray(roots, dtype=float)[None, :] ** 2
+    return (sign * np.exp(-1j * np.angle(factors).sum(axis=1)),
+            log_abs - np.log(np.abs(factors)).sum(axis=1))
 
 
 def count_zeros(log_det, a: float, b: float, max_points: int = 20000, initial_points: int = 65) -> int:

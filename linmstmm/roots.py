@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from linmstmm.counting import count_in_disc, count_zeros, count_zeros_many, deflated
+from linmstmm.counting import count_in_disc, count_zeros, count_zeros_many, deflated, divided_out
 from linmstmm.nullspace import equilibration, nullity
 
 #: Grid points per octave of the scans (the fast path's above 1 rad/s, an
@@ -500,12 +500,15 @@ class RootFinder:
             self._merge(found, members, OMEGA_FLOOR, np.inf)
         return sorted(found)
 
-    def _confirmed(self, found: list[float], count: int | None, omega_max: float | None = None):
+    def _confirmed(self, found: list[float], count: int | None, omega_max: float | None = None,
+                   cap: float = np.inf):
         """The lowest ``count`` of ``found`` (or all up to omega_max) if one count from
-        OMEGA_FLOOR says there are no others below them; None otherwise."""
+        OMEGA_FLOOR says there are no others below them; None otherwise.
+        ``cap``: the count stops there at the latest (rad/s; above the count-th root)."""
         upper = self._count_top(found, count, omega_max)
-        if upper is None:
+        if upper is None or (count is not None and len(found) >= count and found[count - 1] >= cap):
             return None
+        upper = min(upper, cap)
         below = [r for r in found if r < upper]
         return below[:count] if self._no_other_zeros(below, upper) else None
 
@@ -520,48 +523,55 @@ class RootFinder:
         above = [r for r in found if r > top * (1 + self.SAME_ROOT)]
         return (top + above[0]) / 2 if above else top * 1.01
 
-    def _recovered(self, found: list[float], upper: float) -> list[float]:
-        """``found`` with the roots below ``upper`` that the closing count says are missing.
+    def _recovered(self, found: list[float], upper: float, count: int | None = None):
+        """(``found`` with the roots below ``upper`` that the closing count says are
+        missing, the cap for the closing count that follows (rad/s)).
 
         They are located by geometric bisection, down to eighths of an octave,
         on counts of det with the ``found`` roots divided out (:func:`~linmstmm.counting.deflated`;
-        all intervals of one level in one batched count). The intervals that
+        all intervals of one level in one batched count). With ``count``, an
+        interval with at least ``count`` roots (found or missing) below it is
+        not split further: its roots are above the count-th, and the closing
+        count is capped at its lower end. The intervals that
         hold some are scanned densely on the deflated det, whose sign changes
-        and quiet minima belong to the missing roots alone: a sign change is
-        narrowed to xtol by regula falsi on it (a missing root may sit in the
-        same grid step as a found one, where Newton would return to that),
-        a minimum is polished. ``found`` as it was if a count cannot be made.
+        and quiet minima belong to the missing roots alone (:meth:`_deflated_candidates`).
+        ``found`` as it was if a count cannot be made.
         """
         reduced = deflated(self.log_det, [r for r in found if r < upper])
         try:
             missing = count_zeros(reduced, OMEGA_FLOOR, upper)
         except RuntimeError:
-            return found
-        pending, leaves = [(OMEGA_FLOOR, upper, missing)] if missing else [], []
+            return found, upper
+        pending, leaves, cap = [(OMEGA_FLOOR, upper, missing)] if missing else [], [], upper
         while pending:
+            kept, level_cap = self._below_count(leaves + pending, found, count, upper)
+            cap = min(cap, level_cap)
+            leaves, pending = [part for part in leaves if part in kept], [part for part in pending if part in kept]
             leaves += [part for part in pending if part[1] / part[0] <= 2 ** 0.125]
             wide = [part for part in pending if part[1] / part[0] > 2 ** 0.125]
             middles = [np.sqrt(lo * hi) for lo, hi, _ in wide]
             lower = count_zeros_many(reduced, [(lo, mid) for (lo, _, _), mid in zip(wide, middles)]) if wide else []
             if any(isinstance(c, RuntimeError) for c in lower):
-                return found
+                return found, upper
             pending = [part for (lo, hi, k), mid, c in zip(wide, middles, lower)
                        for part in ((lo, mid, c), (mid, hi, k - c)) if part[2] > 0]
         if not leaves:
-            return found
+            return found, cap
         grids = [np.geomspace(lo, hi, 16 * k + 17) for lo, hi, k in leaves]
-        sign, log_abs = reduced(np.concatenate(grids))
-        brackets, minima = [], []
-        for grid, piece_sign, piece_log in zip(grids, *(np.split(v, np.cumsum([g.size for g in grids])[:-1])
-                                                         for v in (np.real(sign), log_abs))):
-            change = np.flatnonzero(piece_sign[:-1] * piece_sign[1:] < 0)
-            brackets += zip(grid[change], grid[change + 1])
-            minima += list(grid[_quiet_minima(piece_sign, piece_log)])
-        found = self._polished(minima, found, confirm=False)
-        if brackets:
-            for root in self._bracket_roots(*map(np.array, zip(*brackets)), log_det=reduced):
-                self._merge(found, [root], OMEGA_FLOOR, np.inf)
-        return sorted(found)
+        return self._deflated_candidates(found, grids, *reduced(np.concatenate(grids)), reduced), cap
+
+    @staticmethod
+    def _below_count(parts, found: list[float], count: int | None, upper: float):
+        """(the (lo, hi, missing) ``parts`` that may hold one of the lowest ``count``
+        roots, the lower end of the first that cannot, else ``upper``): a part
+        with ``count`` roots below it, found or missing, cannot."""
+        kept, missing_below = [], 0
+        for lo, hi, missing in sorted(parts):
+            if count is not None and sum(r < lo for r in found) + missing_below >= count:
+                return kept, lo
+            kept.append((lo, hi, missing))
+            missing_below += missing
+        return kept, upper
 
     def _no_other_zeros(self, known: list[float], upper: float) -> bool:
         """True if (OMEGA_FLOOR, upper) holds no zeros of det Ū_all but ``known``.
@@ -606,11 +616,12 @@ class RootFinder:
         self.deferred_members = []
         brackets, minima = [], []  # (lo, hi, log|det(hi)| − log|det(lo)|) and grid points
         lo, hi = OMEGA_FLOOR, 8.0
-        scan = (np.zeros(0),) * 3
+        scans = [(np.zeros(0),) * 3]  # every chunk's (grid, sign, log|det|), kept for _rescanned
         while True:
             if omega_max is not None:
                 hi = min(hi, omega_max)
-            grid, sign, log_abs = scan = self._scanned(lo, hi, scan)
+            grid, sign, log_abs = scan = self._scanned(lo, hi, scans[-1])
+            scans.append(scan)
             change = np.flatnonzero(sign[:-1] * sign[1:] < 0)
             change = change[grid[change + 1] > lo]  # (the lower chunk's own were taken there)
             waiting = len(brackets) + len(minima)
@@ -632,20 +643,72 @@ class RootFinder:
                     found.sort()
                 brackets, minima = [], []
                 if omega_max is not None or len(found) >= count:
-                    confirmed = self._confirmed(found, count, omega_max)
-                    if confirmed is None:  # a close pair's other member, or a misread multiplicity?
-                        found = self._recounted(self._polished(self.deferred_members, found, confirm=False))
-                        confirmed = self._confirmed(found, count, omega_max)
-                    upper = None if confirmed is not None else self._count_top(found, count, omega_max)
-                    if upper is not None:  # roots the scan could not see
-                        confirmed = self._confirmed(self._recovered(found, upper), count, omega_max)
-                    return confirmed
+                    return self._closed(found, count, omega_max, scans)
             # fewer roots than count? (sign changes only: a shallow quiet minimum far
             # below the first root is no evidence that the roots have run out)
             seen = found + [b[0] for b in brackets]
             if omega_max is None and (hi >= OMEGA_CEILING or (seen and hi > 1e3 * max(seen))):
                 return None
             lo, hi = hi, self._next_top(hi, sorted(seen + minima), count)
+
+    def _closed(self, found: list[float], count: int | None, omega_max: float | None, scans):
+        """``found`` as the closing count confirms it (:meth:`_confirmed`), after the
+        repairs it takes, each followed by that count again; None if none is enough.
+
+        1. The roots the scan's own values show once ``found`` is divided out
+           (:meth:`_rescanned`; no new scan): two roots in one grid step.
+        2. The deferred cluster members polished and every multiplicity recounted
+           (:meth:`_recounted`): a close pair's other member, a misread multiplicity.
+        3. The roots still missing, located by deflated counts (:meth:`_recovered`).
+        """
+        confirmed = self._confirmed(found, count, omega_max)
+        if confirmed is None:
+            rescanned = self._rescanned(found, scans)
+            if rescanned != found:
+                found = rescanned
+                confirmed = self._confirmed(found, count, omega_max)
+        if confirmed is None:
+            found = self._recounted(self._polished(self.deferred_members, found, confirm=False))
+            confirmed = self._confirmed(found, count, omega_max)
+        upper = None if confirmed is not None else self._count_top(found, count, omega_max)
+        if upper is not None:
+            recovered, cap = self._recovered(found, upper, count)
+            confirmed = self._confirmed(recovered, count, omega_max, cap)
+        return confirmed
+
+    def _rescanned(self, found: list[float], scans) -> list[float]:
+        """``found`` with the roots that the fast scan's values (``scans``: (grid, sign,
+        log|det|) per chunk) show once ``found`` is divided out (:func:`divided_out`).
+
+        Two roots in one grid step give det no sign change there, nor does a
+        root hidden beside a found one; the deflated det changes sign at the
+        missing one. Only values already computed are looked at; the
+        candidates are then handled as in :meth:`_recovered`.
+        """
+        grid, sign, log_abs = (np.concatenate(parts) for parts in zip(*scans))
+        grid, first = np.unique(grid, return_index=True)
+        if grid.size < 3 or not found:
+            return found
+        sign, log_abs = divided_out(grid, sign[first], log_abs[first], found)
+        return self._deflated_candidates(found, [grid], sign, log_abs, deflated(self.log_det, found))
+
+    def _deflated_candidates(self, found: list[float], grids, sign, log_abs, reduced) -> list[float]:
+        """``found`` with the roots in the sign changes and quiet minima of a deflated scan:
+        ``grids`` (ascending arrays) with the (phase, log|·|) of ``reduced`` (deflated
+        det) at their points, concatenated. A sign change is narrowed to xtol by
+        regula falsi on ``reduced`` (a missing root may share a grid step with a
+        found one, where Newton would return to that); a minimum is polished."""
+        brackets, minima = [], []
+        for grid, piece_sign, piece_log in zip(grids, *(np.split(v, np.cumsum([g.size for g in grids])[:-1])
+                                                         for v in (np.real(sign), log_abs))):
+            change = np.flatnonzero(piece_sign[:-1] * piece_sign[1:] < 0)
+            brackets += zip(grid[change], grid[change + 1])
+            minima += list(grid[_quiet_minima(piece_sign, piece_log)])
+        found = self._polished(minima, found, confirm=False)
+        if brackets:
+            for root in self._bracket_roots(*map(np.array, zip(*brackets)), log_det=reduced):
+                self._merge(found, [root], OMEGA_FLOOR, np.inf)
+        return sorted(found)
 
     def _recounted(self, found: list[float]) -> list[float]:
         """``found`` with the multiplicity of each root counted over a small circle

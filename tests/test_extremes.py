@@ -101,17 +101,60 @@ def test_a_missing_close_pair_is_recovered_by_deflated_counts():
     one step of the scan (2.9 %). With the closed-form roots given as found, less two
     such pairs, bisection on counts of det with the found roots divided out and a
     dense scan of the deflated det find all four again."""
-    model = single_beam_model(fixed(), None, length=2.0, Iz=2e-7, Iy=3.2e-7, axial=False, torsion=False)
-    planes = cantilever_bending_rad(model.beams[0], 12)
-    upper = 0.99 * min(plane[-1] for plane in planes)  # both planes complete below
-    exact = sorted(w for plane in planes for w in plane if w < upper)
+    model, exact, upper = two_plane_cantilever_roots()
     gaps = np.diff(exact) / exact[1:]
     pairs = np.argsort(gaps)[:2]  # the two closest pairs
     assert np.all(gaps[pairs] < 0.02)
     dropped = {i for p in pairs for i in (p, p + 1)}
     _, finder, _ = frequency_finder(model)
-    recovered = finder._recovered([w for i, w in enumerate(exact) if i not in dropped], upper)
+    recovered, cap = finder._recovered([w for i, w in enumerate(exact) if i not in dropped], upper)
     np.testing.assert_allclose([w for w in recovered if w < upper], exact, rtol=1e-10)
+    assert cap == upper
+
+
+def two_plane_cantilever_roots(modes: int = 12):
+    """A cantilever bending in two planes (Iz : Iy = 1 : 1.6): its model and every
+    bending root (rad/s) below the last complete pair, from the closed form."""
+    model = single_beam_model(fixed(), None, length=2.0, Iz=2e-7, Iy=3.2e-7, axial=False, torsion=False)
+    planes = cantilever_bending_rad(model.beams[0], modes)
+    upper = 0.99 * min(plane[-1] for plane in planes)
+    return model, sorted(w for plane in planes for w in plane if w < upper), upper
+
+
+def test_recovery_for_a_count_stops_above_the_count_th_root():
+    """Asked for the lowest k roots with the two highest missing: bisection does not
+    chase roots above the k-th; the closing count is capped between them."""
+    model, exact, upper = two_plane_cantilever_roots()
+    k = len(exact) - 2
+    _, finder, _ = frequency_finder(model)
+    recovered, cap = finder._recovered(exact[:k], upper, count=k)
+    assert recovered == exact[:k]
+    assert exact[k - 1] < cap <= exact[k]
+    assert finder._confirmed(recovered, k, cap=cap) == exact[:k]
+
+
+def test_a_root_sharing_a_scan_step_with_a_found_one_is_seen_in_the_stored_scan():
+    """The scan's own values, divided by the found roots, change sign at a missing
+    member of a close pair (no sign change of det across the step holding both)."""
+    model, exact, upper = two_plane_cantilever_roots()
+    _, finder, _ = frequency_finder(model)
+    grid = finder._quick_grid(0.5 * exact[0], upper)
+    scan = (grid, *finder.log_det(grid))
+    shared = [i for i in range(len(exact) - 1)
+              if np.searchsorted(grid, exact[i]) == np.searchsorted(grid, exact[i + 1])]
+    assert shared  # the scan cannot tell those pairs apart by sign
+    dropped = {i + 1 for i in shared}
+    rescanned = finder._rescanned([w for i, w in enumerate(exact) if i not in dropped], [scan])
+    np.testing.assert_allclose(rescanned, exact, rtol=1e-10)
+
+
+def test_a_coarse_scan_still_finds_every_root_in_the_fast_path(monkeypatch):
+    """points_per_octave=4 (a step of 19 %, holding both members of several pairs):
+    the fast path's repairs find every root, without the segment search."""
+    model, exact, _ = two_plane_cantilever_roots()
+    _, finder, _ = frequency_finder(model, points_per_octave=4)
+    monkeypatch.setattr(finder, "_search", lambda *args: pytest.fail("fell back to the segment search"))
+    np.testing.assert_allclose(finder.find(len(exact), None), exact, rtol=1e-10)
 
 
 def nafems_fv2_double_cross():

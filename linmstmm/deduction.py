@@ -33,7 +33,8 @@ from linmstmm.elements.frames import FORCE_INDEX
 from linmstmm.elements.rigid import force_extraction, position_incidence, rigid_transfer_parts
 from linmstmm.elements.spring import spring_transfer
 from linmstmm.periodic import carry_run, find_runs
-from linmstmm.numeric import frequencies, power_of_two_scale, size_estimate, zeros_like_stack
+from linmstmm.numeric import (constant_times, frequencies, is_mp, numbers, power_of_two_scale, size_estimate,
+                              zeros_like_stack)
 from linmstmm.topology import Topology
 
 #: Largest βL of one beam piece in the stable evaluation: the piece's own
@@ -114,41 +115,43 @@ class Deduction:
         element = self.topology.elements[e]
         if element.kind == "beam":
             return beam_transfer(element.record, omega, reverse=element.inputs[0] == 1) @ matrix
-        kinematic, inertial = self._polynomial_parts(e)
-        product = kinematic @ matrix
+        kinematic, inertial = self._polynomial_parts(e, exact=is_mp(omega))
+        product = constant_times(kinematic, matrix)
         if inertial is not None:  # only forces and moments from displacements and rotations
             product = product.astype(np.result_type(product, omega), copy=False)
-            product[:, 6:] += np.reshape(omega, (-1, 1, 1)) ** 2 * (inertial[6:, :6] @ matrix[:, :6])
+            product[:, 6:] += np.reshape(omega, (-1, 1, 1)) ** 2 * constant_times(inertial[6:, :6], matrix[:, :6])
         return product
 
-    def _polynomial_parts(self, e: int):
+    def _polynomial_parts(self, e: int, exact: bool = False):
         """(U0, U2) with U_j = U0 + ω² U2 for a rigid body, spring or junction (U2 None
-        when constant); built once per element."""
-        if e not in self._parts:
+        when constant); built once per element, and with ``exact`` once more from the
+        model data in mpmath (:func:`~linmstmm.numeric.numbers`) for the mpmath path."""
+        if (e, exact) not in self._parts:
             element = self.topology.elements[e]
             record = element.record
             if element.kind == "rigid":
-                self._parts[e] = rigid_transfer_parts(
+                parts = rigid_transfer_parts(*(numbers(value, exact) for value in (
                     record.mass, record.com, record.inertia,
-                    element.ports[element.inputs[0]].position, element.ports[element.output].position)
+                    element.ports[element.inputs[0]].position, element.ports[element.output].position)))
             elif element.kind == "spring":
-                self._parts[e] = (spring_transfer(record.k, record.axes, np.zeros(1))[0], None)
+                parts = (spring_transfer(numbers(record.k, exact), record.axes, np.zeros(1))[0], None)
             else:  # junction: a massless rigid body whose ports coincide
-                self._parts[e] = (np.eye(12), None)
-        return self._parts[e]
+                parts = (np.eye(12), None)
+            self._parts[e, exact] = parts
+        return self._parts[e, exact]
 
-    def _other_inputs(self, e: int) -> list:
+    def _other_inputs(self, e: int, exact: bool = False) -> list:
         """(row label, U_{j,Ik} (12, 12), H_{j,Ik} (6, 12)) for each input k >= 2 of
-        element e; built once."""
-        if e not in self._inputs:
+        element e; built once (and once in mpmath with ``exact``, as :meth:`_polynomial_parts`)."""
+        if (e, exact) not in self._inputs:
             element = self.topology.elements[e]
-            out = element.ports[element.output].position
-            first = element.ports[element.inputs[0]].position
-            self._inputs[e] = [(f"{element.name} input {element.ports[p].point}",
-                                force_extraction(element.ports[p].position, out),
-                                position_incidence(first, element.ports[p].position))
-                               for p in element.inputs[1:]]
-        return self._inputs[e]
+            out = numbers(element.ports[element.output].position, exact)
+            first = numbers(element.ports[element.inputs[0]].position, exact)
+            self._inputs[e, exact] = [(f"{element.name} input {element.ports[p].point}",
+                                       force_extraction(numbers(element.ports[p].position, exact), out),
+                                       position_incidence(first, numbers(element.ports[p].position, exact)))
+                                      for p in element.inputs[1:]]
+        return self._inputs[e, exact]
 
     def _combined(self, key, terms):
         """Sum of the (n, rows, k_i) products of (columns_i, product_i) ``terms`` on the
@@ -258,10 +261,11 @@ class Deduction:
                 terms = [(inputs[0].columns, inputs[0].matrix)]
             else:
                 terms = [(inputs[0].columns, self.carried(e, omega, inputs[0].matrix))]
-            for k, ((label, forces, incidence), state) in enumerate(zip(self._other_inputs(e), inputs[1:])):
-                terms.append((state.columns, forces @ state.matrix))
+            for k, ((label, forces, incidence), state) in enumerate(zip(self._other_inputs(e, is_mp(omega)),
+                                                                       inputs[1:])):
+                terms.append((state.columns, constant_times(forces, state.matrix)))
                 rows.append([label, *self._combined((e, k), [(inputs[0].columns, -inputs[0].matrix[:, :6]),
-                                                             (state.columns, incidence @ state.matrix)])])
+                                                             (state.columns, constant_times(incidence, state.matrix))])])
             state = PortState(*self._combined((e,), terms), reference=_largest([state.reference for state in inputs]))
             if stable:
                 state = normaliser.apply(state, rows, open_states)

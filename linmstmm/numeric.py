@@ -29,6 +29,19 @@ def frequencies(omega) -> np.ndarray:
     return omega
 
 
+def numbers(x, exact: bool = False) -> np.ndarray:
+    """``x`` as a float64 array, or with ``exact`` as mpmath numbers (each float
+    converted exactly), so that quantities derived from model data (1/k, lever
+    arms, m·r) are formed at the working precision of the mpmath path."""
+    x = np.asarray(x, dtype=float)
+    return np.vectorize(mpmath.mpf, otypes=[object])(x) if exact else x
+
+
+def number_type(*arrays):
+    """float64, or object if any of ``arrays`` holds mpmath numbers."""
+    return object if any(is_mp(np.asarray(a)) for a in arrays) else np.float64
+
+
 def result_dtype(omega):
     """dtype of matrices built from ``omega``: float64, complex128 or object."""
     return object if is_mp(omega) else np.result_type(omega, np.float64)
@@ -80,3 +93,25 @@ def zeros_like_stack(omega, shape) -> np.ndarray:
     if dtype == object:
         out[...] = mpmath.mpf(0)
     return out
+
+
+def constant_times(constant: np.ndarray, stack: np.ndarray) -> np.ndarray:
+    """``constant @ stack`` for a float matrix (r, c) and a stack (n, c, k).
+
+    For an mpmath (object) stack only the non-zero entries of ``constant``
+    multiply, and ±1 without a product: most entries of a rigid body's,
+    spring's or junction's matrix are 0 or ±1, and a dense object matmul
+    spent three quarters of an mpmath evaluation of Ū_all converting them.
+    """
+    if not is_mp(stack):
+        return constant @ stack
+    out = np.empty((stack.shape[0], constant.shape[0], stack.shape[2]), dtype=object)
+    for row, entries in enumerate(constant):
+        total = np.full((stack.shape[0], stack.shape[2]), mpmath.mpf(0), dtype=object)
+        for column in np.flatnonzero(entries):
+            value = entries[column]
+            part = stack[:, column, :]
+            total = total + part if value == 1 else total - part if value == -1 else total + part * mpmath.mpf(value)
+        out[:, row, :] = total
+    return out
+

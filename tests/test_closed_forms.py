@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 from builders import fixed, make_rigid, single_beam_model, spring_mass_chain
 
-from linmstmm.model import Model
 from linmstmm.counting import count_zeros, deflated
+from linmstmm.model import Model
+from linmstmm.precision import sparse_determinant
 from linmstmm.roots import RootFinder
 from linmstmm.solve import frequency_finder, natural_frequencies
 
@@ -180,9 +181,12 @@ def test_a_misleading_guess_falls_back_to_the_full_search():
     np.testing.assert_allclose(warm.frequencies_hz, cold.frequencies_hz, rtol=1e-12)
 
 
-def test_thirty_digits_match_the_frequency_equation():
-    """--digits 30: the mpmath path against the cantilever equation solved at 40 digits."""
-    model = single_beam_model(fixed(), None, Iz=2e-7, Iy=7e-7, axial=False, torsion=False)
+@pytest.mark.parametrize("Iy", [pytest.param(7e-7, id="simple root"),
+                                pytest.param(2e-7, id="double root (round section)")])
+def test_thirty_digits_match_the_frequency_equation(Iy):
+    """--digits 30: the mpmath path against the cantilever equation solved at 40 digits
+    (a double root is refined by its own iteration: Newton times the multiplicity)."""
+    model = single_beam_model(fixed(), None, Iz=2e-7, Iy=Iy, axial=False, torsion=False)
     beam = model.beams[0]
     got = natural_frequencies(model, count=2, digits=30)
     assert got.precision == "mpmath:30"
@@ -191,3 +195,19 @@ def test_thirty_digits_match_the_frequency_equation():
         stiffness = mp.mpf(beam.E) * mp.mpf(beam.Iz) / (mp.mpf(beam.rho) * mp.mpf(beam.A) * mp.mpf(beam.length) ** 4)
         want = lam**2 * mp.sqrt(stiffness) / (2 * mp.pi)
         assert abs(mp.mpf(got.frequencies_text[0]) / want - 1) < mp.mpf(10) ** -28
+        if Iy == beam.Iz:
+            assert got.frequencies_text[1] == got.frequencies_text[0]
+
+
+def test_sparse_determinant_matches_mpmath_det():
+    """The mpmath path's LU on object arrays against mpmath.det, on a matrix with the
+    zero pattern and mixed scales of Ū_all, and on an exactly singular one."""
+    rng = np.random.default_rng(3)
+    values = rng.normal(size=(9, 9)) * 10.0 ** rng.integers(-6, 7, size=(9, 1))
+    values[rng.random((9, 9)) < 0.6] = 0.0
+    np.fill_diagonal(values, 1.0 + np.abs(values.diagonal()))
+    with mp.workdps(40):
+        matrix = np.vectorize(mp.mpf, otypes=[object])(values)
+        assert abs(sparse_determinant(matrix) / mp.det(mp.matrix(matrix.tolist())) - 1) < mp.mpf(10) ** -35
+        matrix[4] = matrix[2] * 3
+        assert sparse_determinant(matrix) == 0

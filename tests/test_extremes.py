@@ -40,6 +40,11 @@ def chain_along_x(masses, stiffnesses, right_end_fixed=False, name="chain"):
 
 def chain_reference_hz(masses, stiffnesses, right_end_fixed=False):
     """Eigenfrequencies of the 1-D chain from its K and M in mpmath (50 digits), Hz."""
+    return np.array([float(f) for f in chain_reference_mp(masses, stiffnesses, right_end_fixed)])
+
+
+def chain_reference_mp(masses, stiffnesses, right_end_fixed=False):
+    """The same as mpf values at 50 digits, ascending."""
     with mp.workdps(50):
         n = len(masses)
         K = mp.zeros(n, n)
@@ -53,7 +58,7 @@ def chain_reference_hz(masses, stiffnesses, right_end_fixed=False):
             K[n - 1, n - 1] += stiffnesses[n]
         scale = mp.diag([1 / mp.sqrt(m) for m in masses])
         eigenvalues = mp.eigsy(scale * K * scale, eigvals_only=True)
-        return np.sort([float(mp.sqrt(v) / (2 * mp.pi)) for v in eigenvalues])
+        return sorted(mp.sqrt(v) / (2 * mp.pi) for v in eigenvalues)
 
 
 @pytest.mark.parametrize("masses, stiffnesses", [
@@ -64,6 +69,18 @@ def test_contrasts_in_one_model(masses, stiffnesses):
     reference = np.repeat(chain_reference_hz(masses, stiffnesses, True), 3)
     got = natural_frequencies(chain_along_x(masses, stiffnesses, True), count=9)
     np.testing.assert_allclose(got.frequencies_hz, reference, rtol=1e-9)
+
+
+def test_25_digits_in_mixed_units():
+    """Launcher-like magnitudes (tonnes, 1e5–1e8 N/m): Ū_all mixes newtons and metres, so
+    a determinant that calls a pivot below ‖Ū‖·eps zero (mpmath.det did) stops the
+    refinement early; these came back right to only 18–20 digits."""
+    masses, stiffnesses = [2000.0, 500.0, 8000.0], [3e6, 1e8, 5e5, 2e7]
+    got = natural_frequencies(chain_along_x(masses, stiffnesses, True), count=9, digits=25)
+    assert got.precision == "mpmath:25"
+    with mp.workdps(50):
+        want = [f for f in chain_reference_mp(masses, stiffnesses, True) for _ in range(3)]
+        assert max(abs(mp.mpf(text) / f - 1) for text, f in zip(got.frequencies_text, want)) < mp.mpf(10) ** -24
 
 
 def test_chain_of_2000_rigid_bodies_and_springs():

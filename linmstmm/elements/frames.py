@@ -7,6 +7,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from linmstmm.numeric import number_type
+
 U, R, M, Q = slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12)
 
 #: Index of the internal force/moment paired (by work) with displacement
@@ -23,8 +25,8 @@ SYMPLECTIC_FORM[FORCE_INDEX, np.arange(6)] = -1.0
 
 def skew(r) -> np.ndarray:
     """(3, 3) cross-product matrix: ``skew(r) @ v == np.cross(r, v)``."""
-    x, y, z = np.asarray(r, dtype=float)
-    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    x, y, z = np.asarray(r)  # float, or mpmath numbers (then an object array)
+    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]], dtype=number_type(r))
 
 
 def state_rotation(axes) -> np.ndarray:

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from linmstmm.elements.frames import M, Q, R, U, skew
-from linmstmm.numeric import frequencies
+from linmstmm.numeric import frequencies, number_type
 
 
 def rigid_transfer_parts(mass, com, inertia, inp, out) -> tuple[np.ndarray, np.ndarray]:
@@ -27,17 +27,19 @@ def rigid_transfer_parts(mass, com, inertia, inp, out) -> tuple[np.ndarray, np.n
     rotations) is non-zero.
 
     mass : kg. com, inp, out : (3,) positions, m. inertia : (3, 3) about the
-    mass centre, kg m².
+    mass centre, kg m². Floats, or mpmath numbers (:func:`~linmstmm.numeric.numbers`):
+    then both matrices are object arrays.
     """
-    inp, out, com = (np.asarray(p, dtype=float) for p in (inp, out, com))
-    kinematic = np.eye(12)
+    inp, out, com = (np.asarray(p) for p in (inp, out, com))
+    dtype = number_type(mass, com, inertia, inp, out)
+    kinematic = np.eye(12, dtype=dtype)
     kinematic[U, R] = -skew(out - inp)
     kinematic[M, Q] = skew(inp - out)
-    inertial = np.zeros((12, 12))
+    inertial = np.zeros((12, 12), dtype=dtype)
     com_from_input = np.hstack([np.eye(3), -skew(com - inp)])  # u_c = this @ (u_I, θ_I)
     inertial[Q, 0:6] = mass * com_from_input
     inertial[M, 0:6] = -skew(out - com) @ (mass * com_from_input)
-    inertial[M, R] += np.asarray(inertia, dtype=float)
+    inertial[M, R] += np.asarray(inertia)
     return kinematic, inertial
 
 
@@ -52,11 +54,12 @@ def rigid_transfer(mass, com, inertia, inp, out, omega) -> np.ndarray:
 
 
 def force_extraction(inp_k, out) -> np.ndarray:
-    """(12, 12) U_{j,Ik}: carries the force and moment of input k to the output."""
-    extraction = np.zeros((12, 12))
+    """(12, 12) U_{j,Ik}: carries the force and moment of input k to the output
+    (positions float or mpmath numbers, as in :func:`rigid_transfer_parts`)."""
+    extraction = np.zeros((12, 12), dtype=number_type(inp_k, out))
     extraction[M, M] = np.eye(3)
     extraction[Q, Q] = np.eye(3)
-    extraction[M, Q] = skew(np.asarray(inp_k, float) - np.asarray(out, float))
+    extraction[M, Q] = skew(np.asarray(inp_k) - np.asarray(out))
     return extraction
 
 
@@ -67,6 +70,6 @@ def position_extraction() -> np.ndarray:
 
 def position_incidence(inp_1, inp_k) -> np.ndarray:
     """(6, 12) H_{j,Ik} with ``H_j Z_I1 = H_{j,Ik} Z_Ik`` (rigid kinematics)."""
-    incidence = np.eye(6, 12)
-    incidence[U, R] = skew(np.asarray(inp_k, float) - np.asarray(inp_1, float))
+    incidence = np.eye(6, 12, dtype=number_type(inp_1, inp_k))
+    incidence[U, R] = skew(np.asarray(inp_k) - np.asarray(inp_1))
     return incidence

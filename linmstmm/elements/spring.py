@@ -11,15 +11,18 @@ from __future__ import annotations
 import numpy as np
 
 from linmstmm.elements.frames import M, Q, R, U
+from linmstmm.numeric import number_type
 
 
 def spring_compliance(k, axes) -> tuple[np.ndarray, np.ndarray]:
     """Translational and rotational compliance in the inertial frame.
 
-    k : (6,) N/m and N m/rad, ``inf`` allowed. axes : (3, 3) rows = local axes.
+    k : (6,) N/m and N m/rad, ``inf`` allowed; floats, or mpmath numbers
+    (:func:`~linmstmm.numeric.numbers`: the compliances are then formed at the
+    working precision). axes : (3, 3) rows = local axes.
     Returns (C_t, C_r), each (3, 3), m/N and rad/(N m).
     """
-    k = np.asarray(k, dtype=float)
+    k = np.asarray(k) if number_type(k) is object else np.asarray(k, dtype=float)
     axes = np.asarray(axes, dtype=float)
     compliance = 1.0 / k  # inf -> 0: rigid direction
     C_t = axes.T @ np.diag(compliance[:3]) @ axes
@@ -30,7 +33,7 @@ def spring_compliance(k, axes) -> tuple[np.ndarray, np.ndarray]:
 def spring_transfer(k, axes, omega) -> np.ndarray:
     """Transfer matrix stack (n, 12, 12) of a spring; constant in omega."""
     C_t, C_r = spring_compliance(k, axes)
-    U_single = np.eye(12)
+    U_single = np.eye(12, dtype=C_t.dtype)
     U_single[U, Q] = -C_t
     U_single[R, M] = -C_r
     return np.broadcast_to(U_single, (np.size(omega), 12, 12)).copy()

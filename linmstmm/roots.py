@@ -6,8 +6,10 @@ the argument principle (:mod:`linmstmm.counting`).
 The fast path (:meth:`RootFinder._scan_ahead`) scans (sign, log|det|)
 upwards until it has seen enough candidates, polishes them all at once and
 keeps the result only if one count from OMEGA_FLOOR agrees: the count of
-det with the found roots divided out (:func:`~linmstmm.counting.deflated`) must be zero, which
-a missed root or a false one would break. Otherwise the search works
+det with the found roots divided out (:func:`~linmstmm.counting.deflated`)
+must be zero, which a missed root or a false one would break. Where it is
+not, the missing roots are looked for in the stored scan and by deflated
+counts (:meth:`RootFinder._closed`); failing that, the search works
 segment by segment upwards:
 
 1. a count, then a scan on a geometric grid of at least ``points_per_root``
@@ -603,11 +605,10 @@ class RootFinder:
         OMEGA_FLOOR must agree. Multiplicities are
         read from the pencil offsets without a count each: a wrong one changes
         the total, which that count sees (unless an opposite error elsewhere
-        cancels it). If the count finds more, the deferred cluster members
-        (:meth:`clusters`) are polished and every multiplicity recounted
-        (:meth:`_recounted`), then the roots still missing are located by
-        deflated counts (:meth:`_recovered`), each followed by the closing
-        count again. Far fewer
+        cancels it). If the count finds more, the repairs of :meth:`_closed`
+        follow (the stored scan with the found roots divided out, the deferred
+        cluster members and recounted multiplicities, deflated counts), each
+        followed by the closing count again. Far fewer
         evaluations than the segment search when it works; when it does not
         (a root between two candidates, a chain of clusters), :meth:`find`
         falls back.

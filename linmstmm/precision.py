@@ -13,6 +13,12 @@ evaluation at ω + ih (complex step: det is real on the real axis, so
 Im det(ω + ih) / h = det'(ω) with no cancellation). Either stops once its
 step is below 10^−(digits+2) of the root, or raises a RuntimeError after
 MAX_STEPS.
+
+The digits are those of the model records as given: every number the
+solver derives from them (compliances 1/k, lever arms, m·r, EI, ρA) is formed
+in mpmath from the exact binary values. A beam's ``length`` and ``axes`` are
+record fields, float64 values computed from its end points when a file is
+read, and are taken as they are.
 """
 from __future__ import annotations
 

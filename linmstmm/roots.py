@@ -77,6 +77,8 @@ class RootFinder:
     SPLIT = 1e-4
     #: Offsets |μ|/ω below this are polished as members of the same cluster.
     CLUSTER_WINDOW = 2e-3
+    #: Passes of :meth:`_rescanned` over the stored scan, each with the roots the last found.
+    RESCANS = 3
     #: After a Newton step below this (relative), the next one is likely the last:
     #: compute all the offsets there, not only the smallest.
     LAST_STEPS = 1e-8
@@ -656,42 +658,58 @@ class RootFinder:
         """``found`` as the closing count confirms it (:meth:`_confirmed`), after the
         repairs it takes, each followed by that count again; None if none is enough.
 
-        1. The roots the scan's own values show once ``found`` is divided out
-           (:meth:`_rescanned`; no new scan): two roots in one grid step.
-        2. The deferred cluster members polished and every multiplicity recounted
-           (:meth:`_recounted`): a close pair's other member, a misread multiplicity.
+        1. The deferred cluster members polished (:meth:`clusters`: a close pair's
+           other member), then the roots the scan's own values show once
+           ``found`` is divided out (:meth:`_rescanned`; no new scan): two roots
+           in one grid step, one of them found.
+        2. Every multiplicity recounted (:meth:`_recounted`): a misread one.
         3. The roots still missing, located by deflated counts (:meth:`_recovered`).
+
+        The first two look only below the closing count's top (the scan may have
+        gone far past the count-th root: a 40-mode beam's recount of all it saw
+        cost 1000 contour points).
         """
+        def top(roots):
+            return self._count_top(roots, count, omega_max) or np.inf
+
         confirmed = self._confirmed(found, count, omega_max)
-        if confirmed is None:
-            rescanned = self._rescanned(found, scans)
-            if rescanned != found:
-                found = rescanned
+        for repair in (lambda roots: self._rescanned(self._polished(self.deferred_members, roots, confirm=False),
+                                                     scans, top(roots)),
+                       lambda roots: self._recounted(roots, top(roots))):
+            if confirmed is not None:
+                break
+            repaired = repair(found)
+            if repaired != found:
+                found = repaired
                 confirmed = self._confirmed(found, count, omega_max)
-        if confirmed is None:
-            found = self._recounted(self._polished(self.deferred_members, found, confirm=False))
-            confirmed = self._confirmed(found, count, omega_max)
         upper = None if confirmed is not None else self._count_top(found, count, omega_max)
         if upper is not None:
             recovered, cap = self._recovered(found, upper, count)
             confirmed = self._confirmed(recovered, count, omega_max, cap)
         return confirmed
 
-    def _rescanned(self, found: list[float], scans) -> list[float]:
-        """``found`` with the roots that the fast scan's values (``scans``: (grid, sign,
-        log|det|) per chunk) show once ``found`` is divided out (:func:`divided_out`).
+    def _rescanned(self, found: list[float], scans, upper: float = np.inf) -> list[float]:
+        """``found`` with the roots below ``upper`` that the fast scan's values (``scans``:
+        (grid, sign, log|det|) per chunk) show once ``found`` is divided out (:func:`divided_out`).
 
         Two roots in one grid step give det no sign change there, nor does a
         root hidden beside a found one; the deflated det changes sign at the
         missing one. Only values already computed are looked at; the
-        candidates are then handled as in :meth:`_recovered`.
+        candidates are then handled as in :meth:`_recovered`. A root found so
+        can hide the next one in the same step: up to RESCANS passes, while
+        each finds more.
         """
         grid, sign, log_abs = (np.concatenate(parts) for parts in zip(*scans))
         grid, first = np.unique(grid, return_index=True)
-        if grid.size < 3 or not found:
-            return found
-        sign, log_abs = divided_out(grid, sign[first], log_abs[first], found)
-        return self._deflated_candidates(found, [grid], sign, log_abs, deflated(self.log_det, found))
+        first = first[:np.searchsorted(grid, upper) + 1]  # the step across upper too
+        grid, sign, log_abs = grid[:first.size], sign[first], log_abs[first]
+        for _ in range(self.RESCANS if grid.size >= 3 else 0):
+            more = self._deflated_candidates(found, [grid], *divided_out(grid, sign, log_abs, found),
+                                             deflated(self.log_det, found))
+            if more == found:
+                break
+            found = more
+        return found
 
     def _deflated_candidates(self, found: list[float], grids, sign, log_abs, reduced) -> list[float]:
         """``found`` with the roots in the sign changes and quiet minima of a deflated scan:
@@ -711,20 +729,21 @@ class RootFinder:
                 self._merge(found, [root], OMEGA_FLOOR, np.inf)
         return sorted(found)
 
-    def _recounted(self, found: list[float]) -> list[float]:
-        """``found`` with the multiplicity of each root counted over a small circle
-        (all circles in one count; see :meth:`_multiplicities`) instead of read
-        from its pencil offsets, which can show spurious near-zero ones or (a
-        Newton stopped early) miss a double root's second one."""
+    def _recounted(self, found: list[float], upper: float = np.inf) -> list[float]:
+        """``found`` with the multiplicity of each root below ``upper`` counted over a
+        small circle (all circles in one count; see :meth:`_multiplicities`) instead
+        of read from its pencil offsets, which can show spurious near-zero ones or
+        (a Newton stopped early) miss a double root's second one."""
         distinct = sorted(set(found))
-        if not distinct:
+        recount = [r for r in distinct if r < upper]
+        if not recount:
             return found
         radii = [min([self.SPLIT * r] + [abs(r - other) / 2 for other in distinct if other != r])
-                 for r in distinct]
-        counts = count_zeros_many(self.log_det, [(r - radius, r + radius) for r, radius in zip(distinct, radii)],
-                                  initial_points=17)
-        return sorted(r for r, c in zip(distinct, counts)
-                      for _ in range(max(found.count(r) if isinstance(c, RuntimeError) else c, 1)))
+                 for r in recount]
+        counts = dict(zip(recount, count_zeros_many(
+            self.log_det, [(r - radius, r + radius) for r, radius in zip(recount, radii)], initial_points=17)))
+        return sorted(r for r in distinct for _ in range(
+            max(found.count(r) if isinstance(counts.get(r), (RuntimeError, type(None))) else counts[r], 1)))
 
     def _scanned(self, lo: float, hi: float, below) -> tuple:
         """(grid, sign, log|det|) of the fast scan over [lo, hi], led by the last two

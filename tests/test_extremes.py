@@ -165,6 +165,22 @@ def test_a_root_sharing_a_scan_step_with_a_found_one_is_seen_in_the_stored_scan(
     np.testing.assert_allclose(rescanned, exact, rtol=1e-10)
 
 
+def test_both_members_of_a_pair_in_one_scan_step_come_back_from_the_stored_scan():
+    """With neither member found, the first pass over the stored scan finds one (a quiet
+    minimum of the deflated det); the next pass, with that one divided out too, sees
+    the other's sign change."""
+    model, exact, upper = two_plane_cantilever_roots()
+    _, finder, _ = frequency_finder(model)
+    grid = finder._quick_grid(0.5 * exact[0], upper)
+    scan = (grid, *finder.log_det(grid))
+    shared = [i for i in range(len(exact) - 1)
+              if np.searchsorted(grid, exact[i]) == np.searchsorted(grid, exact[i + 1])]
+    assert shared
+    for i in shared:
+        rescanned = finder._rescanned([w for j, w in enumerate(exact) if j not in (i, i + 1)], [scan])
+        np.testing.assert_allclose(rescanned, exact, rtol=1e-10)
+
+
 def test_a_coarse_scan_still_finds_every_root_in_the_fast_path(monkeypatch):
     """points_per_octave=4 (a step of 19 %, holding both members of several pairs):
     the fast path's repairs find every root, without the segment search."""

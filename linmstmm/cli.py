@@ -83,9 +83,14 @@ def _print_frequency_table(title, result):
     print(f"  rigid-body modes: {result['rigid_body_modes']}")
     if "ubar_order" in result:
         print(f"  order of Ubar_all: {result['ubar_order']}")
-    print(f"  {'mode':>4}  {'f [Hz]':>20}  {'omega [rad/s]':>20}")
-    for index, f in enumerate(result["frequencies_hz"], start=1):
-        print(f"  {index:>4}  {f:>20.12g}  {2 * 3.141592653589793 * f:>20.12g}")
+    if result.get("precision", "float64") != "float64":
+        print(f"  precision: {result['precision']}")
+    hz = result.get("frequencies_hz_text") or [f"{f:.12g}" for f in result["frequencies_hz"]]
+    rad_s = result.get("omega_rad_s_text") or [f"{2 * 3.141592653589793 * f:.12g}" for f in result["frequencies_hz"]]
+    width = max([20] + [len(text) for text in hz + rad_s])
+    print(f"  {'mode':>4}  {'f [Hz]':>{width}}  {'omega [rad/s]':>{width}}")
+    for index, (f, omega) in enumerate(zip(hz, rad_s), start=1):
+        print(f"  {index:>4}  {f:>{width}}  {omega:>{width}}")
     print(f"  solve time: {result['seconds'] * 1e3:.2f} ms")
     if result.get("note"):
         print(f"  note: {result['note']}")

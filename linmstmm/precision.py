@@ -72,25 +72,28 @@ def sparse_determinant(matrix: np.ndarray) -> mpmath.mpf:
     return det
 
 
-def refine_roots(deduction, model, omegas, digits: int) -> list:
+def refine_roots(deduction, model, omegas, digits: int, multiplicities=None) -> list:
     """The roots ``omegas`` (rad/s, ascending, repeated per multiplicity) to ``digits`` digits.
 
-    Returns mpf values, one per entry of ``omegas``. Raises RuntimeError for a
-    root the refinement does not settle on.
+    multiplicities : {root: multiplicity} where it differs from the number of
+    repeats in ``omegas`` (the highest root of a list cut at a count may be
+    double with one entry). Returns mpf values, one per entry of ``omegas``.
+    Raises RuntimeError for a root the refinement does not settle on.
     """
     refined = []
     i = 0
     while i < len(omegas):
-        m = 1
-        while i + m < len(omegas) and omegas[i + m] == omegas[i]:
-            m += 1
+        repeats = 1
+        while i + repeats < len(omegas) and omegas[i + repeats] == omegas[i]:
+            repeats += 1
+        m = (multiplicities or {}).get(omegas[i], repeats)
         dps = digits + GUARD_DIGITS + growth_digits(model, omegas[i])
         with mpmath.workdps(dps):
             start, tolerance = mpmath.mpf(omegas[i]), mpmath.mpf(10) ** -(digits + 2)
             root = (_secant(deduction, start, tolerance) if m == 1
                     else _multiple_newton(deduction, start, m, tolerance))
-            refined += [+root] * m
-        i += m
+            refined += [+root] * repeats
+        i += repeats
     return refined
 
 

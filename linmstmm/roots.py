@@ -735,15 +735,20 @@ class RootFinder:
         of read from its pencil offsets, which can show spurious near-zero ones or
         (a Newton stopped early) miss a double root's second one."""
         distinct = sorted(set(found))
-        recount = [r for r in distinct if r < upper]
-        if not recount:
-            return found
-        radii = [min([self.SPLIT * r] + [abs(r - other) / 2 for other in distinct if other != r])
-                 for r in recount]
-        counts = dict(zip(recount, count_zeros_many(
-            self.log_det, [(r - radius, r + radius) for r, radius in zip(recount, radii)], initial_points=17)))
-        return sorted(r for r in distinct for _ in range(
-            max(found.count(r) if isinstance(counts.get(r), (RuntimeError, type(None))) else counts[r], 1)))
+        counts = dict(zip(distinct, self.multiplicities([r for r in distinct if r < upper], distinct)))
+        return sorted(r for r in distinct for _ in range(counts.get(r) or found.count(r)))
+
+    def multiplicities(self, roots, others=()) -> list:
+        """How many roots sit at each of ``roots`` (rad/s, roots found), counted over a
+        circle of radius SPLIT·ω, less where a root of ``others`` is nearer (all
+        circles in one count; see :meth:`_multiplicities`); None where the count
+        cannot be made."""
+        if not len(roots):
+            return []
+        radii = [min([self.SPLIT * r] + [abs(r - other) / 2 for other in others if other != r]) for r in roots]
+        counts = count_zeros_many(self.log_det, [(r - radius, r + radius) for r, radius in zip(roots, radii)],
+                                  initial_points=17)
+        return [None if isinstance(c, RuntimeError) else max(c, 1) for c in counts]
 
     def _scanned(self, lo: float, hi: float, below) -> tuple:
         """(grid, sign, log|det|) of the fast scan over [lo, hi], led by the last two

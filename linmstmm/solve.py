@@ -34,8 +34,8 @@ class FrequencyResult:
     seconds : wall time of the solve (loading excluded).
     precision : "float64", or "mpmath:<digits>" when roots were refined in
     mpmath (all of them for ``digits`` > 15, else only those float64 could
-    not certify). frequencies_text : the frequencies as decimal strings at
-    that precision (mpmath only).
+    not certify). frequencies_text, omegas_text : the frequencies (Hz) and
+    circular frequencies (rad/s) as decimal strings at that precision (mpmath only).
     """
 
     model: str
@@ -47,6 +47,7 @@ class FrequencyResult:
     note: str = ""
     indeterminate_released: int = 0
     frequencies_text: list | None = None
+    omegas_text: list | None = None
 
     def to_dict(self) -> dict:
         """The ``linmstmm freqs --json`` object (``shared/spec/cli.md``)."""
@@ -61,6 +62,7 @@ class FrequencyResult:
             "indeterminate_released": int(self.indeterminate_released),
             **({"note": self.note} if self.note else {}),
             **({"frequencies_hz_text": self.frequencies_text} if self.frequencies_text else {}),
+            **({"omega_rad_s_text": self.omegas_text} if self.omegas_text else {}),
         }
 
 
@@ -102,15 +104,20 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         omegas = np.array(finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count))
     else:
         omegas = np.array(finder.find(count, omega_max))
-    precision, text = "float64", None
+    precision, text, omega_text = "float64", None, None
     uncertain = sorted({w for w in omegas if finder.last_step.get(w, 0.0) > CERTIFIED_STEP})
     wanted = digits if digits and digits > FLOAT64_DIGITS else (ESCALATION_DIGITS if uncertain else None)
     if wanted:
         chosen = omegas if digits and digits > FLOAT64_DIGITS else [w for w in omegas if w in uncertain]
-        refined = dict(zip(chosen, refine_roots(deduction, model, list(chosen), wanted)))
+        # The highest root may be one of several equal ones cut off by count.
+        top = max(chosen)
+        multiplicity = finder.multiplicities([top], sorted(set(omegas)))[0]
+        refined = dict(zip(chosen, refine_roots(deduction, model, list(chosen), wanted,
+                                                {top: multiplicity} if multiplicity else None)))
         with mpmath.workdps(wanted + 10):  # 2π and the division at the refined precision
             text = [mpmath.nstr(refined[w] / (2 * mpmath.pi), wanted) if w in refined
                     else repr(w / (2 * np.pi)) for w in omegas]
+            omega_text = [mpmath.nstr(refined[w], wanted) if w in refined else repr(float(w)) for w in omegas]
         omegas = np.array([float(refined.get(w, w)) for w in omegas])
         precision = f"mpmath:{wanted}" + ("" if len(chosen) == len(omegas) else f" ({len(set(chosen))} roots)")
     note = ""
@@ -118,4 +125,4 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         note = finder.note or f"only {omegas.size} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s"
     return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.full_order,
                            time.perf_counter() - start, precision=precision, note=note,
-                           indeterminate_released=released, frequencies_text=text)
+                           indeterminate_released=released, frequencies_text=text, omegas_text=omega_text)

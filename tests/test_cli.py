@@ -54,6 +54,18 @@ def test_freqs_table_is_readable():
     assert "cantilever with tip mass" in result.stdout and "6.7535" in result.stdout
 
 
+def test_freqs_table_shows_the_digits_asked_for():
+    """--digits 25, count cut inside a double root: the table prints what the JSON carries
+    (f and ω at 25 digits), and the cut root is refined as the double root it is."""
+    table = run("freqs", "models/cantilever_tip_mass.toml", "--count", "3", "--digits", "25")
+    data = json.loads(run("freqs", "models/cantilever_tip_mass.toml", "--count", "3", "--digits", "25",
+                          "--json").stdout)
+    assert table.returncode == 0, table.stderr
+    assert data["precision"] == "mpmath:25" and "precision: mpmath:25" in table.stdout
+    for f, omega in zip(data["frequencies_hz_text"], data["omega_rad_s_text"]):
+        assert len(f.replace(".", "")) == 25 and f"{f}  {omega}" in table.stdout
+
+
 @pytest.mark.parametrize("args", [("freqs", "models/cantilever_tip_mass.toml", "--count", "0"),
                                   ("freqs", "models/cantilever_tip_mass.toml", "--fmax", "-3"),
                                   ("freqs", "models/cantilever_tip_mass.toml", "--bogus"),

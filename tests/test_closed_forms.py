@@ -199,6 +199,19 @@ def test_thirty_digits_match_the_frequency_equation(Iy):
             assert got.frequencies_text[1] == got.frequencies_text[0]
 
 
+def test_digits_for_a_double_root_cut_by_the_count():
+    """count=3 of a round cantilever ends inside its second (double) bending root: that
+    root is still refined as double (as simple, the secant crawled and gave up)."""
+    model = single_beam_model(fixed(), None, Iz=2e-7, Iy=2e-7, axial=False, torsion=False)
+    beam = model.beams[0]
+    got = natural_frequencies(model, count=3, digits=25)
+    with mp.workdps(40):
+        lam = mp.findroot(lambda x: mp.cos(x) * mp.cosh(x) + 1, 4.694)
+        stiffness = mp.mpf(beam.E) * mp.mpf(beam.Iz) / (mp.mpf(beam.rho) * mp.mpf(beam.A) * mp.mpf(beam.length) ** 4)
+        want = lam**2 * mp.sqrt(stiffness) / (2 * mp.pi)
+        assert abs(mp.mpf(got.frequencies_text[2]) / want - 1) < mp.mpf(10) ** -23
+
+
 def test_sparse_determinant_matches_mpmath_det():
     """The mpmath path's LU on object arrays against mpmath.det, on a matrix with the
     zero pattern and mixed scales of Ū_all, and on an exactly singular one."""

@@ -114,4 +114,3 @@ def constant_times(constant: np.ndarray, stack: np.ndarray) -> np.ndarray:
             total = total + part if value == 1 else total - part if value == -1 else total + part * mpmath.mpf(value)
         out[:, row, :] = total
     return out
-

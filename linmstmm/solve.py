@@ -110,10 +110,10 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     if wanted:
         chosen = omegas if digits and digits > FLOAT64_DIGITS else [w for w in omegas if w in uncertain]
         # The highest root may be one of several equal ones cut off by count.
-        top = max(chosen)
-        multiplicity = finder.multiplicities([top], sorted(set(omegas)))[0]
+        top = [max(chosen)] if len(chosen) else []
+        cut = dict(zip(top, finder.multiplicities(top, sorted(set(omegas)))))
         refined = dict(zip(chosen, refine_roots(deduction, model, list(chosen), wanted,
-                                                {top: multiplicity} if multiplicity else None)))
+                                                {w: m for w, m in cut.items() if m})))
         with mpmath.workdps(wanted + 10):  # 2π and the division at the refined precision
             text = [mpmath.nstr(refined[w] / (2 * mpmath.pi), wanted) if w in refined
                     else repr(w / (2 * np.pi)) for w in omegas]

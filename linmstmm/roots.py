@@ -56,6 +56,11 @@ class RootFinder:
 
     log_det : callable omega (n,) -> (sign (n,), log|det| (n,)).
     matrix : callable omega (n,) -> Ū_all stack (n, N, N).
+    xtol : Newton's relative tolerance. points_per_octave : scan density; a
+    coarser scan is not faster: below about 16 it leaves roots that the
+    closing count then finds missing, and finding them costs more than the
+    scan saved (reports/speed_accuracy.md: MLRS 36 ms at 24, 0.3–0.5 s at 4
+    and 2). points_per_root : the segment search's scan density per counted root.
 
     Candidates come from the scan; each is polished by local linearisation
     (Newton for the nonlinear eigenproblem Ū(ω) v = 0): with A = Ū(ω) and

@@ -380,6 +380,19 @@ def family_summary(points) -> list[str]:
     return lines
 
 
+def asks_less(setting: str) -> bool:
+    """Whether a ``key=value, …`` RootFinder setting asks for less work than the defaults
+    somewhere (a coarser scan or a looser tolerance) and for more nowhere."""
+    defaults = root_finder_defaults()
+    less = more = False
+    for part in setting.split(", "):
+        key, value = part.split("=")
+        ratio = float(value) / defaults[key]
+        less |= ratio > 1 if key == "xtol" else ratio < 1
+        more |= ratio < 1 if key == "xtol" else ratio > 1
+    return less and not more
+
+
 def fastest(points, predicate):
     chosen = [p for p in points if predicate(p) and np.isfinite(p["seconds"]) and np.isfinite(p["error"])
               and p["error"] <= TARGET_ERROR]
@@ -813,6 +826,14 @@ def write_report(args, command, facts, loads, elapsed, beam_model, beam_referenc
                                 "times the tolerance asked for (and than the float64 default's error)")
             elif p["found"] < COUNT:
                 findings.append(f"{name}, `{p['setting']}`: returned only {p['found']} frequencies")
+        default = next(p["seconds"] for p in points if p["family"] == "natural_frequencies()")
+        for p in points:
+            if p["family"].startswith("MSTMM") and p["family"] != "MSTMM mpmath" and asks_less(p["setting"]) \
+                    and p["seconds"] > 2 * default:
+                findings.append(f"{name}, `{p['setting']}`: {p['seconds'] / default:.1f}× slower than the "
+                                "defaults although it asks for less work (a coarser scan leaves roots for "
+                                "the closing count to find missing, and its repairs cost more than the "
+                                "scan saved)")
     if beam_crosscheck > 1e-25:
         findings.append(f"`natural_frequencies(digits=30)` agrees with the closed form to {beam_crosscheck:.1e} "
                         "only: the mpmath path computes some model coefficients in float64 before converting "

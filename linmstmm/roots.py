@@ -110,6 +110,8 @@ class RootFinder:
         self._rigid: int | None = None
         #: starts of cluster members not yet polished (see :meth:`clusters`)
         self.deferred_members: list[float] = []
+        #: rad/s: a count found no root from OMEGA_FLOOR up to here (see :meth:`_scanned`)
+        self.root_free_below = OMEGA_FLOOR
 
     def divide_out_rigid_body_zeros(self, rigid: int) -> None:
         """Count and scan det Ū_all / ω^2r instead of det Ū_all.
@@ -536,9 +538,10 @@ class RootFinder:
         """(``found`` with the roots below ``upper`` that the closing count says are
         missing, the cap for the closing count that follows (rad/s)).
 
-        They are located by geometric bisection, down to eighths of an octave,
-        on counts of det with the ``found`` roots divided out (:func:`~linmstmm.counting.deflated`;
-        all intervals of one level in one batched count). With ``count``, an
+        They are located by geometric bisection from :attr:`root_free_below` up,
+        down to eighths of an octave, on counts of det with the ``found`` roots
+        divided out (:func:`~linmstmm.counting.deflated`; all intervals of one
+        level in one batched count). With ``count``, an
         interval with at least ``count`` roots (found or missing) below it is
         not split further: its roots are above the count-th, and the closing
         count is capped at its lower end. The intervals that
@@ -551,7 +554,8 @@ class RootFinder:
             missing = count_zeros(reduced, OMEGA_FLOOR, upper)
         except RuntimeError:
             return found, upper
-        pending, leaves, cap = [(OMEGA_FLOOR, upper, missing)] if missing else [], [], upper
+        floor = min(self.root_free_below, upper)  # the bisection starts above what a count found empty
+        pending, leaves, cap = [(floor, upper, missing)] if missing else [], [], upper
         while pending:
             kept, level_cap = self._below_count(leaves + pending, found, count, upper)
             cap = min(cap, level_cap)
@@ -621,7 +625,7 @@ class RootFinder:
         falls back.
         """
         found: list[float] = []
-        self.deferred_members = []
+        self.deferred_members, self.root_free_below = [], OMEGA_FLOOR
         brackets, minima = [], []  # (lo, hi, log|det(hi)| − log|det(lo)|) and grid points
         lo, hi = OMEGA_FLOOR, 8.0
         scans = [(np.zeros(0),) * 3]  # every chunk's (grid, sign, log|det|), kept for _rescanned
@@ -761,9 +765,11 @@ class RootFinder:
         quiet minimum at the edge between two chunks is seen (a double root of a
         round tube 1 % below a chunk's top was missed), and lo is not evaluated
         twice. The first chunk, 13 octaves from OMEGA_FLOOR that hold no root in
-        most models, is left out if a cheap count finds none there."""
+        most models, is left out if a cheap count finds none there (and
+        :attr:`root_free_below` says so)."""
         tail = tuple(part[-2:] for part in below)
         if lo == OMEGA_FLOOR and self._holds_no_roots(lo, hi):
+            self.root_free_below = hi
             return tail
         grid = self._quick_grid(lo, hi)
         grid = grid[1:] if tail[0].size and grid[0] == tail[0][-1] else grid

@@ -113,6 +113,22 @@ def test_cantilever_first_40_bending_modes_per_plane():
     np.testing.assert_allclose(got.frequencies_hz, want, rtol=1e-9)
 
 
+def test_40th_double_bending_root_to_20_digits():
+    """A round cantilever's first 40 double roots at digits=20 (βL up to ≈ 124: the
+    beam functions grow by 54 digits, covered by the mpmath path's guard digits),
+    against cos λ + 1/cosh λ = 0 solved at 60 digits."""
+    model = single_beam_model(fixed(), None, length=2.0, Iz=2e-7, Iy=2e-7, axial=False, torsion=False)
+    beam = model.beams[0]
+    got = natural_frequencies(model, count=80, digits=20)
+    with mp.workdps(60):
+        stiffness = mp.mpf(beam.E) * mp.mpf(beam.Iz) / (mp.mpf(beam.rho) * mp.mpf(beam.A) * mp.mpf(beam.length) ** 4)
+        starts = [1.875, 4.694] + [(2 * n - 1) * mp.pi / 2 for n in range(3, 41)]
+        want = [lam**2 * mp.sqrt(stiffness) / (2 * mp.pi)
+                for lam in (mp.findroot(lambda x: mp.cos(x) + 1 / mp.cosh(x), x0) for x0 in starts)
+                for _ in range(2)]
+        assert max(abs(mp.mpf(text) / f - 1) for text, f in zip(got.frequencies_text, want)) < mp.mpf(10) ** -19
+
+
 def test_a_missing_close_pair_is_recovered_by_deflated_counts():
     """Two bending planes (Iz : Iy = 1 : 1.6) give pairs of roots 1–2 % apart, inside
     one step of the scan (2.9 %). With the closed-form roots given as found, less two

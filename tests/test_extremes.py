@@ -166,16 +166,23 @@ def test_recovery_for_a_count_stops_above_the_count_th_root():
     assert finder._confirmed(recovered, k, cap=cap) == exact[:k]
 
 
-def test_a_root_sharing_a_scan_step_with_a_found_one_is_seen_in_the_stored_scan():
-    """The scan's own values, divided by the found roots, change sign at a missing
-    member of a close pair (no sign change of det across the step holding both)."""
+def scan_with_shared_steps():
+    """The two-plane cantilever's finder, exact roots, one fast-path scan (grid, sign,
+    log|det|) below its top, and the indices i whose roots i and i + 1 share a step
+    of that scan (det has no sign change there)."""
     model, exact, upper = two_plane_cantilever_roots()
     _, finder, _ = frequency_finder(model)
     grid = finder._quick_grid(0.5 * exact[0], upper)
-    scan = (grid, *finder.log_det(grid))
     shared = [i for i in range(len(exact) - 1)
               if np.searchsorted(grid, exact[i]) == np.searchsorted(grid, exact[i + 1])]
-    assert shared  # the scan cannot tell those pairs apart by sign
+    assert shared
+    return finder, exact, (grid, *finder.log_det(grid)), shared
+
+
+def test_a_root_sharing_a_scan_step_with_a_found_one_is_seen_in_the_stored_scan():
+    """The scan's own values, divided by the found roots, change sign at a missing
+    member of a close pair (no sign change of det across the step holding both)."""
+    finder, exact, scan, shared = scan_with_shared_steps()
     dropped = {i + 1 for i in shared}
     rescanned = finder._rescanned([w for i, w in enumerate(exact) if i not in dropped], [scan])
     np.testing.assert_allclose(rescanned, exact, rtol=1e-10)
@@ -185,13 +192,7 @@ def test_both_members_of_a_pair_in_one_scan_step_come_back_from_the_stored_scan(
     """With neither member found, the first pass over the stored scan finds one (a quiet
     minimum of the deflated det); the next pass, with that one divided out too, sees
     the other's sign change."""
-    model, exact, upper = two_plane_cantilever_roots()
-    _, finder, _ = frequency_finder(model)
-    grid = finder._quick_grid(0.5 * exact[0], upper)
-    scan = (grid, *finder.log_det(grid))
-    shared = [i for i in range(len(exact) - 1)
-              if np.searchsorted(grid, exact[i]) == np.searchsorted(grid, exact[i + 1])]
-    assert shared
+    finder, exact, scan, shared = scan_with_shared_steps()
     for i in shared:
         rescanned = finder._rescanned([w for j, w in enumerate(exact) if j not in (i, i + 1)], [scan])
         np.testing.assert_allclose(rescanned, exact, rtol=1e-10)

@@ -181,21 +181,26 @@ def test_a_misleading_guess_falls_back_to_the_full_search():
     np.testing.assert_allclose(warm.frequencies_hz, cold.frequencies_hz, rtol=1e-12)
 
 
+def cantilever_bending_hz(beam, start: float):
+    """Hz (mpf, working precision) of the fixed–free bending root of ``beam`` (z plane)
+    with cos λ cosh λ + 1 = 0 solved from λ ≈ ``start``."""
+    lam = mp.findroot(lambda x: mp.cos(x) * mp.cosh(x) + 1, start)
+    stiffness = mp.mpf(beam.E) * mp.mpf(beam.Iz) / (mp.mpf(beam.rho) * mp.mpf(beam.A) * mp.mpf(beam.length) ** 4)
+    return lam**2 * mp.sqrt(stiffness) / (2 * mp.pi)
+
+
 @pytest.mark.parametrize("Iy", [pytest.param(7e-7, id="simple root"),
                                 pytest.param(2e-7, id="double root (round section)")])
 def test_thirty_digits_match_the_frequency_equation(Iy):
     """--digits 30: the mpmath path against the cantilever equation solved at 40 digits
     (a double root is refined by its own iteration: Newton times the multiplicity)."""
     model = single_beam_model(fixed(), None, Iz=2e-7, Iy=Iy, axial=False, torsion=False)
-    beam = model.beams[0]
     got = natural_frequencies(model, count=2, digits=30)
     assert got.precision == "mpmath:30"
     with mp.workdps(40):
-        lam = mp.findroot(lambda x: mp.cos(x) * mp.cosh(x) + 1, 1.875)
-        stiffness = mp.mpf(beam.E) * mp.mpf(beam.Iz) / (mp.mpf(beam.rho) * mp.mpf(beam.A) * mp.mpf(beam.length) ** 4)
-        want = lam**2 * mp.sqrt(stiffness) / (2 * mp.pi)
+        want = cantilever_bending_hz(model.beams[0], 1.875)
         assert abs(mp.mpf(got.frequencies_text[0]) / want - 1) < mp.mpf(10) ** -28
-        if Iy == beam.Iz:
+        if Iy == model.beams[0].Iz:
             assert got.frequencies_text[1] == got.frequencies_text[0]
 
 
@@ -203,12 +208,9 @@ def test_digits_for_a_double_root_cut_by_the_count():
     """count=3 of a round cantilever ends inside its second (double) bending root: that
     root is still refined as double (as simple, the secant crawled and gave up)."""
     model = single_beam_model(fixed(), None, Iz=2e-7, Iy=2e-7, axial=False, torsion=False)
-    beam = model.beams[0]
     got = natural_frequencies(model, count=3, digits=25)
     with mp.workdps(40):
-        lam = mp.findroot(lambda x: mp.cos(x) * mp.cosh(x) + 1, 4.694)
-        stiffness = mp.mpf(beam.E) * mp.mpf(beam.Iz) / (mp.mpf(beam.rho) * mp.mpf(beam.A) * mp.mpf(beam.length) ** 4)
-        want = lam**2 * mp.sqrt(stiffness) / (2 * mp.pi)
+        want = cantilever_bending_hz(model.beams[0], 4.694)
         assert abs(mp.mpf(got.frequencies_text[2]) / want - 1) < mp.mpf(10) ** -23
 
 

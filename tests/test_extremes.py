@@ -92,13 +92,15 @@ def test_chain_of_2000_rigid_bodies_and_springs():
     np.testing.assert_allclose(got.frequencies_hz, np.repeat(omega / (2 * np.pi), 3), rtol=1e-9)
 
 
-def cantilever_bending_rad(beam, modes: int, dps: int = 40) -> list[list[float]]:
+def cantilever_bending_rad(beam, modes: int, dps: int = 40, exact: bool = False) -> list[list]:
     """The lowest ``modes`` bending frequencies (rad/s) of a fixed–free ``beam`` in its
-    z and y planes: cos λ + 1/cosh λ = 0 solved in mpmath at ``dps`` digits."""
+    z and y planes: cos λ + 1/cosh λ = 0 solved in mpmath at ``dps`` digits; floats,
+    or mpf values with ``exact``."""
     with mp.workdps(dps):
         starts = [1.875, 4.694] + [(2 * n - 1) * mp.pi / 2 for n in range(3, modes + 1)]
         lambdas = [mp.findroot(lambda x: mp.cos(x) + 1 / mp.cosh(x), x0) for x0 in starts]
-        return [[float(lam**2 * mp.sqrt(mp.mpf(beam.E) * mp.mpf(I) / (mp.mpf(beam.rho) * mp.mpf(beam.A)
+        value = (lambda x: +x) if exact else float
+        return [[value(lam**2 * mp.sqrt(mp.mpf(beam.E) * mp.mpf(I) / (mp.mpf(beam.rho) * mp.mpf(beam.A)
                                                                       * mp.mpf(beam.length) ** 4)))
                  for lam in lambdas] for I in (beam.Iz, beam.Iy)]
 
@@ -118,14 +120,10 @@ def test_40th_double_bending_root_to_20_digits():
     beam functions grow by 54 digits, covered by the mpmath path's guard digits),
     against cos λ + 1/cosh λ = 0 solved at 60 digits."""
     model = single_beam_model(fixed(), None, length=2.0, Iz=2e-7, Iy=2e-7, axial=False, torsion=False)
-    beam = model.beams[0]
     got = natural_frequencies(model, count=80, digits=20)
     with mp.workdps(60):
-        stiffness = mp.mpf(beam.E) * mp.mpf(beam.Iz) / (mp.mpf(beam.rho) * mp.mpf(beam.A) * mp.mpf(beam.length) ** 4)
-        starts = [1.875, 4.694] + [(2 * n - 1) * mp.pi / 2 for n in range(3, 41)]
-        want = [lam**2 * mp.sqrt(stiffness) / (2 * mp.pi)
-                for lam in (mp.findroot(lambda x: mp.cos(x) + 1 / mp.cosh(x), x0) for x0 in starts)
-                for _ in range(2)]
+        plane, _ = cantilever_bending_rad(model.beams[0], 40, dps=60, exact=True)
+        want = [omega / (2 * mp.pi) for omega in plane for _ in range(2)]
         assert max(abs(mp.mpf(text) / f - 1) for text, f in zip(got.frequencies_text, want)) < mp.mpf(10) ** -19
 
 

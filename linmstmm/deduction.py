@@ -32,9 +32,9 @@ from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.elements.frames import FORCE_INDEX
 from linmstmm.elements.rigid import force_extraction, position_incidence, rigid_transfer_parts
 from linmstmm.elements.spring import spring_transfer
-from linmstmm.periodic import carry_run, find_runs
 from linmstmm.numeric import (constant_times, frequencies, is_mp, numbers, power_of_two_scale, size_estimate,
                               zeros_like_stack)
+from linmstmm.periodic import carry_run, find_runs
 from linmstmm.topology import Topology
 
 #: Largest βL of one beam piece in the stable evaluation: the piece's own

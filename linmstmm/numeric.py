@@ -96,7 +96,7 @@ def zeros_like_stack(omega, shape) -> np.ndarray:
 
 
 def constant_times(constant: np.ndarray, stack: np.ndarray) -> np.ndarray:
-    """``constant @ stack`` for a float matrix (r, c) and a stack (n, c, k).
+    """``constant @ stack`` for a matrix (r, c), float or mpmath numbers, and a stack (n, c, k).
 
     For an mpmath (object) stack only the non-zero entries of ``constant``
     multiply, and ±1 without a product: most entries of a rigid body's,

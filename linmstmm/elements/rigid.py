@@ -63,13 +63,9 @@ def force_extraction(inp_k, out) -> np.ndarray:
     return extraction
 
 
-def position_extraction() -> np.ndarray:
-    """(6, 12) H_j: the displacement and rotation of a state vector."""
-    return np.eye(6, 12)
-
-
 def position_incidence(inp_1, inp_k) -> np.ndarray:
-    """(6, 12) H_{j,Ik} with ``H_j Z_I1 = H_{j,Ik} Z_Ik`` (rigid kinematics)."""
+    """(6, 12) H_{j,Ik} with ``H_j Z_I1 = H_{j,Ik} Z_Ik`` (rigid kinematics; H_j takes
+    rows 0:6, the displacement and rotation, as the deduction does directly)."""
     incidence = np.eye(6, 12, dtype=number_type(inp_1, inp_k))
     incidence[U, R] = skew(np.asarray(inp_k) - np.asarray(inp_1))
     return incidence

@@ -22,7 +22,7 @@ def spring_compliance(k, axes) -> tuple[np.ndarray, np.ndarray]:
     working precision). axes : (3, 3) rows = local axes.
     Returns (C_t, C_r), each (3, 3), m/N and rad/(N m).
     """
-    k = np.asarray(k) if number_type(k) is object else np.asarray(k, dtype=float)
+    k = np.asarray(k, dtype=number_type(k))
     axes = np.asarray(axes, dtype=float)
     compliance = 1.0 / k  # inf -> 0: rigid direction
     C_t = axes.T @ np.diag(compliance[:3]) @ axes

@@ -109,8 +109,8 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     wanted = digits if digits and digits > FLOAT64_DIGITS else (ESCALATION_DIGITS if uncertain else None)
     if wanted:
         chosen = omegas if digits and digits > FLOAT64_DIGITS else [w for w in omegas if w in uncertain]
-        # The highest root may be one of several equal ones cut off by count.
-        top = [max(chosen)] if len(chosen) else []
+        # The last root may be one of several equal ones cut off by count.
+        top = [omegas[-1]] if count is not None and len(chosen) and max(chosen) == omegas[-1] else []
         cut = dict(zip(top, finder.multiplicities(top, sorted(set(omegas)))))
         refined = dict(zip(chosen, refine_roots(deduction, model, list(chosen), wanted,
                                                 {w: m for w, m in cut.items() if m})))

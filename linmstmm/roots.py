@@ -38,6 +38,13 @@ from linmstmm.nullspace import equilibration, nullity
 #: Grid points per octave of the scans (the fast path's above 1 rad/s, an
 #: eighth of it below; every segment's).
 POINTS_PER_OCTAVE = 24
+#: Coarser scans are refused. They were never faster: a coarse scan leaves
+#: roots that the closing count finds missing, and the repairs cost more than
+#: the scan saved. Measured on this machine before they were refused: MLRS 10 modes
+#: 39 ms at 16, 52 ms at 12, 0.3–0.5 s at 4 and 2; the tip-mass cantilever
+#: 40 modes 78 ms at 24, 158 ms at 20, 172 ms at 16; a 1000-beam chain
+#: 3.3 s at 24, 6.6 s at 16; a 10,000-body spring chain 1.0–1.2 s at all.
+MIN_POINTS_PER_OCTAVE = POINTS_PER_OCTAVE
 #: Loosest Newton tolerance (relative) RootFinder accepts: roots are told apart
 #: down to SPLIT = 1e-4, so the polishing must be much tighter than that.
 MAX_XTOL = 1e-6
@@ -56,11 +63,10 @@ class RootFinder:
 
     log_det : callable omega (n,) -> (sign (n,), log|det| (n,)).
     matrix : callable omega (n,) -> Ū_all stack (n, N, N).
-    xtol : Newton's relative tolerance. points_per_octave : scan density; a
-    coarser scan is not faster: below about 16 it leaves roots that the
-    closing count then finds missing, and finding them costs more than the
-    scan saved (reports/speed_accuracy.md: MLRS 36 ms at 24, 0.3–0.5 s at 4
-    and 2). points_per_root : the segment search's scan density per counted root.
+    xtol : Newton's relative tolerance. points_per_octave : scan density, at
+    least POINTS_PER_OCTAVE (a denser scan leaves fewer close roots to the
+    repairs; a coarser one is refused, see MIN_POINTS_PER_OCTAVE).
+    points_per_root : the segment search's scan density per counted root.
 
     Candidates come from the scan; each is polished by local linearisation
     (Newton for the nonlinear eigenproblem Ū(ω) v = 0): with A = Ū(ω) and
@@ -98,6 +104,10 @@ class RootFinder:
         if not 0 < xtol <= MAX_XTOL:
             raise ValueError(f"xtol must be in (0, {MAX_XTOL:g}], got {xtol:g}: looser Newton "
                              "tolerances blur distinct roots into one")
+        if points_per_octave < MIN_POINTS_PER_OCTAVE:
+            raise ValueError(f"points_per_octave must be at least {MIN_POINTS_PER_OCTAVE}, got "
+                             f"{points_per_octave:g}: a coarser scan is slower, not faster (the roots "
+                             "it misses cost more to recover than it saves; reports/speed_accuracy.md)")
         self.log_det = log_det
         self.matrix = matrix
         self.xtol = xtol

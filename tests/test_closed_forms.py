@@ -173,6 +173,15 @@ def test_a_count_across_a_phase_jump_fails_fast():
     assert RootFinder(jumping, matrix=None)._no_other_zeros([], 10.0) is False
 
 
+@pytest.mark.parametrize("option, match", [(dict(xtol=1e-5), "xtol must be in"),
+                                           (dict(points_per_octave=16), "points_per_octave must be at least 24")])
+def test_settings_that_cost_more_than_they_save_are_refused(option, match):
+    """A looser xtol blurs distinct roots; a coarser scan is slower, not faster (the
+    measurements are in MIN_POINTS_PER_OCTAVE's comment): both are refused by name."""
+    with pytest.raises(ValueError, match=match):
+        frequency_finder(spring_mass_chain(), **option)
+
+
 def test_a_misleading_guess_falls_back_to_the_full_search():
     """A warm start that misses roots is caught by the root count."""
     model = spring_mass_chain()

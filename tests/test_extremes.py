@@ -197,10 +197,12 @@ def test_both_members_of_a_pair_in_one_scan_step_come_back_from_the_stored_scan(
 
 
 def test_a_coarse_scan_still_finds_every_root_in_the_fast_path(monkeypatch):
-    """points_per_octave=4 (a step of 19 %, holding both members of several pairs):
+    """A scan of 4 points per octave (a step of 19 %, holding both members of several
+    pairs; refused from users, set here to exercise the repairs on many roots at once):
     the fast path's repairs find every root, without the segment search."""
     model, exact, _ = two_plane_cantilever_roots()
-    _, finder, _ = frequency_finder(model, points_per_octave=4)
+    _, finder, _ = frequency_finder(model)
+    finder.points_per_octave = 4
     monkeypatch.setattr(finder, "_search", lambda *args: pytest.fail("fell back to the segment search"))
     np.testing.assert_allclose(finder.find(len(exact), None), exact, rtol=1e-10)
 

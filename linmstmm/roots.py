@@ -88,6 +88,10 @@ class RootFinder:
     SPLIT = 1e-4
     #: Offsets |μ|/ω below this are polished as members of the same cluster.
     CLUSTER_WINDOW = 2e-3
+    #: :meth:`_narrowed` evaluates this many − 1 equally spaced points per bracket and round.
+    NARROWING_SECTIONS = 8
+    #: The same for the fast path's deferred members (:attr:`deferred_members`).
+    DEFERRED_WINDOW = 6e-2
     #: Passes of :meth:`_rescanned` over the stored scan, each with the roots the last found.
     RESCANS = 3
     #: After a Newton step below this (relative), the next one is likely the last:
@@ -274,10 +278,12 @@ class RootFinder:
                 continue
             groups.append([centre] * multiplicity)
             real = mu[np.abs(mu.imag) <= 1e-6 * np.abs(mu)].real
-            near = real[(np.abs(real) < self.CLUSTER_WINDOW * centre) & (np.abs(real) >= self.SPLIT * centre)]
+            outside = np.abs(real) >= self.SPLIT * centre
             if confirm:
+                near = real[outside & (np.abs(real) < self.CLUSTER_WINDOW * centre)]
                 members_from += [(len(groups) - 1, centre - offset) for offset in near]
             else:  # polished only if the caller's closing count finds one missing
+                near = real[outside & (np.abs(real) < self.DEFERRED_WINDOW * centre)]
                 self.deferred_members += [centre - offset for offset in near]
         if members_from:
             returned = []  # members that came back to a root of their group: more evidence
@@ -338,11 +344,15 @@ class RootFinder:
     def _narrowed(self, lo, hi, width: float, log_det=None):
         """Sign-change brackets (lo_i, hi_i) narrowed to ``width``·hi, all at once: (lo, hi).
 
-        Regula falsi on det itself (the point where the line through ±|det| at
-        the ends crosses zero, from log|det| so nothing overflows), with the
-        Illinois rule: an end kept twice in a row has its |det| halved, so
-        both ends move and convergence is superlinear; a bracket that has kept
-        one end three times in a row is bisected until the other end moves.
+        Each round evaluates, for every bracket (a, b) at once, the regula falsi
+        point x (where the line through ±|det| at the ends crosses zero, from
+        log|det| so nothing overflows), x ± 1e-4 (b − a), x ± 1e-2 (b − a) and
+        NARROWING_SECTIONS − 1 equally spaced points; the bracket becomes the
+        narrowest sign change among them. Near a simple root x is off by
+        O((b − a)²), so a bracket shrinks up to 1e4-fold per round, and at least
+        NARROWING_SECTIONS-fold anywhere. A round costs one evaluation of det
+        whatever its size (MLRS: 1.1 ms, plus 0.07 ms a point): one point per
+        round (Illinois regula falsi) took ten rounds where this takes three.
         ``log_det``: of another function (default: det Ū_all's).
         """
         log_det = self.log_det if log_det is None else log_det
@@ -351,26 +361,33 @@ class RootFinder:
             return lo, hi
         sign, log_abs = log_det(np.r_[lo, hi])
         sign = np.real(sign)
-        sign_lo, log_lo, log_hi = sign[:lo.size], log_abs[:lo.size], log_abs[lo.size:]
-        kept = np.zeros(lo.size)  # +k: lo kept k times in a row, −k: hi
+        sign_lo, sign_hi, log_lo, log_hi = sign[:lo.size], sign[lo.size:], log_abs[:lo.size], log_abs[lo.size:]
         width = max(width, 4 * np.finfo(float).eps)
+        moving = np.ones(lo.size, dtype=bool)
+        sections = np.arange(1, self.NARROWING_SECTIONS) / self.NARROWING_SECTIONS
         while True:
-            active = np.flatnonzero(hi - lo > width * hi)
+            active = np.flatnonzero(moving & (hi - lo > width * hi))
             if active.size == 0:
                 return lo, hi
             a, b = lo[active], hi[active]
+            w = (b - a)[:, None]
             fraction = 1 / (1 + np.exp(np.clip(log_hi[active] - log_lo[active], -700, 700)))
-            fraction = np.where(np.abs(kept[active]) >= 3, 0.5, fraction)
-            x = np.clip(a + (b - a) * fraction, a + (b - a) * 1e-3, b - (b - a) * 1e-3)
-            sign_x, log_x = log_det(x)
-            sign_x = np.real(sign_x)
-            left = sign_x * sign_lo[active] < 0  # the root is in (lo, x]: hi moves, lo is kept
-            kept[active] = np.where(left, np.maximum(kept[active], 0) + 1, np.minimum(kept[active], 0) - 1)
-            halve = np.log(2.0) * (np.abs(kept[active]) >= 2)
-            hi[active], lo[active] = np.where(left, x, b), np.where(left, a, x)
-            log_hi[active] = np.where(left, log_x, log_hi[active] - halve)
-            log_lo[active] = np.where(left, log_lo[active] - halve, log_x)
-            sign_lo[active] = np.where(left, sign_lo[active], sign_x)
+            x = (a + (b - a) * fraction)[:, None]
+            inside = np.sort(np.clip(np.concatenate([x + w * [-1e-2, -1e-4, 0.0, 1e-4, 1e-2],
+                                                     a[:, None] + w * sections], axis=1),
+                                     a[:, None] + 1e-6 * w, b[:, None] - 1e-6 * w), axis=1)
+            sign_x, log_x = log_det(inside.ravel())
+            points = np.concatenate([a[:, None], inside, b[:, None]], axis=1)
+            signs = np.concatenate([sign_lo[active, None], np.real(sign_x).reshape(inside.shape),
+                                    sign_hi[active, None]], axis=1)
+            logs = np.concatenate([log_lo[active, None], log_x.reshape(inside.shape), log_hi[active, None]], axis=1)
+            steps = np.where(signs[:, :-1] * signs[:, 1:] < 0, np.diff(points, axis=1), np.inf)
+            k = np.argmin(steps, axis=1)
+            rows = np.arange(active.size)
+            lo[active], hi[active] = points[rows, k], points[rows, k + 1]
+            sign_lo[active], sign_hi[active] = signs[rows, k], signs[rows, k + 1]
+            log_lo[active], log_hi[active] = logs[rows, k], logs[rows, k + 1]
+            moving[active] = (lo[active] != a) | (hi[active] != b)  # rounding left no point inside
 
     def _bracketed(self, lo, hi, log_ratio, confirm: bool = True) -> list[list[float]]:
         """The cluster of the root in each sign-change bracket (lo_i, hi_i].
@@ -531,7 +548,7 @@ class RootFinder:
             return None
         upper = min(upper, cap)
         below = [r for r in found if r < upper]
-        return below[:count] if self._no_other_zeros(below, upper) else None
+        return below[:count] if self._no_other_zeros(found, upper) else None
 
     def _count_top(self, found: list[float], count: int | None, omega_max: float | None):
         """Top of the closing count: omega_max, or midway between the count-th root
@@ -602,9 +619,12 @@ class RootFinder:
         The count runs on det with the known roots divided out (:func:`~linmstmm.counting.deflated`),
         so its phase turns only for zeros not in ``known`` (or by −π for a
         ``known`` one that is not a zero) and DEFLATED_POINTS starting points
-        suffice where counting them all took 65 and a refinement round. False
-        also where it cannot count: the segment search then decides (and says so
-        if it cannot either).
+        suffice where counting them all took 65 and a refinement round. Known
+        roots above ``upper`` are divided out too: outside the contour they
+        change nothing, and the next root just above ``upper`` no longer turns
+        the phase fast near the contour's end (MLRS 20 modes: three refinement
+        rounds fewer). False also where it cannot count: the segment search then
+        decides (and says so if it cannot either).
         """
         try:
             return count_zeros(deflated(self.log_det, known), OMEGA_FLOOR, upper,
@@ -692,8 +712,8 @@ class RootFinder:
             return self._count_top(roots, count, omega_max) or np.inf
 
         confirmed = self._confirmed(found, count, omega_max)
-        for repair in (lambda roots: self._rescanned(self._polished(self.deferred_members, roots, confirm=False),
-                                                     scans, top(roots)),
+        for repair in (lambda roots: self._rescanned(self._polished(self._member_starts(roots, top(roots)), roots,
+                                                                    confirm=False), scans, top(roots)),
                        lambda roots: self._recounted(roots, top(roots))):
             if confirmed is not None:
                 break
@@ -706,6 +726,15 @@ class RootFinder:
             recovered, cap = self._recovered(found, upper, count)
             confirmed = self._confirmed(recovered, count, omega_max, cap)
         return confirmed
+
+    def _member_starts(self, found: list[float], upper: float) -> list[float]:
+        """The :attr:`deferred_members` worth polishing: below ``upper``, not within SPLIT
+        of a root ``found`` (Newton would return to it) nor of a lower start (the same)."""
+        starts: list[float] = []
+        for start in sorted(self.deferred_members):
+            if start < upper and all(abs(start - r) > self.SPLIT * r for r in found + starts[-1:]):
+                starts.append(start)
+        return starts
 
     def _rescanned(self, found: list[float], scans, upper: float = np.inf) -> list[float]:
         """``found`` with the roots below ``upper`` that the fast scan's values (``scans``:

@@ -92,6 +92,9 @@ class RootFinder:
     NARROWING_SECTIONS = 8
     #: The same for the fast path's deferred members (:attr:`deferred_members`).
     DEFERRED_WINDOW = 6e-2
+    #: A deferred member this close to another root found or start, relative to its
+    #: offset from the root that gave it, is that root again (linearisation error).
+    MEMBER_OVERLAP = 0.25
     #: Passes of :meth:`_rescanned` over the stored scan, each with the roots the last found.
     RESCANS = 3
     #: After a Newton step below this (relative), the next one is likely the last:
@@ -123,7 +126,7 @@ class RootFinder:
         self.note = ""
         self._rigid: int | None = None
         #: starts of cluster members not yet polished (see :meth:`clusters`)
-        self.deferred_members: list[float] = []
+        self.deferred_members: list[tuple[float, float]] = []  # (start, the root whose pencil gave it)
         #: rad/s: a count found no root from OMEGA_FLOOR up to here (see :meth:`_scanned`)
         self.root_free_below = OMEGA_FLOOR
 
@@ -284,7 +287,7 @@ class RootFinder:
                 members_from += [(len(groups) - 1, centre - offset) for offset in near]
             else:  # polished only if the caller's closing count finds one missing
                 near = real[outside & (np.abs(real) < self.DEFERRED_WINDOW * centre)]
-                self.deferred_members += [centre - offset for offset in near]
+                self.deferred_members += [(centre - offset, centre) for offset in near]
         if members_from:
             returned = []  # members that came back to a root of their group: more evidence
             for (g, _), result in zip(members_from, self.polish([s for _, s in members_from])):
@@ -669,9 +672,13 @@ class RootFinder:
             waiting = len(brackets) + len(minima)
             brackets += zip(grid[change], grid[change + 1], log_abs[change + 1] - log_abs[change])
             minima += list(grid[_quiet_minima(sign, log_abs)])
-            # A chunk with no new candidate after some: polish those, their multiplicities
-            # may make up the count (a chain's triple roots are one sign change each).
-            stalled = omega_max is None and 0 < waiting == len(brackets) + len(minima)
+            # A chunk with few new candidates (a quarter of those seen, or none) after some:
+            # polish those; their multiplicities (a chain's triple roots are one sign change
+            # each) and the close pairs their pencils point at (no sign change where both
+            # share a scan step) may make up the count, where scanning on for more would
+            # polish roots far above it (MLRS 40 modes: up to 240 Hz for a 43.5 Hz count).
+            new = len(brackets) + len(minima) - waiting
+            stalled = omega_max is None and waiting > 0 and new <= (len(found) + waiting) / 4
             if (omega_max is not None and hi >= omega_max or stalled
                     or omega_max is None and len(found) + len(brackets) + len(minima) >= count):
                 if count is not None:  # only the lowest candidates matter
@@ -684,6 +691,8 @@ class RootFinder:
                         self._merge(found, members, OMEGA_FLOOR, np.inf)
                     found.sort()
                 brackets, minima = [], []
+                if count is not None and found and len(found) < count:  # pairs hidden in one scan step?
+                    found = self._with_members(found, found[-1])
                 if omega_max is not None or len(found) >= count:
                     return self._closed(found, count, omega_max, scans)
             # fewer roots than count? (sign changes only: a shallow quiet minimum far
@@ -697,14 +706,15 @@ class RootFinder:
         """``found`` as the closing count confirms it (:meth:`_confirmed`), after the
         repairs it takes, each followed by that count again; None if none is enough.
 
-        1. The deferred cluster members polished (:meth:`clusters`: a close pair's
-           other member), then the roots the scan's own values show once
-           ``found`` is divided out (:meth:`_rescanned`; no new scan): two roots
-           in one grid step, one of them found.
-        2. Every multiplicity recounted (:meth:`_recounted`): a misread one.
-        3. The roots still missing, located by deflated counts (:meth:`_recovered`).
+        1. The deferred cluster members polished (:meth:`_with_members`: a close
+           pair's other member, which the pencil at the found one points at).
+        2. The roots the scan's own values show once ``found`` is divided out
+           (:meth:`_rescanned`; no new scan): two roots in one grid step, one of
+           them found.
+        3. Every multiplicity recounted (:meth:`_recounted`): a misread one.
+        4. The roots still missing, located by deflated counts (:meth:`_recovered`).
 
-        The first two look only below the closing count's top (the scan may have
+        The first three look only below the closing count's top (the scan may have
         gone far past the count-th root: a 40-mode beam's recount of all it saw
         cost 1000 contour points).
         """
@@ -712,8 +722,8 @@ class RootFinder:
             return self._count_top(roots, count, omega_max) or np.inf
 
         confirmed = self._confirmed(found, count, omega_max)
-        for repair in (lambda roots: self._rescanned(self._polished(self._member_starts(roots, top(roots)), roots,
-                                                                    confirm=False), scans, top(roots)),
+        for repair in (lambda roots: self._with_members(roots, top(roots)),
+                       lambda roots: self._rescanned(roots, scans, top(roots)),
                        lambda roots: self._recounted(roots, top(roots))):
             if confirmed is not None:
                 break
@@ -727,14 +737,18 @@ class RootFinder:
             confirmed = self._confirmed(recovered, count, omega_max, cap)
         return confirmed
 
-    def _member_starts(self, found: list[float], upper: float) -> list[float]:
-        """The :attr:`deferred_members` worth polishing: below ``upper``, not within SPLIT
-        of a root ``found`` (Newton would return to it) nor of a lower start (the same)."""
+    def _with_members(self, found: list[float], upper: float) -> list[float]:
+        """``found`` with the roots Newton reaches from the :attr:`deferred_members` below
+        ``upper``, which leave the list: not those within SPLIT of a root found (Newton
+        would return to it) or of a lower start (the same root)."""
         starts: list[float] = []
-        for start in sorted(self.deferred_members):
-            if start < upper and all(abs(start - r) > self.SPLIT * r for r in found + starts[-1:]):
+        for start, origin in sorted(self.deferred_members):
+            near = self.MEMBER_OVERLAP * abs(start - origin)
+            if start < upper and all(abs(start - r) > max(self.SPLIT * r, near * (r != origin))
+                                     for r in found + starts[-1:]):
                 starts.append(start)
-        return starts
+        self.deferred_members = [member for member in self.deferred_members if member[0] >= upper]
+        return self._polished(starts, found, confirm=False) if starts else found
 
     def _rescanned(self, found: list[float], scans, upper: float = np.inf) -> list[float]:
         """``found`` with the roots below ``upper`` that the fast scan's values (``scans``:

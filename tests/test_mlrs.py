@@ -126,6 +126,19 @@ def test_agrees_with_finite_elements(model, mstmm):
     np.testing.assert_allclose(mstmm.frequencies_hz, reference, rtol=1e-7)
 
 
+def test_thirty_modes_with_their_close_pairs_from_the_cheap_repairs(model, monkeypatch):
+    """The launcher's left/right pairs (19.40/19.46, 21.86/21.88, 26.87/26.89 Hz: 0.08-0.3 %
+    apart) share a scan step with no sign change between them. The pencil at a found
+    neighbour points at them (the deferred members), so the fast path closes without
+    the deflated-count recovery, and agrees with the FE route."""
+    from linmstmm.fe import fe_frequencies
+    from linmstmm.roots import RootFinder
+
+    monkeypatch.setattr(RootFinder, "_recovered", lambda *args: pytest.fail("needed the deflated-count recovery"))
+    found = natural_frequencies(model, count=30).frequencies_hz
+    np.testing.assert_allclose(found, fe_frequencies(model, count=30).frequencies_hz, rtol=1e-7)
+
+
 def test_sweep_over_a_salvo(model, mstmm):
     """Scene 1 is the model file (whose cradle is rounded to 7 digits); by tube 18,
     17 rockets are gone and every mode is higher."""

@@ -156,11 +156,13 @@ class Deduction:
     def _combined(self, key, terms):
         """Sum of the (n, rows, k_i) products of (columns_i, product_i) ``terms`` on the
         union of their columns: (columns, (n, rows, k)). Which columns meet where is
-        fixed by the topology, so the union and each term's place in it are found
-        once per ``key``: (element,) for its output, (element, k) for the geometric
-        row of its input k + 2."""
+        fixed by the topology and by which orthonormalisations widened the inputs'
+        columns (:meth:`_Orthonormaliser.apply`), so the union and each term's place
+        in it are found once per ``key`` and input columns: ``key`` is (element,)
+        for its output, (element, k) for the geometric row of its input k + 2."""
         if len(terms) == 1:  # one input (most elements): no union to form
             return terms[0]
+        key = (key,) + tuple(c.tobytes() for c, _ in terms)  # a wider orthonormalisation widens them
         if key not in self._layouts:
             columns = np.unique(np.concatenate([c for c, _ in terms]))
             self._layouts[key] = columns, [_index(np.searchsorted(columns, c)) for c, _ in terms]
@@ -235,7 +237,7 @@ class Deduction:
         open_states: dict[int, PortState] = {}
         given = self.root_given(n)
         rows = [["root", given.columns, -given.matrix]]
-        normaliser = _Orthonormaliser(omega, self._shared_columns(), len(self.topology.cuts)) if stable else None
+        normaliser = _Orthonormaliser(omega) if stable else None
         order = self.topology.order
         runs = {run.start: run for run in self.periodic_runs()} if stable else {}
         position = 0
@@ -245,9 +247,12 @@ class Deduction:
             inputs = []
             for p in element.inputs:
                 link = element.ports[p].link
-                inputs.append(open_states.pop(link[1]) if link[0] == "element" else self.tip_state(link, n))
-                if stable and link[0] == "cut":
-                    normaliser.consume_cut_side(link[1], self._cut_columns[link[1]])
+                if link[0] == "element":
+                    inputs.append(open_states.pop(link[1]))
+                elif stable and link[0] == "cut" and not self.topology.cuts[link[1]].closing:
+                    inputs.append(normaliser.enter_cut_side(link, lambda side: self.tip_state(side, n)))
+                else:
+                    inputs.append(self.tip_state(link, n))
             run = runs.get(position)
             powered = None if run is None else self._carry_run(run, omega, inputs[0], normaliser, rows, open_states)
             if powered is not None:
@@ -284,7 +289,8 @@ class Deduction:
         orthonormalised after each product), or None if the cell is too
         ill-conditioned to power."""
         matrix = carry_run(self._cell_matrix(run, omega), run.repetitions, state.matrix,
-                           lambda m: normaliser.apply(PortState(state.columns, m), rows, open_states).matrix)
+                           lambda m: normaliser.apply(PortState(state.columns, m), rows, open_states,
+                                                      keep_columns=True).matrix)
         return None if matrix is None else PortState(state.columns, matrix)
 
     def _cell_matrix(self, run, omega) -> np.ndarray:
@@ -304,12 +310,6 @@ class Deduction:
             state = PortState(state.columns, piece @ state.matrix, state.reference)
             state = normaliser.apply(state, rows, open_states)
         return state
-
-    def _shared_columns(self) -> set:
-        """Columns not orthonormalised at the start: every open cut's (until both sides
-        are in). A closing cut's columns are carried by one state only."""
-        return {int(c) for index, cut in enumerate(self.topology.cuts) if not cut.closing
-                for c in self._cut_columns[index]}
 
     def root_state(self, outputs) -> PortState:
         """The computed state at the root (output of the last element)."""
@@ -373,13 +373,18 @@ def _largest(references):
 class _Orthonormaliser:
     """Godunov orthonormalisation of the unknowns carried by one port state.
 
-    The columns S of a state that no other open state shares (nor a cut side
-    still to come, nor the root row) are replaced by
-    an orthonormal basis of [rows on S; state on S] (QR with a positive real
-    diagonal, so the basis is smooth in ω): z̄_S = R⁻¹ w_S. The geometric rows
-    already formed on S are rewritten in the new unknowns, det R is
-    accumulated, and growing beam solutions can no longer swamp the
-    decaying ones. Only float and complex stacks are handled.
+    The columns S of a state are replaced by an orthonormal basis of
+    everything formed on them: the state itself and every other block that
+    holds one of its columns (the rows already formed, the other open
+    states, a cut side still waiting to enter), widened to the union of
+    their columns until no block outside shares one. QR with a positive
+    real diagonal (so the basis is smooth in ω): z̄_S = R⁻¹ w_S; every block
+    is rewritten in the new unknowns, det R is accumulated, and growing beam
+    solutions can no longer swamp the decaying ones. A loop's cut columns
+    are carried along both arcs of the loop and are orthonormalised like any
+    other (the launcher's tube between its supports grew by 1e16 at
+    8000 rad/s while they were left alone, and det lost 7 digits). Only
+    float and complex stacks are handled.
     """
 
     #: Orthonormalise once a state has grown (or shrunk) by this factor since the last time.
@@ -388,17 +393,21 @@ class _Orthonormaliser:
     #: power of two (a chain of 300 cells above its cutoff grows ×400 per cell).
     FAR = 1e100
 
-    def __init__(self, omega, shared_columns, n_cuts: int):
-        self.shared = shared_columns
+    def __init__(self, omega):
         self.log_scale = np.zeros(omega.size)
-        self._sides_in = [0] * n_cuts
+        #: (cut, side) -> PortState of a cut side whose other side entered first
+        self.waiting: dict[tuple, PortState] = {}
 
-    def consume_cut_side(self, c, columns) -> None:
-        """A side of cut c entered the carry; with both in, its columns belong to one
-        state and may be orthonormalised."""
-        self._sides_in[c] += 1
-        if self._sides_in[c] == 2:
-            self.shared -= {int(k) for k in columns}
+    def enter_cut_side(self, link, tip) -> PortState:
+        """The state of cut side ``link`` = ("cut", c, side) as it enters the carry:
+        its tip state (``tip(link)``), and the other side then waits, a block of
+        every orthonormalisation on the cut's columns; or, if it was the one
+        waiting, its tip state as those left it."""
+        _, c, side = link
+        if (c, side) in self.waiting:
+            return self.waiting.pop((c, side))
+        self.waiting[c, 1 - side] = tip(("cut", c, 1 - side))
+        return tip(link)
 
     @staticmethod
     def _unit_scale(stacked, kinds) -> np.ndarray:
@@ -421,28 +430,46 @@ class _Orthonormaliser:
         size = np.where(size > 0, size, size.max(axis=1, keepdims=True))
         return 1 / (size[:, kinds] * peak[:, :, 0])
 
-    def apply(self, state: PortState, rows, open_states) -> PortState:
-        """The state on orthonormalised columns (or unchanged if they are shared).
+    def _sharing(self, state: PortState, rows, open_states):
+        """(columns, blocks): the union of ``state``'s columns and those of every block
+        that holds one of them, closed (no block outside holds one); blocks are
+        (kind, key, columns, matrix) with kind "row" (key: the row), "state" (key in
+        ``open_states``) or "waiting" (key in :attr:`waiting`)."""
+        others = ([("row", row, row[1], row[2]) for row in rows]
+                  + [("state", key, other.columns, other.matrix) for key, other in open_states.items()]
+                  + [("waiting", key, tip.columns, tip.matrix) for key, tip in self.waiting.items()])
+        held = [set(int(c) for c in block[2]) for block in others]
+        columns, chosen = set(int(c) for c in state.columns), set()
+        while True:
+            more = {i for i, cs in enumerate(held) if i not in chosen and cs & columns}
+            if not more:
+                return np.array(sorted(columns), dtype=int), [others[i] for i in sorted(chosen)]
+            chosen |= more
+            for i in more:
+                columns |= held[i]
+
+    def apply(self, state: PortState, rows, open_states, keep_columns: bool = False) -> PortState:
+        """The state on orthonormalised columns, every block sharing them rewritten
+        (``rows`` and ``open_states`` in place); unchanged if it has not grown, or if
+        there are fewer rows than columns to orthonormalise.
 
         open_states : the other states not yet consumed downstream.
+        keep_columns : only where no block widens the columns (a periodic run's
+        powers need the state's own columns).
         """
         if state.reference is not None:
             growth = size_estimate(state.matrix).max(axis=(1, 2)) / state.reference
             if growth.max() < self.GROWTH and growth.min() > 1 / self.GROWTH:
                 return state
-        columns = set(int(c) for c in state.columns)
-        if columns & self.shared or any(columns & set(int(c) for c in other.columns)
-                                        for other in open_states.values()):
+        columns, blocks = self._sharing(state, rows, open_states)
+        if keep_columns and columns.size != state.columns.size:
             return state
-        touching = [row for row in rows if columns & set(int(c) for c in row[1])]
-        if any(not set(int(c) for c in row[1]) <= columns for row in touching):
-            return state
-        blocks = [_embed(row[1], row[2], state.columns) for row in touching]
-        stacked = np.concatenate(blocks + [state.matrix], axis=1)
+        parts = [_embed(block_columns, matrix, columns) for _, _, block_columns, matrix in blocks]
+        parts.append(_embed(state.columns, state.matrix, columns))
+        stacked = np.concatenate(parts, axis=1)
         if stacked.shape[1] < stacked.shape[2]:
             return state
-        row_scale = self._unit_scale(stacked, np.concatenate(
-            [np.arange(block.shape[1]) // 3 for block in blocks + [state.matrix]]))
+        row_scale = self._unit_scale(stacked, np.concatenate([np.arange(part.shape[1]) // 3 for part in parts]))
         q, r = np.linalg.qr(stacked * row_scale[:, :, None])
         diagonal = np.diagonal(r, axis1=1, axis2=2)
         if not np.all(np.abs(diagonal) > 0):  # dependent columns (exactly at a root): keep as is
@@ -458,11 +485,17 @@ class _Orthonormaliser:
             q = q * common[:, None, None]
             self.log_scale -= np.log(common) * q.shape[2]
         offset = 0
-        for row in touching:
-            row[1], row[2] = state.columns, q[:, offset:offset + row[2].shape[1]]
-            offset += row[2].shape[1]
+        for kind, key, _, matrix in blocks:
+            part = q[:, offset:offset + matrix.shape[1]]
+            offset += matrix.shape[1]
+            if kind == "row":
+                key[1], key[2] = columns, part
+            elif kind == "state":
+                open_states[key] = PortState(columns, part, size_estimate(part).max(axis=(1, 2)))
+            else:
+                self.waiting[key] = PortState(columns, part, size_estimate(part).max(axis=(1, 2)))
         q = q[:, offset:]
-        return PortState(state.columns, q, size_estimate(q).max(axis=(1, 2)))
+        return PortState(columns, q, size_estimate(q).max(axis=(1, 2)))
 
 
 def balanced_slogdet(stack):

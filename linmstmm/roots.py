@@ -476,9 +476,12 @@ class RootFinder:
             raise RuntimeError(f"cannot separate the {expected} roots in ({lo:.12g}, {hi:.12g}) "
                                f"rad/s in float64 (found {len(inside)}): ask for more digits")
         found = list(found)
-        sign_lo, sign_hi = self.log_det(np.array([lo, hi]))[0]
-        start = self.shrink_brackets([lo], [hi])[0] if sign_lo * sign_hi < 0 else (lo + hi) / 2
-        self._merge(found, self.cluster(start), lo, hi)
+        (sign_lo, sign_hi), (log_lo, log_hi) = self.log_det(np.array([lo, hi]))
+        if sign_lo * sign_hi < 0:  # with the bracket's own fallback where Newton cannot reach its root
+            for members in self._bracketed(np.array([lo]), np.array([hi]), np.array([log_hi - log_lo])):
+                self._merge(found, members, lo, hi)
+        else:
+            self._merge(found, self.cluster((lo + hi) / 2), lo, hi)
         inside = sorted(r for r in found if lo < r <= hi)
         if len(inside) == expected:
             return inside

@@ -139,6 +139,39 @@ def test_thirty_modes_with_their_close_pairs_from_the_cheap_repairs(model, monke
     np.testing.assert_allclose(found, fe_frequencies(model, count=30).frequencies_hz, rtol=1e-7)
 
 
+@pytest.mark.parametrize("omega", [3000.0, 8000.0])
+def test_det_stays_accurate_where_the_tube_between_its_supports_grows(model, omega):
+    """The loop cradle - supports - tube is cut at the tube's front support, so the
+    cut's unknowns ride along the tube until both arcs meet at the cradle. They are
+    orthonormalised with every block that holds them: det Ū_all agrees with the
+    mpmath determinant at 40 digits to 1e-10 (left alone they grew 1e16 and det was
+    off by 2e-7 at 8000 rad/s)."""
+    import mpmath
+
+    from linmstmm.precision import mp_determinant
+
+    deduction = Deduction(build_topology(model))
+    _, log_abs = deduction.log_det(np.array([omega]))
+    with mpmath.workdps(40):
+        reference = float(mpmath.log(abs(mp_determinant(deduction, mpmath.mpf(omega)))))
+    assert abs(log_abs[0] - reference) < 1e-10
+
+
+def test_a_root_newton_cannot_reach_is_isolated_from_its_sign_change(model):
+    """682.27 Hz, 0.25 % below its pair: the orthonormalised Ū_all is not smooth enough
+    there for Newton on its pencil, so the count bisection (RootFinder._isolate) takes
+    it from the sign change by regula falsi on det (it raised "cannot count" before);
+    it agrees with the FE route."""
+    from linmstmm.fe import fe_frequencies
+    from linmstmm.solve import frequency_finder
+
+    _, finder, _ = frequency_finder(model)
+    reference = fe_frequencies(model, count=76).frequencies_hz
+    target = 2 * np.pi * reference[np.argmin(np.abs(reference - 682.27))]
+    found = finder._isolate(target * (1 - 1e-4), target * (1 + 1e-4), 1, [])
+    np.testing.assert_allclose(found, [target], rtol=1e-9)
+
+
 def test_sweep_over_a_salvo(model, mstmm):
     """Scene 1 is the model file (whose cradle is rounded to 7 digits); by tube 18,
     17 rockets are gone and every mode is higher."""

@@ -202,7 +202,8 @@ class RootFinder:
         Newton for the nonlinear eigenproblem: ω ← ω − μ with μ the offset
         of smallest size. Stops at |μ| <= xtol·ω, or when the steps stop
         shrinking below UNCERTAIN·ω (the rounding floor of Ū_all); gives up
-        on a start whose step twice fails to shrink above that (not near a root).
+        on a start whose step twice fails to shrink above that, or is twice
+        mostly imaginary and above SPLIT·ω (not near a real root).
         ``early``: also stop a round sooner where convergence to a simple root
         is quadratic (:meth:`_quadratic`), for a caller that counts all its
         roots at the end (a double root whose second offset shows only within
@@ -236,7 +237,10 @@ class RootFinder:
                     self.last_step[omega[i]] = step / omega[i]
                     results[i] = (omega[i], mu - mu[0].real)  # offsets seen from the new ω
                 else:
-                    setbacks[i] += step >= previous[i]
+                    # A mostly imaginary nearest offset sees no real root at its distance:
+                    # ω creeps by its real part (MLRS above 170 Hz: 40 rounds, 1e-8 each).
+                    sideways = abs(mu[0].imag) > abs(mu[0].real) and step > self.SPLIT * omega[i]
+                    setbacks[i] += (step >= previous[i]) + sideways
                     previous[i] = step
                     if setbacks[i] < 2:  # Newton that twice fails to shrink its step is lost
                         still.append(i)

@@ -654,11 +654,12 @@ class RootFinder:
         without a new candidate; all are polished at once (more chunks if their
         multiplicities leave fewer than ``count`` roots) and one count from
         OMEGA_FLOOR must agree. Multiplicities are
-        read from the pencil offsets without a count each: a wrong one changes
-        the total, which that count sees (unless an opposite error elsewhere
-        cancels it). If the count finds more, the repairs of :meth:`_closed`
-        follow (the stored scan with the found roots divided out, the deferred
-        cluster members and recounted multiplicities, deflated counts), each
+        read from the pencil offsets; those above one are counted over a circle
+        first (a spurious one would cancel a missing root in that count), and a
+        simple one misread changes the total, which that count sees. If the count
+        finds more, the repairs of :meth:`_closed` follow (the deferred cluster
+        members, the stored scan with the found roots divided out, deflated
+        counts, recounted multiplicities), each
         followed by the closing count again. Far fewer
         evaluations than the segment search when it works; when it does not
         (a root between two candidates, a chain of clusters), :meth:`find`
@@ -713,13 +714,21 @@ class RootFinder:
         """``found`` as the closing count confirms it (:meth:`_confirmed`), after the
         repairs it takes, each followed by that count again; None if none is enough.
 
+        First, every multiplicity read as more than one is counted over a small
+        circle (:meth:`_recounted`): the pencil can show a spurious near-zero offset
+        (MLRS above 400 Hz read 53 of 78 roots as double), and a root counted twice
+        that is simple would cancel a missing root in the closing count, which sees
+        zeros less the roots divided out. Then the repairs:
+
         1. The deferred cluster members polished (:meth:`_with_members`: a close
            pair's other member, which the pencil at the found one points at).
         2. The roots the scan's own values show once ``found`` is divided out
            (:meth:`_rescanned`; no new scan): two roots in one grid step, one of
            them found.
-        3. The roots still missing, located by deflated counts (:meth:`_recovered`).
-        4. Every multiplicity recounted (:meth:`_recounted`): a misread one. Last,
+        3. The roots still missing, located by deflated counts (:meth:`_recovered`),
+           below the count's top or, with fewer than ``count`` found, below the
+           highest root found.
+        4. Every multiplicity recounted: one read as simple may be double. Last,
            as the rarest and dearest: a circle's count per root (MLRS 50 modes:
            850 contour points, 1 s, where the recovery alone was enough).
 
@@ -730,6 +739,7 @@ class RootFinder:
         def top(roots):
             return self._count_top(roots, count, omega_max) or np.inf
 
+        found = self._recounted(found, top(found), multiple_only=True)
         confirmed = self._confirmed(found, count, omega_max)
         for repair in (lambda roots: self._with_members(roots, top(roots)),
                        lambda roots: self._rescanned(roots, scans, top(roots))):
@@ -739,7 +749,10 @@ class RootFinder:
             if repaired != found:
                 found = repaired
                 confirmed = self._confirmed(found, count, omega_max)
-        upper = None if confirmed is not None else self._count_top(found, count, omega_max)
+        upper = None
+        if confirmed is None and found:  # with fewer than count found (misread multiplicities
+            # recounted), the missing may still be below the highest: look there
+            upper = self._count_top(found, count, omega_max) or found[-1] * (1 + self.CLUSTER_WINDOW)
         if upper is not None:
             found, cap = self._recovered(found, upper, count)
             confirmed = self._confirmed(found, count, omega_max, cap)
@@ -802,13 +815,15 @@ class RootFinder:
                 self._merge(found, [root], OMEGA_FLOOR, np.inf)
         return sorted(found)
 
-    def _recounted(self, found: list[float], upper: float = np.inf) -> list[float]:
-        """``found`` with the multiplicity of each root below ``upper`` counted over a
-        small circle (all circles in one count; see :meth:`_multiplicities`) instead
-        of read from its pencil offsets, which can show spurious near-zero ones or
-        (a Newton stopped early) miss a double root's second one."""
+    def _recounted(self, found: list[float], upper: float = np.inf, multiple_only: bool = False) -> list[float]:
+        """``found`` with the multiplicity of each root below ``upper`` (``multiple_only``:
+        of those it holds more than once) counted over a small circle (all circles in
+        one count; see :meth:`_multiplicities`) instead of read from its pencil offsets,
+        which can show spurious near-zero ones or (a Newton stopped early) miss a double
+        root's second one."""
         distinct = sorted(set(found))
-        counts = dict(zip(distinct, self.multiplicities([r for r in distinct if r < upper], distinct)))
+        asked = [r for r in distinct if r < upper and (found.count(r) > 1 or not multiple_only)]
+        counts = dict(zip(asked, self.multiplicities(asked, distinct)))
         return sorted(r for r in distinct for _ in range(counts.get(r) or found.count(r)))
 
     def multiplicities(self, roots, others=()) -> list:

@@ -164,6 +164,20 @@ def test_recovery_for_a_count_stops_above_the_count_th_root():
     assert finder._confirmed(recovered, k, cap=cap) == exact[:k]
 
 
+def test_spurious_doubles_and_missing_roots_are_both_repaired():
+    """Two roots read as double (a spurious near-zero offset of the pencil, as MLRS
+    showed above 400 Hz) and two others missing, so the count is met by the wrong
+    roots: the doubles are recounted first, and the two missing ones are then
+    recovered below the highest root found although fewer than ``count`` remain."""
+    model, exact, _ = two_plane_cantilever_roots()
+    k = len(exact) - 2
+    found = sorted(exact[:2] + [exact[2]] * 2 + exact[4:6] + [exact[6]] * 2 + exact[8:k])
+    assert len(found) == k
+    _, finder, _ = frequency_finder(model)
+    repaired = finder._closed(found, k, None, [(np.zeros(0),) * 3])
+    np.testing.assert_allclose(repaired, exact[:k], rtol=1e-10)
+
+
 def scan_with_shared_steps():
     """The two-plane cantilever's finder, exact roots, one fast-path scan (grid, sign,
     log|det|) below its top, and the indices i whose roots i and i + 1 share a step

@@ -425,8 +425,8 @@ class _Orthonormaliser:
         """
         peak = size_estimate(stacked).max(axis=(1, 2))
         peak = np.where(peak > 0, peak, 1.0)[:, None, None]
-        squares = np.abs(stacked / peak) ** 2  # relative to the peak: no overflow
-        size = np.stack([np.sqrt(squares[:, kinds == kind].sum(axis=(1, 2))) for kind in range(4)], axis=1)
+        squares = (np.abs(stacked / peak) ** 2).sum(axis=2)  # (n, rows), relative to the peak: no overflow
+        size = np.sqrt(squares @ (kinds[:, None] == np.arange(4)))  # (n, 4): each kind's rows together
         size = np.where(size > 0, size, size.max(axis=1, keepdims=True))
         return 1 / (size[:, kinds] * peak[:, :, 0])
 
@@ -438,8 +438,8 @@ class _Orthonormaliser:
         others = ([("row", row, row[1], row[2]) for row in rows]
                   + [("state", key, other.columns, other.matrix) for key, other in open_states.items()]
                   + [("waiting", key, tip.columns, tip.matrix) for key, tip in self.waiting.items()])
-        held = [set(int(c) for c in block[2]) for block in others]
-        columns, chosen = set(int(c) for c in state.columns), set()
+        held = [set(block[2].tolist()) for block in others]
+        columns, chosen = set(state.columns.tolist()), set()
         while True:
             more = {i for i, cs in enumerate(held) if i not in chosen and cs & columns}
             if not more:

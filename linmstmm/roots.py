@@ -129,6 +129,10 @@ class RootFinder:
         self.deferred_members: list[tuple[float, float]] = []  # (start, the root whose pencil gave it)
         #: rad/s: a count found no root from OMEGA_FLOOR up to here (see :meth:`_scanned`)
         self.root_free_below = OMEGA_FLOOR
+        #: root -> (multiplicity, radius rad/s): roots float64 could not tell apart (:meth:`_separated`)
+        self.unseparated: dict[float, tuple[int, float]] = {}
+        #: root -> multiplicity a circle count gave it (1 where it could not be made; :meth:`_settled`)
+        self._counted: dict[float, int] = {}
 
     def divide_out_rigid_body_zeros(self, rigid: int) -> None:
         """Count and scan det Ū_all / ω^2r instead of det Ū_all.
@@ -337,6 +341,7 @@ class RootFinder:
         counts = count_zeros_many(self.log_det, intervals, initial_points=17) if asked else []
         for i, count in zip(asked, counts):
             multiplicities[i] = 1 if isinstance(count, RuntimeError) else max(count, 1)
+        self._counted.update((polished[i][0], multiplicities[i]) for i in asked)
         return multiplicities
 
     def cluster(self, omega: float) -> list[float]:
@@ -552,13 +557,32 @@ class RootFinder:
                    cap: float = np.inf):
         """The lowest ``count`` of ``found`` (or all up to omega_max) if one count from
         OMEGA_FLOOR says there are no others below them; None otherwise.
-        ``cap``: the count stops there at the latest (rad/s; above the count-th root)."""
+        ``cap``: the count stops there at the latest (rad/s; above the count-th root).
+        Multiplicities above one inside the count are counted over circles first
+        (:meth:`_settled`)."""
+        found = self._settled(found, count, omega_max, cap)
         upper = self._count_top(found, count, omega_max)
         if upper is None or (count is not None and len(found) >= count and found[count - 1] >= cap):
             return None
         upper = min(upper, cap)
         below = [r for r in found if r < upper]
         return below[:count] if self._no_other_zeros(found, upper) else None
+
+    def _settled(self, found: list[float], count: int | None, omega_max: float | None,
+                 cap: float = np.inf) -> list[float]:
+        """``found`` with every multiplicity above one below the closing count's top (and
+        ``cap``) counted over a circle (:meth:`_recounted`), again while that moves the
+        top up. The closing count sees zeros less the roots divided out: a simple root
+        read as double from a spurious near-zero pencil offset would cancel a missing
+        root (a random tree at 40 modes read one as fivefold, with four missing, and
+        passed; MLRS above 400 Hz read 53 of 78 roots as double)."""
+        while True:
+            found = sorted(r for r in set(found) for _ in range(self._counted.get(r, found.count(r))))
+            top = min(self._count_top(found, count, omega_max) or np.inf, cap)
+            doubtful = sorted({r for r in found if r < top and r not in self._counted and found.count(r) > 1})
+            if not doubtful:
+                return found
+            found = self._recounted(found, doubtful)
 
     def _count_top(self, found: list[float], count: int | None, omega_max: float | None):
         """Top of the closing count: omega_max, or midway between the count-th root
@@ -714,11 +738,8 @@ class RootFinder:
         """``found`` as the closing count confirms it (:meth:`_confirmed`), after the
         repairs it takes, each followed by that count again; None if none is enough.
 
-        First, every multiplicity read as more than one is counted over a small
-        circle (:meth:`_recounted`): the pencil can show a spurious near-zero offset
-        (MLRS above 400 Hz read 53 of 78 roots as double), and a root counted twice
-        that is simple would cancel a missing root in the closing count, which sees
-        zeros less the roots divided out. Then the repairs:
+        Every closing count first has the multiplicities above one inside it
+        counted over circles (:meth:`_settled`). The repairs:
 
         1. The deferred cluster members polished (:meth:`_with_members`: a close
            pair's other member, which the pencil at the found one points at).
@@ -739,7 +760,7 @@ class RootFinder:
         def top(roots):
             return self._count_top(roots, count, omega_max) or np.inf
 
-        found = self._recounted(found, top(found), multiple_only=True)
+        found = self._settled(found, count, omega_max)
         confirmed = self._confirmed(found, count, omega_max)
         for repair in (lambda roots: self._with_members(roots, top(roots)),
                        lambda roots: self._rescanned(roots, scans, top(roots))):
@@ -757,7 +778,7 @@ class RootFinder:
             found, cap = self._recovered(found, upper, count)
             confirmed = self._confirmed(found, count, omega_max, cap)
             if confirmed is None:
-                recounted = self._recounted(found, min(top(found), cap))
+                recounted = self._recounted(found, [r for r in sorted(set(found)) if r < min(top(found), cap)])
                 confirmed = None if recounted == found else self._confirmed(recounted, count, omega_max, cap)
         return confirmed
 
@@ -815,16 +836,16 @@ class RootFinder:
                 self._merge(found, [root], OMEGA_FLOOR, np.inf)
         return sorted(found)
 
-    def _recounted(self, found: list[float], upper: float = np.inf, multiple_only: bool = False) -> list[float]:
-        """``found`` with the multiplicity of each root below ``upper`` (``multiple_only``:
-        of those it holds more than once) counted over a small circle (all circles in
-        one count; see :meth:`_multiplicities`) instead of read from its pencil offsets,
-        which can show spurious near-zero ones or (a Newton stopped early) miss a double
-        root's second one."""
+    def _recounted(self, found: list[float], roots) -> list[float]:
+        """``found`` with the multiplicity of each of ``roots`` (distinct, in ``found``)
+        counted over a small circle (all circles in one count; see :meth:`_multiplicities`)
+        instead of read from its pencil offsets, which can show spurious near-zero ones
+        or (a Newton stopped early) miss a double root's second one. Where a circle
+        cannot be counted the root is taken as simple: an unconfirmed multiplicity could
+        hide a missing root from the closing count, a missing one cannot."""
         distinct = sorted(set(found))
-        asked = [r for r in distinct if r < upper and (found.count(r) > 1 or not multiple_only)]
-        counts = dict(zip(asked, self.multiplicities(asked, distinct)))
-        return sorted(r for r in distinct for _ in range(counts.get(r) or found.count(r)))
+        self._counted.update((r, count or 1) for r, count in zip(roots, self.multiplicities(roots, distinct)))
+        return sorted(r for r in distinct for _ in range(self._counted[r] if r in roots else found.count(r)))
 
     def multiplicities(self, roots, others=()) -> list:
         """How many roots sit at each of ``roots`` (rad/s, roots found), counted over a
@@ -878,11 +899,43 @@ class RootFinder:
         the fast path (:meth:`_scan_ahead`) when one count confirms it, else
         the segment search (:meth:`_search`).
         """
-        if count is not None or omega_max is not None:
-            found = self._scan_ahead(count, omega_max)
-            if found is not None:
-                return found[:count] if count is not None else found
-        return self._search(count, omega_max, omega_start)
+        found = self._scan_ahead(count, omega_max) if count is not None or omega_max is not None else None
+        if found is None:
+            found = self._search(count, omega_max, omega_start)
+        found = self._separated(found)
+        return found[:count] if count is not None else found
+
+    def _separated(self, roots: list[float]) -> list[float]:
+        """``roots`` with each multiple one that is a cluster of distinct roots split into them.
+
+        Roots closer than SPLIT are counted as one multiple root (a circle of that
+        radius holds them all). Each multiple root is counted again over a circle
+        100 times smaller (all in one count): a multiple root keeps its count, a
+        cluster does not, and its members are then isolated by bisection on the
+        count within the first circle (:meth:`_isolate`). A random loop's double
+        root and the simple one 1.9e-5 above it had come back as one triple root.
+        Where float64 cannot separate them they stay together, and
+        :attr:`unseparated` says so (root -> (multiplicity, radius, rad/s)).
+        """
+        distinct = sorted(set(roots))
+        multiple = [r for r in distinct if roots.count(r) > 1]
+        if not multiple:
+            return roots
+        radii = [min([self.SPLIT * r] + [abs(r - other) / 2 for other in distinct if other != r]) for r in multiple]
+        tight = count_zeros_many(self.log_det, [(r - radius / 100, r + radius / 100)
+                                                for r, radius in zip(multiple, radii)], initial_points=17)
+        separated = list(roots)
+        for r, radius, count in zip(multiple, radii, tight):
+            m = roots.count(r)
+            if count == m:
+                continue
+            try:
+                members = self._isolate(r - radius, r + radius, m, [r])
+            except RuntimeError:
+                self.unseparated[r] = (m, radius)
+                continue
+            separated = [x for x in separated if x != r] + members
+        return sorted(separated)
 
     @staticmethod
     def _next_top(lo: float, roots: list[float], count: int | None) -> float:

@@ -105,10 +105,12 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     else:
         omegas = np.array(finder.find(count, omega_max))
     precision, text, omega_text = "float64", None, None
-    uncertain = sorted({w for w in omegas if finder.last_step.get(w, 0.0) > CERTIFIED_STEP})
+    unseparated = {w: finder.unseparated[w] for w in sorted(set(omegas)) if w in finder.unseparated}
+    uncertain = sorted({w for w in omegas if finder.last_step.get(w, 0.0) > CERTIFIED_STEP} - set(unseparated))
     wanted = digits if digits and digits > FLOAT64_DIGITS else (ESCALATION_DIGITS if uncertain else None)
     if wanted:
-        chosen = omegas if digits and digits > FLOAT64_DIGITS else [w for w in omegas if w in uncertain]
+        chosen = ([w for w in omegas if w not in unseparated] if digits and digits > FLOAT64_DIGITS
+                  else [w for w in omegas if w in uncertain])
         # The last root may be one of several equal ones cut off by count.
         top = [omegas[-1]] if count is not None and len(chosen) and max(chosen) == omegas[-1] else []
         cut = dict(zip(top, finder.multiplicities(top, sorted(set(omegas)))))
@@ -120,9 +122,13 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
             omega_text = [mpmath.nstr(refined[w], wanted) if w in refined else repr(float(w)) for w in omegas]
         omegas = np.array([float(refined.get(w, w)) for w in omegas])
         precision = f"mpmath:{wanted}" + ("" if len(chosen) == len(omegas) else f" ({len(set(chosen))} roots)")
-    note = ""
+    notes = [f"float64 could not tell {m} roots within ±{radius / (2 * np.pi):.3g} Hz of {w / (2 * np.pi):.10g} Hz "
+             "apart (a cluster, or a multiple root it could not confirm): they are reported together there"
+             for w, (m, radius) in unseparated.items()]
     if count is not None and omegas.size < count and fmax is None:
-        note = finder.note or f"only {omegas.size} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s"
+        notes.append(finder.note or f"only {omegas.size} elastic natural frequencies exist below "
+                                    f"{OMEGA_CEILING:.3g} rad/s")
+    note = "; ".join(notes)
     return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.full_order,
                            time.perf_counter() - start, precision=precision, note=note,
                            indeterminate_released=released, frequencies_text=text, omegas_text=omega_text)

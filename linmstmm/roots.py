@@ -926,15 +926,15 @@ class RootFinder:
                                                 for r, radius in zip(multiple, radii)], initial_points=17)
         separated = list(roots)
         for r, radius, count in zip(multiple, radii, tight):
-            m = roots.count(r)
-            if count == m:
+            m = self._counted.get(r, roots.count(r))  # (``roots`` may end inside a multiple root)
+            if count == m or (r == distinct[-1] and count > roots.count(r)):
                 continue
             try:
                 members = self._isolate(r - radius, r + radius, m, [r])
             except RuntimeError:
                 self.unseparated[r] = (m, radius)
                 continue
-            separated = [x for x in separated if x != r] + members
+            separated = [x for x in separated if x != r] + members[:roots.count(r)]
         return sorted(separated)
 
     @staticmethod

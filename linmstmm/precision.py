@@ -33,6 +33,10 @@ from linmstmm.elements.beam import bending_wavenumber
 GUARD_DIGITS = 12
 #: Iterations of either refinement before it gives up.
 MAX_STEPS = 30
+#: A refinement that does not settle is tried again at twice the working precision,
+#: up to this many times: the growth estimate misses cancellations such as a
+#: ring's T_loop − I (random ring 23 at 2692 Hz: det right to 3 digits at 43).
+PRECISION_DOUBLINGS = 2
 
 
 def growth_digits(model, omega: float) -> int:
@@ -78,7 +82,8 @@ def refine_roots(deduction, model, omegas, digits: int, multiplicities=None) -> 
     multiplicities : {root: multiplicity} where it differs from the number of
     repeats in ``omegas`` (the highest root of a list cut at a count may be
     double with one entry). Returns mpf values, one per entry of ``omegas``.
-    Raises RuntimeError for a root the refinement does not settle on.
+    Raises RuntimeError for a root the refinement does not settle on, even at
+    2**PRECISION_DOUBLINGS times the working precision.
     """
     refined = []
     i = 0
@@ -88,11 +93,18 @@ def refine_roots(deduction, model, omegas, digits: int, multiplicities=None) -> 
             repeats += 1
         m = (multiplicities or {}).get(omegas[i], repeats)
         dps = digits + GUARD_DIGITS + growth_digits(model, omegas[i])
-        with mpmath.workdps(dps):
-            start, tolerance = mpmath.mpf(omegas[i]), mpmath.mpf(10) ** -(digits + 2)
-            root = (_secant(deduction, start, tolerance) if m == 1
-                    else _multiple_newton(deduction, start, m, tolerance))
-            refined += [+root] * repeats
+        for attempt in range(PRECISION_DOUBLINGS + 1):
+            with mpmath.workdps(dps << attempt):
+                start, tolerance = mpmath.mpf(omegas[i]), mpmath.mpf(10) ** -(digits + 2)
+                try:
+                    root = (_secant(deduction, start, tolerance) if m == 1
+                            else _multiple_newton(deduction, start, m, tolerance))
+                except RuntimeError:
+                    if attempt == PRECISION_DOUBLINGS:
+                        raise
+                    continue
+                refined += [+root] * repeats
+                break
         i += repeats
     return refined
 

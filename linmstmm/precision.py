@@ -33,6 +33,8 @@ from linmstmm.elements.beam import bending_wavenumber
 GUARD_DIGITS = 12
 #: Iterations of either refinement before it gives up.
 MAX_STEPS = 30
+#: Points of det in mpmath across a cluster float64 could not separate (:func:`separated_cluster`).
+CLUSTER_POINTS = 65
 #: A refinement that does not settle is tried again at twice the working precision,
 #: up to this many times: the growth estimate misses cancellations such as a
 #: ring's T_loop − I (random ring 23 at 2692 Hz: det right to 3 digits at 43).
@@ -154,3 +156,34 @@ def _multiple_newton(deduction, start, multiplicity: int, tolerance):
         previous = abs(step)
     raise RuntimeError(f"the {multiplicity}-fold root near {float(start):.12g} rad/s does not "
                        f"settle in mpmath at {mpmath.mp.dps} digits")
+
+
+def separated_cluster(deduction, model, omega: float, multiplicity: int, radius: float, digits: int):
+    """The ``multiplicity`` roots within ``radius`` of ``omega`` (rad/s) that float64 could
+    not tell apart (:attr:`RootFinder.unseparated`), to ``digits`` digits; None if they
+    are not found in full.
+
+    det Ū_all in mpmath on CLUSTER_POINTS points across the interval: each sign
+    change holds a simple root (bracketed refinement, Anderson–Björck), each local
+    minimum of |det| between points of one sign a double root (:func:`_multiple_newton`).
+    They must make up ``multiplicity`` (the float64 count over the circle), else None.
+    """
+    dps = digits + GUARD_DIGITS + growth_digits(model, omega)
+    with mpmath.workdps(dps):
+        tolerance = mpmath.mpf(10) ** -(digits + 2)
+        lo, width = mpmath.mpf(omega) - mpmath.mpf(radius), 2 * mpmath.mpf(radius)
+        grid = [lo + width * k / (CLUSTER_POINTS - 1) for k in range(CLUSTER_POINTS)]
+        values = [mp_determinant(deduction, x) for x in grid]
+        roots = []
+        try:
+            for k in range(CLUSTER_POINTS - 1):
+                if values[k] * values[k + 1] < 0:
+                    roots.append(mpmath.findroot(lambda x: mp_determinant(deduction, x), (grid[k], grid[k + 1]),
+                                                 solver="anderson", tol=(tolerance * abs(grid[k])) ** 2))
+            for k in range(1, CLUSTER_POINTS - 1):
+                if (values[k - 1] * values[k] > 0 and values[k] * values[k + 1] > 0
+                        and abs(values[k]) < abs(values[k - 1]) and abs(values[k]) < abs(values[k + 1])):
+                    roots += [_multiple_newton(deduction, grid[k], 2, tolerance)] * 2
+        except (RuntimeError, ValueError, ZeroDivisionError):
+            return None
+        return sorted(+root for root in roots) if len(roots) == multiplicity else None

@@ -915,7 +915,9 @@ class RootFinder:
         count within the first circle (:meth:`_isolate`). A random loop's double
         root and the simple one 1.9e-5 above it had come back as one triple root.
         Where float64 cannot separate them they stay together, and
-        :attr:`unseparated` says so (root -> (multiplicity, radius, rad/s)).
+        :attr:`unseparated` says so (root -> (multiplicity, radius, rad/s)):
+        ``natural_frequencies`` then separates them in mpmath
+        (:func:`~linmstmm.precision.separated_cluster`), or names them in its note.
         """
         distinct = sorted(set(roots))
         multiple = [r for r in distinct if roots.count(r) > 1]

@@ -10,7 +10,7 @@ import numpy as np
 from linmstmm.deduction import Deduction
 from linmstmm.model import Model
 from linmstmm.nullspace import release_indeterminate
-from linmstmm.precision import refine_roots
+from linmstmm.precision import refine_roots, separated_cluster
 from linmstmm.roots import OMEGA_CEILING, RootFinder
 from linmstmm.topology import build_topology
 
@@ -91,7 +91,10 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     count : the lowest N; fmax : Hz, all up to fmax; both: whichever stops first.
     digits : significant digits wanted; above FLOAT64_DIGITS every root is
     refined in mpmath. Without it, roots float64 cannot certify are refined
-    at ESCALATION_DIGITS automatically.
+    at ESCALATION_DIGITS automatically, and so are clusters of roots float64
+    could not tell apart (:attr:`RootFinder.unseparated`, separated by
+    :func:`~linmstmm.precision.separated_cluster`); a cluster mpmath cannot
+    separate either is named in the note.
     root : boundary end (point name) to use as the root of the transfer tree.
     guess_hz : frequencies of a similar model (a neighbouring scene) to start
     from; used with ``count`` only, and checked by a root count either way.
@@ -107,21 +110,30 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     precision, text, omega_text = "float64", None, None
     unseparated = {w: finder.unseparated[w] for w in sorted(set(omegas)) if w in finder.unseparated}
     uncertain = sorted({w for w in omegas if finder.last_step.get(w, 0.0) > CERTIFIED_STEP} - set(unseparated))
-    wanted = digits if digits and digits > FLOAT64_DIGITS else (ESCALATION_DIGITS if uncertain else None)
+    every = bool(digits and digits > FLOAT64_DIGITS)
+    wanted = digits if every else (ESCALATION_DIGITS if uncertain or unseparated else None)
     if wanted:
-        chosen = ([w for w in omegas if w not in unseparated] if digits and digits > FLOAT64_DIGITS
-                  else [w for w in omegas if w in uncertain])
+        chosen = [w for w in omegas if w not in unseparated and (every or w in uncertain)]
         # The last root may be one of several equal ones cut off by count.
         top = [omegas[-1]] if count is not None and len(chosen) and max(chosen) == omegas[-1] else []
         cut = dict(zip(top, finder.multiplicities(top, sorted(set(omegas)))))
         refined = dict(zip(chosen, refine_roots(deduction, model, list(chosen), wanted,
                                                 {w: m for w, m in cut.items() if m})))
+        values = [refined.get(w) for w in omegas]
+        distinct_refined = len(set(chosen))
+        for w, (m, radius) in list(unseparated.items()):
+            members = separated_cluster(deduction, model, w, m, radius, wanted)
+            if members is not None:
+                for i, member in zip([i for i, x in enumerate(omegas) if x == w], members):
+                    values[i] = member
+                distinct_refined += len(set(members))
+                del unseparated[w]
         with mpmath.workdps(wanted + 10):  # 2π and the division at the refined precision
-            text = [mpmath.nstr(refined[w] / (2 * mpmath.pi), wanted) if w in refined
-                    else repr(w / (2 * np.pi)) for w in omegas]
-            omega_text = [mpmath.nstr(refined[w], wanted) if w in refined else repr(float(w)) for w in omegas]
-        omegas = np.array([float(refined.get(w, w)) for w in omegas])
-        precision = f"mpmath:{wanted}" + ("" if len(chosen) == len(omegas) else f" ({len(set(chosen))} roots)")
+            text = [mpmath.nstr(v / (2 * mpmath.pi), wanted) if v is not None else repr(w / (2 * np.pi))
+                    for w, v in zip(omegas, values)]
+            omega_text = [mpmath.nstr(v, wanted) if v is not None else repr(float(w)) for w, v in zip(omegas, values)]
+        omegas = np.array([float(v) if v is not None else w for w, v in zip(omegas, values)])
+        precision = f"mpmath:{wanted}" + ("" if all(v is not None for v in values) else f" ({distinct_refined} roots)")
     notes = [f"float64 could not tell {m} roots within ±{radius / (2 * np.pi):.3g} Hz of {w / (2 * np.pi):.10g} Hz "
              "apart (a cluster, or a multiple root it could not confirm): they are reported together there"
              for w, (m, radius) in unseparated.items()]

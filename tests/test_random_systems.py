@@ -139,26 +139,26 @@ def test_forced_cut_on_a_ring_without_boundary():
     assert [(cut.point, cut.closing) for cut in cuts] == [(point, True)]
 
 
-def test_forty_modes_agree_with_fe_or_the_note_names_the_cluster():
-    """Loops 32 at 40 modes: a double root 3e-5 below a simple one at 2663 Hz, where
-    float64 Ū_all cannot separate them. Every frequency agrees with FE to 1e-7
-    except those the note names as not told apart, and the FE roots they stand for
-    lie within the radius it gives (they had come back as one double root, silently).
-    The fivefold misreading of seed floating_tree 15 (four roots missing) is the
-    reason for the circle counts in RootFinder._settled."""
+def test_a_cluster_float64_cannot_separate_is_separated_in_mpmath():
+    """Loops 32 at 40 modes: a root 3e-5 below another at 2663 Hz, which float64 Ū_all
+    cannot tell apart. The float64 search flags them (RootFinder.unseparated, the FE
+    roots within the radius it gives; they had come back as one double root,
+    silently); natural_frequencies then finds both in mpmath on a grid across that
+    radius, and all 40 agree with FE."""
     from linmstmm.solve import frequency_finder
 
     model = random_model("loops", 32)
-    reference = 2 * np.pi * fe_frequencies(model, count=40).frequencies_hz
+    reference = fe_frequencies(model, count=40).frequencies_hz
     _, finder, _ = frequency_finder(model)
-    found = np.array(finder.find(40, None))
+    found = np.array(finder.find(40, None)) / (2 * np.pi)
     wrong = np.flatnonzero(np.abs(found / reference - 1) > AGREEMENT)
+    assert wrong.size
     for i in wrong:
-        assert found[i] in finder.unseparated, f"{found[i] / (2 * np.pi):.6f} Hz is off and not flagged"
-        _, radius = finder.unseparated[found[i]]
-        assert abs(reference[i] - found[i]) <= radius
-    note = natural_frequencies(model, 40).note
-    assert all(f"{w / (2 * np.pi):.10g} Hz" in note for w in finder.unseparated)
+        _, radius = finder.unseparated[2 * np.pi * found[i]]
+        assert abs(reference[i] - found[i]) <= radius / (2 * np.pi)
+    result = natural_frequencies(model, 40)
+    assert result.note == "" and result.precision.startswith("mpmath:20")
+    assert relative(result.frequencies_hz, reference) <= AGREEMENT
 
 
 def test_a_fivefold_misreading_does_not_hide_four_missing_roots():

@@ -920,7 +920,8 @@ class RootFinder:
         (:func:`~linmstmm.precision.separated_cluster`), or names them in its note.
         """
         distinct = sorted(set(roots))
-        multiple = [r for r in distinct if roots.count(r) > 1]
+        # (a list cut at a count may hold one copy of a root counted as multiple)
+        multiple = [r for r in distinct if max(roots.count(r), self._counted.get(r, 1)) > 1]
         if not multiple:
             return roots
         radii = [min([self.SPLIT * r] + [abs(r - other) / 2 for other in distinct if other != r]) for r in multiple]

@@ -483,7 +483,8 @@ class RootFinder:
             return inside
         if depth > 60 or len(inside) > expected or (hi - lo) < 1e-9 * hi:
             raise RuntimeError(f"cannot separate the {expected} roots in ({lo:.12g}, {hi:.12g}) "
-                               f"rad/s in float64 (found {len(inside)}): ask for more digits")
+                               f"rad/s in float64 (found {len(inside)}): det Ū_all is not accurate enough there, "
+                               "and --digits only refines the roots float64 has found")
         found = list(found)
         (sign_lo, sign_hi), (log_lo, log_hi) = self.log_det(np.array([lo, hi]))
         if sign_lo * sign_hi < 0:  # with the bracket's own fallback where Newton cannot reach its root
@@ -988,9 +989,10 @@ def _inverse_eigenvalues(stack, full, iterations: int = 6) -> list[np.ndarray]:
     array), falling back to all where it has not settled to 1e-6."""
     n = len(stack)
     vector = np.ones((n, stack.shape[1], 1))
-    for _ in range(iterations):
-        vector = stack @ vector
-        vector /= np.linalg.norm(vector, axis=1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):  # a zero vector: NaN, not settled below
+        for _ in range(iterations):
+            vector = stack @ vector
+            vector /= np.linalg.norm(vector, axis=1, keepdims=True)
     image = stack @ vector
     nu = (vector.conj().transpose(0, 2, 1) @ image)[:, 0, 0]
     settled = np.linalg.norm(image[:, :, 0] - nu[:, None] * vector[:, :, 0], axis=1) <= 1e-6 * np.abs(nu)

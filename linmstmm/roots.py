@@ -83,6 +83,12 @@ class RootFinder:
     #: floor of Ū_all: the root is accepted, with that step as its uncertainty
     #: (:attr:`last_step`; the caller refines uncertain roots in mpmath).
     UNCERTAIN = 1e-7
+    #: Roots whose last Newton step was above this (relative) are checked on det itself
+    #: (:meth:`_checked`).
+    CERTIFIED_CHECK = 1e-9
+    #: log|det| must rise by this much either side of a root without a sign change (a
+    #: double root's rises by 2 ln 10 at ten times the distance to it).
+    DIP = 1.0
     #: Offsets |μ|/ω below this may be a multiple root split by rounding (a count decides);
     #: roots closer than this are reported as one multiple root.
     SPLIT = 1e-4
@@ -249,6 +255,27 @@ class RootFinder:
                     if setbacks[i] < 2:  # Newton that twice fails to shrink its step is lost
                         still.append(i)
             active = still
+        return self._checked(results)
+
+    def _checked(self, results):
+        """``polish`` results less the roots accepted at the rounding floor (a last step
+        above CERTIFIED_CHECK) that det itself does not bear out: no sign change and no
+        dip of log|det| between ω(1 ± 10·step). Where the pencil of Ū_all is not smooth,
+        Newton can settle beside a root (random loops 122: 975.90 and 977.07 Hz for one
+        root at 976.97, and the count bisection then gave up)."""
+        doubtful = [i for i, (root, _) in enumerate(results)
+                    if root is not None and self.last_step.get(root, 0.0) > self.CERTIFIED_CHECK]
+        if not doubtful:
+            return results
+        roots = np.array([results[i][0] for i in doubtful])
+        offsets = 10 * np.array([self.last_step[root] for root in roots])
+        sign, log_abs = self.log_det(np.concatenate([roots * (1 - offsets), roots, roots * (1 + offsets)]))
+        sign, log_abs = np.real(sign).reshape(3, -1), log_abs.reshape(3, -1)
+        borne_out = (sign[0] * sign[2] < 0) | (np.minimum(log_abs[0], log_abs[2]) > log_abs[1] + self.DIP)
+        results = list(results)
+        for i, ok in zip(doubtful, borne_out):
+            if not ok:
+                results[i] = (None, np.zeros(0))
         return results
 
     def _quadratic(self, step: float, previous: float, omega: float, mu: np.ndarray) -> bool:

@@ -47,6 +47,12 @@ def growth_digits(model, omega: float) -> int:
     return int(math.ceil(total / math.log(10)))
 
 
+def working_digits(model, omega: float, digits: int) -> int:
+    """mpmath precision for ``digits`` digits of a root near ``omega`` (rad/s): guard digits
+    and the beams' growth on top."""
+    return digits + GUARD_DIGITS + growth_digits(model, omega)
+
+
 def mp_determinant(deduction, omega) -> mpmath.mpf:
     """det Ū_all(ω) in mpmath at the working precision (omega an mpf)."""
     return sparse_determinant(deduction.matrix(np.array([omega], dtype=object))[0])
@@ -94,7 +100,7 @@ def refine_roots(deduction, model, omegas, digits: int, multiplicities=None) -> 
         while i + repeats < len(omegas) and omegas[i + repeats] == omegas[i]:
             repeats += 1
         m = (multiplicities or {}).get(omegas[i], repeats)
-        dps = digits + GUARD_DIGITS + growth_digits(model, omegas[i])
+        dps = working_digits(model, omegas[i], digits)
         for attempt in range(PRECISION_DOUBLINGS + 1):
             with mpmath.workdps(dps << attempt):
                 start, tolerance = mpmath.mpf(omegas[i]), mpmath.mpf(10) ** -(digits + 2)
@@ -168,8 +174,7 @@ def separated_cluster(deduction, model, omega: float, multiplicity: int, radius:
     minimum of |det| between points of one sign a double root (:func:`_multiple_newton`).
     They must make up ``multiplicity`` (the float64 count over the circle), else None.
     """
-    dps = digits + GUARD_DIGITS + growth_digits(model, omega)
-    with mpmath.workdps(dps):
+    with mpmath.workdps(working_digits(model, omega, digits)):
         tolerance = mpmath.mpf(10) ** -(digits + 2)
         lo, width = mpmath.mpf(omega) - mpmath.mpf(radius), 2 * mpmath.mpf(radius)
         grid = [lo + width * k / (CLUSTER_POINTS - 1) for k in range(CLUSTER_POINTS)]

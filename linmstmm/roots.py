@@ -45,6 +45,10 @@ POINTS_PER_OCTAVE = 24
 #: 40 modes 78 ms at 24, 158 ms at 20, 172 ms at 16; a 1000-beam chain
 #: 3.3 s at 24, 6.6 s at 16; a 10,000-body spring chain 1.0–1.2 s at all.
 MIN_POINTS_PER_OCTAVE = POINTS_PER_OCTAVE
+#: A root whose last Newton step (its rounding floor in float64) was larger than this,
+#: relative, is uncertified: checked on det itself (:meth:`RootFinder._checked`), and
+#: refined in mpmath by ``natural_frequencies``.
+CERTIFIED_STEP = 1e-9
 #: Loosest Newton tolerance (relative) RootFinder accepts: roots are told apart
 #: down to SPLIT = 1e-4, so the polishing must be much tighter than that.
 MAX_XTOL = 1e-6
@@ -83,9 +87,6 @@ class RootFinder:
     #: floor of Ū_all: the root is accepted, with that step as its uncertainty
     #: (:attr:`last_step`; the caller refines uncertain roots in mpmath).
     UNCERTAIN = 1e-7
-    #: Roots whose last Newton step was above this (relative) are checked on det itself
-    #: (:meth:`_checked`).
-    CERTIFIED_CHECK = 1e-9
     #: log|det| must rise by this much either side of a root without a sign change (a
     #: double root's rises by 2 ln 10 at ten times the distance to it).
     DIP = 1.0
@@ -259,12 +260,12 @@ class RootFinder:
 
     def _checked(self, results):
         """``polish`` results less the roots accepted at the rounding floor (a last step
-        above CERTIFIED_CHECK) that det itself does not bear out: no sign change and no
+        above CERTIFIED_STEP) that det itself does not bear out: no sign change and no
         dip of log|det| between ω(1 ± 10·step). Where the pencil of Ū_all is not smooth,
         Newton can settle beside a root (random loops 122: 975.90 and 977.07 Hz for one
         root at 976.97, and the count bisection then gave up)."""
         doubtful = [i for i, (root, _) in enumerate(results)
-                    if root is not None and self.last_step.get(root, 0.0) > self.CERTIFIED_CHECK]
+                    if root is not None and self.last_step.get(root, 0.0) > CERTIFIED_STEP]
         if not doubtful:
             return results
         roots = np.array([results[i][0] for i in doubtful])
@@ -605,7 +606,7 @@ class RootFinder:
         root (a random tree at 40 modes read one as fivefold, with four missing, and
         passed; MLRS above 400 Hz read 53 of 78 roots as double)."""
         while True:
-            found = sorted(r for r in set(found) for _ in range(self._counted.get(r, found.count(r))))
+            found = self._as_counted(found)
             top = min(self._count_top(found, count, omega_max) or np.inf, cap)
             doubtful = sorted({r for r in found if r < top and r not in self._counted and found.count(r) > 1})
             if not doubtful:
@@ -871,9 +872,18 @@ class RootFinder:
         or (a Newton stopped early) miss a double root's second one. Where a circle
         cannot be counted the root is taken as simple: an unconfirmed multiplicity could
         hide a missing root from the closing count, a missing one cannot."""
-        distinct = sorted(set(found))
-        self._counted.update((r, count or 1) for r, count in zip(roots, self.multiplicities(roots, distinct)))
-        return sorted(r for r in distinct for _ in range(self._counted[r] if r in roots else found.count(r)))
+        self._counted.update((r, count or 1) for r, count in zip(roots, self.multiplicities(roots, sorted(set(found)))))
+        return self._as_counted(found)
+
+    def _as_counted(self, found: list[float]) -> list[float]:
+        """``found`` with each root repeated as often as a circle count gave it (:attr:`_counted`),
+        the others as often as they are."""
+        return sorted(r for r in set(found) for _ in range(self._counted.get(r, found.count(r))))
+
+    def _circle_radius(self, root: float, others) -> float:
+        """Radius (rad/s) of the circle that counts the multiplicity of ``root``: SPLIT·ω,
+        less where a root of ``others`` is nearer (half the distance)."""
+        return min([self.SPLIT * root] + [abs(root - other) / 2 for other in others if other != root])
 
     def multiplicities(self, roots, others=()) -> list:
         """How many roots sit at each of ``roots`` (rad/s, roots found), counted over a
@@ -882,7 +892,7 @@ class RootFinder:
         cannot be made."""
         if not len(roots):
             return []
-        radii = [min([self.SPLIT * r] + [abs(r - other) / 2 for other in others if other != r]) for r in roots]
+        radii = [self._circle_radius(r, others) for r in roots]
         counts = count_zeros_many(self.log_det, [(r - radius, r + radius) for r, radius in zip(roots, radii)],
                                   initial_points=17)
         return [None if isinstance(c, RuntimeError) else max(c, 1) for c in counts]
@@ -952,7 +962,7 @@ class RootFinder:
         multiple = [r for r in distinct if max(roots.count(r), self._counted.get(r, 1)) > 1]
         if not multiple:
             return roots
-        radii = [min([self.SPLIT * r] + [abs(r - other) / 2 for other in distinct if other != r]) for r in multiple]
+        radii = [self._circle_radius(r, distinct) for r in multiple]
         tight = count_zeros_many(self.log_det, [(r - radius / 100, r + radius / 100)
                                                 for r, radius in zip(multiple, radii)], initial_points=17)
         separated = list(roots)

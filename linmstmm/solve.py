@@ -11,15 +11,12 @@ from linmstmm.deduction import Deduction
 from linmstmm.model import Model
 from linmstmm.nullspace import release_indeterminate
 from linmstmm.precision import refine_roots, separated_cluster
-from linmstmm.roots import OMEGA_CEILING, RootFinder
+from linmstmm.roots import CERTIFIED_STEP, OMEGA_CEILING, RootFinder
 from linmstmm.topology import build_topology
 
 
 #: Digits float64 delivers; more are computed in mpmath.
 FLOAT64_DIGITS = 14
-#: A root whose last Newton step (its rounding floor in float64) was larger than
-#: this, relative, is refined in mpmath.
-CERTIFIED_STEP = 1e-9
 #: Digits used when an uncertified root is escalated to mpmath.
 ESCALATION_DIGITS = 20
 

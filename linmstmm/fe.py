@@ -793,6 +793,9 @@ class FEResult:
     n_dof : reduced DOFs of that mesh. seconds : wall time of the whole solve.
     mode_shapes : (n_full, m) mass-normalised full vectors on that mesh (see
         :class:`DofIndex` for the layout), or None.
+    note : empty, or why some frequencies are less accurate than asked: the
+        refinement stopped at ``max_elements_per_beam`` with their estimated
+        error above ``rtol``.
     """
 
     model: str
@@ -803,9 +806,10 @@ class FEResult:
     n_dof: int
     seconds: float
     mode_shapes: np.ndarray | None = None
+    note: str = ""
 
     def to_dict(self) -> dict:
-        """JSON-ready summary (the CLI ``--json`` keys plus the FE ones)."""
+        """JSON-ready summary (the CLI ``--json`` keys plus the FE ones; ``note`` only when set)."""
         return {"model": self.model,
                 "frequencies_hz": [float(f) for f in self.frequencies_hz],
                 "rigid_body_modes": int(self.rigid_body_modes),
@@ -813,7 +817,8 @@ class FEResult:
                 "elements_per_beam": self.elements_per_beam,
                 "error_estimate": [float(e) for e in self.error_estimate],
                 "seconds": float(self.seconds),
-                "method": "fe"}
+                "method": "fe",
+                **({"note": self.note} if self.note else {})}
 
 
 def _romberg(values, max_order: int = 4):
@@ -899,14 +904,27 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
     keep = np.ones(len(lam), bool) if lam_max is None else lam <= lam_max
     lam, X, lam_error = lam[keep][:count], X[:, keep][:, :count], lam_error[keep][:count]
     order = np.argsort(lam)
+    frequencies_hz, error_estimate = np.sqrt(lam[order]) / _TWO_PI, np.maximum(lam_error[order], ROUNDOFF) / 2
+    short = np.flatnonzero(error_estimate > rtol) if model.beams and elements_per_beam is None else []
     return FEResult(model=model.name,
-                    frequencies_hz=np.sqrt(lam[order]) / _TWO_PI,
+                    frequencies_hz=frequencies_hz,
                     rigid_body_modes=fe.rigid_modes.shape[1],
-                    error_estimate=np.maximum(lam_error[order], ROUNDOFF) / 2,
+                    error_estimate=error_estimate,
                     elements_per_beam=fe.elements_per_beam if model.beams else None,
                     n_dof=fe.n_dof,
                     seconds=perf_counter() - started,
-                    mode_shapes=(fe.T @ X[:, order]) if mode_shapes else None)
+                    mode_shapes=(fe.T @ X[:, order]) if mode_shapes else None,
+                    note=_short_of_rtol(frequencies_hz, error_estimate, short, rtol, fe.elements_per_beam))
+
+
+def _short_of_rtol(frequencies_hz, error_estimate, short, rtol, elements_per_beam) -> str:
+    """The note of a refinement that stopped at its mesh cap short of ``rtol`` (empty if none is)."""
+    if not len(short):
+        return ""
+    listed = ", ".join(f"{frequencies_hz[i]:.6g} Hz ({error_estimate[i]:.1e})" for i in short[:5])
+    more = f" and {len(short) - 5} more" if len(short) > 5 else ""
+    return (f"mesh refinement stopped at {elements_per_beam} elements per beam (max_elements_per_beam) "
+            f"with {len(short)} frequencies above rtol = {rtol:.0e} (estimated relative error): {listed}{more}")
 
 
 def _fixed_mesh(model, elements_per_beam, count, lam_max, estimate_error):

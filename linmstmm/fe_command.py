@@ -60,4 +60,6 @@ def run_fe(args) -> int:
     print(f"  mesh: {mesh}, {result.n_dof} DOFs")
     if np.isfinite(result.error_estimate).any():
         print(f"  largest estimated relative error: {np.nanmax(result.error_estimate):.1e}")
+    if result.note:
+        print(f"  note: {result.note}")
     return 0

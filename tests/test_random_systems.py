@@ -198,3 +198,19 @@ def test_newton_settled_beside_a_root_is_not_taken_for_one():
     model = random_model("loops", 122)
     found = natural_frequencies(model, 40).frequencies_hz
     assert relative(found, fe_frequencies(model, count=40).frequencies_hz) <= AGREEMENT
+
+
+def test_a_veering_pair_past_the_fe_refinement_agrees_with_finer_meshes():
+    """Tree 85's 39th and 40th roots (7797.6 and 7807.5 Hz, a veering pair) are where the
+    FE route's automatic refinement stops at its cap of 1024 elements per beam, 2.6e-7
+    off with an estimated error of 2e-5, and its note says so. Its linear axial and
+    torsion elements converge as h², so meshes of 2048 and 4096 elements extrapolated
+    at second order are the independent reference (8.5e-10 from MSTMM at 4096, 5e-11
+    at 8192)."""
+    model = random_model("tree", 85)
+    found = natural_frequencies(model, 40).frequencies_hz
+    automatic = fe_frequencies(model, count=40)
+    assert "stopped at 1024 elements per beam" in automatic.note and "7797.65 Hz" in automatic.note
+    fine, finer = (fe_frequencies(model, count=40, elements_per_beam=n, estimate_error=False).frequencies_hz
+                   for n in (2048, 4096))
+    assert relative(found, finer + (finer - fine) / 3) <= 1e-8

@@ -897,6 +897,11 @@ class RootFinder:
                                   initial_points=17)
         return [None if isinstance(c, RuntimeError) else max(c, 1) for c in counts]
 
+    def multiplicity(self, root: float, others=()) -> int | None:
+        """How many roots sit at ``root``: the circle count already made for it while
+        finding the roots, else one made now (:meth:`multiplicities`)."""
+        return self._counted.get(root) or self.multiplicities([root], others)[0]
+
     def _scanned(self, lo: float, hi: float, below) -> tuple:
         """(grid, sign, log|det|) of the fast scan over [lo, hi], led by the last two
         points of ``below`` (the chunk under it, same form): a sign change or a

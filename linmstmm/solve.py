@@ -110,27 +110,9 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     every = bool(digits and digits > FLOAT64_DIGITS)
     wanted = digits if every else (ESCALATION_DIGITS if uncertain or unseparated else None)
     if wanted:
-        chosen = [w for w in omegas if w not in unseparated and (every or w in uncertain)]
-        # The last root may be one of several equal ones cut off by count.
-        top = [omegas[-1]] if count is not None and len(chosen) and max(chosen) == omegas[-1] else []
-        cut = dict(zip(top, finder.multiplicities(top, sorted(set(omegas)))))
-        refined = dict(zip(chosen, refine_roots(deduction, model, list(chosen), wanted,
-                                                {w: m for w, m in cut.items() if m})))
-        values = [refined.get(w) for w in omegas]
-        distinct_refined = len(set(chosen))
-        for w, (m, radius) in list(unseparated.items()):
-            members = separated_cluster(deduction, model, w, m, radius, wanted)
-            if members is not None:
-                for i, member in zip([i for i, x in enumerate(omegas) if x == w], members):
-                    values[i] = member
-                distinct_refined += len(set(members))
-                del unseparated[w]
-        with mpmath.workdps(wanted + 10):  # 2π and the division at the refined precision
-            text = [mpmath.nstr(v / (2 * mpmath.pi), wanted) if v is not None else repr(w / (2 * np.pi))
-                    for w, v in zip(omegas, values)]
-            omega_text = [mpmath.nstr(v, wanted) if v is not None else repr(float(w)) for w, v in zip(omegas, values)]
-        omegas = np.array([float(v) if v is not None else w for w, v in zip(omegas, values)])
-        precision = f"mpmath:{wanted}" + ("" if all(v is not None for v in values) else f" ({distinct_refined} roots)")
+        omegas, precision, text, omega_text = _refined_in_mpmath(
+            deduction, model, finder, omegas, [w for w in omegas if w not in unseparated and (every or w in uncertain)],
+            unseparated, wanted, cut_by_count=count is not None)
     notes = [f"float64 could not tell {m} roots within ±{radius / (2 * np.pi):.3g} Hz of {w / (2 * np.pi):.10g} Hz "
              "apart (a cluster, or a multiple root it could not confirm): they are reported together there"
              for w, (m, radius) in unseparated.items()]
@@ -141,3 +123,34 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.full_order,
                            time.perf_counter() - start, precision=precision, note=note,
                            indeterminate_released=released, frequencies_text=text, omegas_text=omega_text)
+
+
+def _refined_in_mpmath(deduction, model, finder, omegas, chosen, unseparated, digits, cut_by_count):
+    """The roots ``chosen`` (rad/s, of ``omegas``) refined in mpmath to ``digits`` and the
+    clusters in ``unseparated`` separated there (each one separated leaves it).
+
+    The last root may be one of several equal ones cut off by the count
+    (``cut_by_count``): its multiplicity, as a circle counted it, goes to the refinement.
+    Returns (omegas (n,) float, precision label, frequency texts (Hz), omega texts (rad/s)):
+    the texts at ``digits`` where refined, float reprs elsewhere.
+    """
+    top = [omegas[-1]] if cut_by_count and len(chosen) and max(chosen) == omegas[-1] else []
+    cut = {w: finder.multiplicity(w, sorted(set(omegas))) for w in top}
+    refined = dict(zip(chosen, refine_roots(deduction, model, list(chosen), digits,
+                                            {w: m for w, m in cut.items() if m})))
+    values = [refined.get(w) for w in omegas]
+    distinct_refined = len(set(chosen))
+    for w, (m, radius) in list(unseparated.items()):
+        members = separated_cluster(deduction, model, w, m, radius, digits)
+        if members is not None:
+            for i, member in zip([i for i, x in enumerate(omegas) if x == w], members):
+                values[i] = member
+            distinct_refined += len(set(members))
+            del unseparated[w]
+    with mpmath.workdps(digits + 10):  # 2π and the division at the refined precision
+        text = [mpmath.nstr(v / (2 * mpmath.pi), digits) if v is not None else repr(w / (2 * np.pi))
+                for w, v in zip(omegas, values)]
+        omega_text = [mpmath.nstr(v, digits) if v is not None else repr(float(w)) for w, v in zip(omegas, values)]
+    omegas = np.array([float(v) if v is not None else w for w, v in zip(omegas, values)])
+    precision = f"mpmath:{digits}" + ("" if all(v is not None for v in values) else f" ({distinct_refined} roots)")
+    return omegas, precision, text, omega_text

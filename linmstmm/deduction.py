@@ -348,11 +348,25 @@ class Deduction:
         return ubar
 
     def log_det(self, omega, stable: bool = True):
-        """(sign or phase, log|det Ū_all|) over the frequency stack, each shape (n,)."""
+        """(sign or phase, log|det Ū_all|) over the frequency stack, each shape (n,).
+
+        LU with partial pivoting on Ū_all as it is, in its own units. Scaling
+        its rows to max |a| = 1 first (as this did until the 80-mode sweep) let
+        pivoting pick rows whose few large entries cancel, and the small ones
+        that hold det were lost: Ū_all is graded two ways (a thin beam's free
+        tip dominates the rows it enters, a heavy body's force rows the cut's
+        columns), which no diagonal scaling removes. Measured on 350 random
+        models and the MLRS at 14,424 points from 20 to 8000 Hz (real, and
+        complex 0.3 % off the axis), against the exact determinant (mpmath,
+        300 digits where 60 were not enough) of the same float64 matrix:
+        row-scaled LU was off by 1e-6 to 0.23 in log|det| at 25 points (random
+        floating_loops 0 at 80 modes came back 1.2e-5 off, silently), this LU
+        at none.
+        """
         if not stable:
-            return balanced_slogdet(self.matrix(omega))
+            return np.linalg.slogdet(self.matrix(omega))
         ubar, log_scale = self.matrix(omega, stable=True)
-        sign, log_abs = balanced_slogdet(ubar)
+        sign, log_abs = np.linalg.slogdet(ubar)
         return sign, log_abs + log_scale
 
 
@@ -496,19 +510,6 @@ class _Orthonormaliser:
                 self.waiting[key] = PortState(columns, part, size_estimate(part).max(axis=(1, 2)))
         q = q[:, offset:]
         return PortState(columns, q, size_estimate(q).max(axis=(1, 2)))
-
-
-def balanced_slogdet(stack):
-    """slogdet of a (n, N, N) stack after exact power-of-two row scaling.
-
-    Ū_all mixes metres, radians, newtons and newton-metres; scaling every row
-    to max |a| ~ 1 first lets partial pivoting compare like with like, so LU's
-    error stays relative to each row's own size. (Column scaling would change
-    nothing: LU with partial pivoting commutes with it exactly.)
-    """
-    rows = power_of_two_scale(size_estimate(stack).max(axis=2))
-    sign, log_abs = np.linalg.slogdet(stack * rows[:, :, None])
-    return sign, log_abs - np.log(rows).sum(axis=1)
 
 
 def _embed(columns, block, onto):

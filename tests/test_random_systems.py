@@ -20,7 +20,7 @@ import pytest
 
 from linmstmm.fe import fe_frequencies
 from linmstmm.model import load_model
-from linmstmm.solve import natural_frequencies
+from linmstmm.solve import frequency_finder, natural_frequencies
 from linmstmm.topology import build_topology
 from random_models import (KINDS, boundary_labels, junctions, loop_connections, loop_count,
                            mstmm_frequencies, random_model, relative, reordered, tip_bodies,
@@ -214,3 +214,41 @@ def test_a_veering_pair_past_the_fe_refinement_agrees_with_finer_meshes():
     fine, finer = (fe_frequencies(model, count=40, elements_per_beam=n, estimate_error=False).frequencies_hz
                    for n in (2048, 4096))
     assert relative(found, finer + (finer - fine) / 3) <= 1e-8
+
+
+@pytest.mark.parametrize("hz", [2797.02, 3306.1, 3831.7])
+def test_det_of_a_two_way_graded_matrix_is_accurate(hz):
+    """Floating_loops 0 above 2.7 kHz: the thin beam's free tip dominates the rows it
+    enters and the heavy bodies' force rows dominate the loop cut's columns, so Ū_all
+    is graded two ways. LU on it as it is agrees with the 60-digit determinant to
+    1e-8 in log|det|; LU after scaling its rows to max 1 was off by 0.03 to 1.2, and
+    Newton settled on three points that are not roots (the 47th to 51st frequencies
+    came back 1.2e-5 off, silently)."""
+    import mpmath
+
+    from linmstmm.deduction import Deduction
+    from linmstmm.precision import mp_determinant
+
+    deduction = Deduction(build_topology(model("floating_loops", 0)))
+    omega = 2 * np.pi * hz
+    with mpmath.workdps(60):
+        reference = float(mpmath.log(abs(mp_determinant(deduction, mpmath.mpf(omega)))))
+    alone, batch = deduction.log_det(np.array([omega]))[1][0], deduction.log_det(omega * np.array([1, 1.1]))[1][0]
+    assert abs(alone - reference) < 1e-8 and abs(batch - reference) < 1e-8
+
+
+def test_a_two_way_graded_model_has_no_false_roots():
+    """Floating_loops 0's 47th to 52nd frequencies, where the row-scaled LU led Newton to
+    points 1e-5 off that are not roots (see above; all 80 now agree with FE to 3.2e-10,
+    within FE's own estimate of 3.5e-9): the 60-digit determinant changes sign across each one."""
+    import mpmath
+
+    from linmstmm.precision import mp_determinant
+
+    m = model("floating_loops", 0)
+    deduction, finder, _ = frequency_finder(m)
+    found = 2 * np.pi * natural_frequencies(m, 52).frequencies_hz[46:]
+    with mpmath.workdps(60):
+        for omega in found:
+            below, above = (mp_determinant(deduction, mpmath.mpf(omega * (1 + s * 1e-9))) for s in (-1, 1))
+            assert below * above < 0, omega / (2 * np.pi)

@@ -706,8 +706,21 @@ def _lanczos_start(fe: FEModel, flexibility, block: int) -> np.ndarray:
     operator = LinearOperator((n, n), matvec=flexibility, dtype=float)
     start = np.random.default_rng(0).standard_normal(n)
     _, X = eigsh(fe.K, k=block, M=fe.M, sigma=0.0, which="LM", OPinv=operator,
-                 v0=start, ncv=min(n, max(2 * block + 1, 20)))
+                 v0=start, ncv=_lanczos_vectors(n, block))
     return X
+
+
+def _lanczos_vectors(n_dof: int, block: int) -> int:
+    """ARPACK's ``ncv`` for ``block`` modes of an ``n_dof`` model."""
+    return min(n_dof, max(2 * block + 1, 20))
+
+
+def _massive_dofs(fe: FEModel) -> int:
+    """DOFs that carry mass, less the rigid-body modes: at most the rank of K⁺M. A
+    Krylov space of K⁺M cannot grow past it, so ARPACK asked for more vectors than
+    that stops ("could not build an Arnoldi factorization": random trees at 80
+    modes, 204 DOFs of which 198 carry mass, 201 vectors)."""
+    return int(np.count_nonzero(fe.M.diagonal())) - fe.rigid_modes.shape[1]
 
 
 def _block_size(wanted: int) -> int:
@@ -730,7 +743,7 @@ def _lowest_modes(fe: FEModel, flexibility, wanted: int, sweeps: int = 8):
     block = min(_block_size(wanted), fe.n_dof - fe.rigid_modes.shape[1])
     if block <= 0:
         X = np.zeros((fe.n_dof, 0))
-    elif fe.n_dof <= DENSE_LIMIT or 2 * block >= fe.n_dof:
+    elif fe.n_dof <= DENSE_LIMIT or _lanczos_vectors(fe.n_dof, block) >= _massive_dofs(fe):
         X = _dense_start(fe, flexibility)[:, :block]
     else:
         X = _lanczos_start(fe, flexibility, block)

@@ -39,6 +39,8 @@ def add_fe_command(subparsers):
 
 def run_fe(args) -> int:
     """Run ``linmstmm fe``: print a table, or one JSON object with ``--json``."""
+    from scipy.sparse.linalg import ArpackError
+
     from linmstmm.cli import ComputationError, _print_frequency_table, _request
     from linmstmm.fe import fe_frequencies
     from linmstmm.model import load_model
@@ -48,7 +50,7 @@ def run_fe(args) -> int:
     try:
         result = fe_frequencies(model, count=count, fmax=fmax,
                                 elements_per_beam=args.elements_per_beam, rtol=args.rtol)
-    except np.linalg.LinAlgError as error:
+    except (np.linalg.LinAlgError, ArpackError) as error:
         raise ComputationError(f"{args.model}: finite-element solve failed: {error}") from error
     data = result.to_dict()
     if args.json:

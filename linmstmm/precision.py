@@ -183,8 +183,12 @@ def separated_cluster(deduction, model, omega: float, multiplicity: int, radius:
         try:
             for k in range(CLUSTER_POINTS - 1):
                 if values[k] * values[k + 1] < 0:
-                    roots.append(mpmath.findroot(lambda x: mp_determinant(deduction, x), (grid[k], grid[k + 1]),
-                                                 solver="anderson", tol=(tolerance * abs(grid[k])) ** 2))
+                    # (verify=False: findroot would check det(root)² against tol, det being ~1e100)
+                    root = mpmath.findroot(lambda x: mp_determinant(deduction, x), (grid[k], grid[k + 1]),
+                                           solver="anderson", tol=(tolerance * abs(grid[k])) ** 2, verify=False)
+                    if not grid[k] <= root <= grid[k + 1]:
+                        return None
+                    roots.append(root)
             for k in range(1, CLUSTER_POINTS - 1):
                 if (values[k - 1] * values[k] > 0 and values[k] * values[k + 1] > 0
                         and abs(values[k]) < abs(values[k - 1]) and abs(values[k]) < abs(values[k + 1])):

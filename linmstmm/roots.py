@@ -93,6 +93,10 @@ class RootFinder:
     #: Offsets |μ|/ω below this may be a multiple root split by rounding (a count decides);
     #: roots closer than this are reported as one multiple root.
     SPLIT = 1e-4
+    #: An interval this narrow (relative) that a count says holds roots float64 cannot find
+    #: is their enclosure: :meth:`_isolate` reports them at its middle, for
+    #: ``natural_frequencies`` to separate in mpmath (:attr:`unseparated`).
+    CERTIFIED_WIDTH = 1e-9
     #: Offsets |μ|/ω below this are polished as members of the same cluster.
     CLUSTER_WINDOW = 2e-3
     #: :meth:`_narrowed` evaluates this many − 1 equally spaced points per bracket and round.
@@ -136,7 +140,8 @@ class RootFinder:
         self.deferred_members: list[tuple[float, float]] = []  # (start, the root whose pencil gave it)
         #: rad/s: a count found no root from OMEGA_FLOOR up to here (see :meth:`_scanned`)
         self.root_free_below = OMEGA_FLOOR
-        #: root -> (multiplicity, radius rad/s): roots float64 could not tell apart (:meth:`_separated`)
+        #: root -> (multiplicity, radius rad/s): roots float64 could not tell apart (:meth:`_separated`),
+        #: or could not find where a count encloses them (:meth:`_isolate`)
         self.unseparated: dict[float, tuple[int, float]] = {}
         #: root -> multiplicity a circle count gave it (1 where it could not be made; :meth:`_settled`)
         self._counted: dict[float, int] = {}
@@ -504,12 +509,20 @@ class RootFinder:
         """Bisect (lo, hi] on the root count until every root is found.
 
         found : roots already found (anywhere). Returns the roots in (lo, hi].
-        Raises RuntimeError if the count cannot be met.
+        Where (lo, hi] is narrower than CERTIFIED_WIDTH and float64 still finds
+        fewer roots than the count (random ring 12 at 4822.65 Hz: a sign change
+        that regula falsi on det could not narrow), they are all reported at its
+        middle and recorded in :attr:`unseparated`. Raises RuntimeError if the
+        count cannot be met otherwise.
         """
         inside = sorted(r for r in found if lo < r <= hi)
         if len(inside) == expected:
             return inside
-        if depth > 60 or len(inside) > expected or (hi - lo) < 1e-9 * hi:
+        if len(inside) < expected and hi - lo < self.CERTIFIED_WIDTH * hi:
+            middle = (lo + hi) / 2  # the count encloses them: within CERTIFIED_WIDTH / 2 of it
+            self.unseparated[middle] = (expected, (hi - lo) / 2)
+            return [middle] * expected
+        if depth > 60 or len(inside) > expected:
             raise RuntimeError(f"cannot separate the {expected} roots in ({lo:.12g}, {hi:.12g}) "
                                f"rad/s in float64 (found {len(inside)}): det Ū_all is not accurate enough there, "
                                "and --digits only refines the roots float64 has found")

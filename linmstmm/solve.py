@@ -113,8 +113,11 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         omegas, precision, text, omega_text = _refined_in_mpmath(
             deduction, model, finder, omegas, [w for w in omegas if w not in unseparated and (every or w in uncertain)],
             unseparated, wanted, cut_by_count=count is not None)
-    notes = [f"float64 could not tell {m} roots within ±{radius / (2 * np.pi):.3g} Hz of {w / (2 * np.pi):.10g} Hz "
-             "apart (a cluster, or a multiple root it could not confirm): they are reported together there"
+    notes = [(f"float64 could not tell {m} roots within ±{radius / (2 * np.pi):.3g} Hz of {w / (2 * np.pi):.10g} Hz "
+              "apart (a cluster, or a multiple root it could not confirm): they are reported together there")
+             if m > 1 else
+             (f"float64 could not locate the root a count encloses within ±{radius / (2 * np.pi):.3g} Hz of "
+              f"{w / (2 * np.pi):.10g} Hz: it is reported there")
              for w, (m, radius) in unseparated.items()]
     if count is not None and omegas.size < count and fmax is None:
         notes.append(finder.note or f"only {omegas.size} elastic natural frequencies exist below "

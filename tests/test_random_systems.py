@@ -221,8 +221,8 @@ def test_det_of_a_two_way_graded_matrix_is_accurate(hz):
     enters and the heavy bodies' force rows dominate the loop cut's columns, so Ū_all
     is graded two ways. LU on it as it is agrees with the 60-digit determinant to
     1e-8 in log|det|; LU after scaling its rows to max 1 was off by 0.03 to 1.2, and
-    Newton settled on three points that are not roots (the 47th to 51st frequencies
-    came back 1.2e-5 off, silently)."""
+    Newton settled on points that are not roots (seven of the 47th to 55th frequencies
+    came back 1.4e-7 to 1.2e-5 off, silently)."""
     import mpmath
 
     from linmstmm.deduction import Deduction
@@ -238,7 +238,7 @@ def test_det_of_a_two_way_graded_matrix_is_accurate(hz):
 
 def test_a_two_way_graded_model_has_no_false_roots():
     """Floating_loops 0's 47th to 52nd frequencies, where the row-scaled LU led Newton to
-    points 1e-5 off that are not roots (see above; all 80 now agree with FE to 3.2e-10,
+    points up to 1.2e-5 off that are not roots (see above; all 80 now agree with FE to 3.2e-10,
     within FE's own estimate of 3.5e-9): the 60-digit determinant changes sign across each one."""
     import mpmath
 

@@ -274,3 +274,17 @@ def test_roots_a_count_encloses_but_float64_cannot_find_are_separated_in_mpmath(
     with mpmath.workdps(80):
         below, above = (mp_determinant(deduction, root * (1 + s * mpmath.mpf(10) ** -18)) for s in (-1, 1))
     assert below * above < 0
+
+
+def test_a_point_newton_settled_on_is_dropped_where_the_count_finds_no_root():
+    """Random loops 32 at 80 modes: Newton settled at two points in (70001.23, 70004.83)
+    rad/s, which holds one root by the count, and the search raised "cannot separate".
+    The interval is bisected on the count: a part the count finds empty drops what was
+    found there. The root kept has a sign change of det either side of it."""
+    _, finder, _ = frequency_finder(model("loops", 32))
+    lo, hi = 70001.2324288, 70004.8346574
+    (root,) = finder._isolate(lo, hi, 1, [])
+    false = lo + 0.1 * (hi - lo) if root - lo > hi - root else hi - 0.1 * (hi - lo)
+    assert finder._isolate(lo, hi, 1, [root, false]) == [root]
+    sign, _ = finder.log_det(root * (1 + np.array([-1e-9, 1e-9])))
+    assert np.real(sign[0] * sign[1]) < 0

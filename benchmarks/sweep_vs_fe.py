@@ -1,6 +1,6 @@
 """Random models against the FE route: the sweep behind the closing notes of issue 4.
 
-    python benchmarks/sweep_vs_fe.py --modes 80 --seeds 0 32 [--kinds ring loops]
+    python benchmarks/sweep_vs_fe.py --modes 80 --seeds 0 32 [--kinds ring loops] [--digits 20]
 
 For each seed and kind of ``tests/random_models.py`` it solves the lowest
 ``--modes`` frequencies with ``natural_frequencies`` and with ``fe_frequencies``
@@ -37,13 +37,13 @@ AGREEMENT = 1e-7
 TRUSTED = 1e-8
 
 
-def compare(kind: str, seed: int, modes: int) -> tuple[str, str]:
+def compare(kind: str, seed: int, modes: int, digits: int | None = None) -> tuple[str, str]:
     """(verdict, line) for one random model: verdict is "ok", "disagree", "untrusted"
     or "error"."""
     model = random_model(kind, seed)
     started = time.perf_counter()
     try:
-        result = natural_frequencies(model, modes)
+        result = natural_frequencies(model, modes, digits=digits)
     except Exception as error:  # a sweep reports every failure and goes on
         return "error", f"{kind} {seed} MSTMM ERROR {type(error).__name__}: {error}"
     mstmm_seconds = time.perf_counter() - started
@@ -77,11 +77,12 @@ def main() -> None:
     parser.add_argument("--modes", type=int, default=40)
     parser.add_argument("--seeds", type=int, nargs=2, default=(0, 10), metavar=("FIRST", "STOP"))
     parser.add_argument("--kinds", nargs="+", choices=KINDS, default=list(KINDS))
+    parser.add_argument("--digits", type=int, default=None, help="natural_frequencies(digits=...)")
     args = parser.parse_args()
     tally: dict[str, int] = {}
     for seed in range(*args.seeds):
         for kind in args.kinds:
-            verdict, line = compare(kind, seed, args.modes)
+            verdict, line = compare(kind, seed, args.modes, args.digits)
             tally[verdict] = tally.get(verdict, 0) + 1
             print(line, flush=True)
     print(f"{args.modes} modes, seeds {args.seeds[0]}-{args.seeds[1] - 1}: "

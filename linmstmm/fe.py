@@ -918,7 +918,7 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
     lam, X, lam_error = lam[keep][:count], X[:, keep][:, :count], lam_error[keep][:count]
     order = np.argsort(lam)
     frequencies_hz, error_estimate = np.sqrt(lam[order]) / _TWO_PI, np.maximum(lam_error[order], ROUNDOFF) / 2
-    short = np.flatnonzero(error_estimate > rtol) if model.beams and elements_per_beam is None else []
+    refined = bool(model.beams) and elements_per_beam is None
     return FEResult(model=model.name,
                     frequencies_hz=frequencies_hz,
                     rigid_body_modes=fe.rigid_modes.shape[1],
@@ -927,11 +927,13 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
                     n_dof=fe.n_dof,
                     seconds=perf_counter() - started,
                     mode_shapes=(fe.T @ X[:, order]) if mode_shapes else None,
-                    note=_short_of_rtol(frequencies_hz, error_estimate, short, rtol, fe.elements_per_beam))
+                    note=_short_of_rtol(frequencies_hz, error_estimate, rtol, fe.elements_per_beam) if refined else "")
 
 
-def _short_of_rtol(frequencies_hz, error_estimate, short, rtol, elements_per_beam) -> str:
-    """The note of a refinement that stopped at its mesh cap short of ``rtol`` (empty if none is)."""
+def _short_of_rtol(frequencies_hz, error_estimate, rtol, elements_per_beam) -> str:
+    """The note of a refinement that stopped at its mesh cap with estimates above ``rtol``
+    (empty if none is)."""
+    short = np.flatnonzero(error_estimate > rtol)
     if not len(short):
         return ""
     listed = ", ".join(f"{frequencies_hz[i]:.6g} Hz ({error_estimate[i]:.1e})" for i in short[:5])

@@ -73,6 +73,19 @@ def variants(m):
             + [(f"cut at {c}", mstmm_frequencies(m, cut_at=(c,))) for c in cuts])
 
 
+def mp_det_changes_sign(deduction, omega, relative, digits) -> bool:
+    """Whether det Ū_all in mpmath at ``digits`` changes sign between ω(1 ∓ ``relative``):
+    a root there, independently of float64."""
+    import mpmath
+
+    from linmstmm.precision import mp_determinant
+
+    with mpmath.workdps(digits):
+        below, above = (mp_determinant(deduction, mpmath.mpf(omega) * (1 + s * mpmath.mpf(relative)))
+                        for s in (-1, 1))
+        return below * above < 0
+
+
 # --------------------------------------------------------------------------
 
 def test_generator_makes_valid_small_models_with_every_feature(tmp_path):
@@ -240,17 +253,11 @@ def test_a_two_way_graded_model_has_no_false_roots():
     """Floating_loops 0's 47th to 52nd frequencies, where the row-scaled LU led Newton to
     points up to 1.2e-5 off that are not roots (see above; all 80 now agree with FE to 3.2e-10,
     within FE's own estimate of 3.5e-9): the 60-digit determinant changes sign across each one."""
-    import mpmath
-
-    from linmstmm.precision import mp_determinant
-
     m = model("floating_loops", 0)
     deduction, finder, _ = frequency_finder(m)
     found = 2 * np.pi * natural_frequencies(m, 52).frequencies_hz[46:]
-    with mpmath.workdps(60):
-        for omega in found:
-            below, above = (mp_determinant(deduction, mpmath.mpf(omega * (1 + s * 1e-9))) for s in (-1, 1))
-            assert below * above < 0, omega / (2 * np.pi)
+    for omega in found:
+        assert mp_det_changes_sign(deduction, omega, 1e-9, 60), omega / (2 * np.pi)
 
 
 def test_roots_a_count_encloses_but_float64_cannot_find_are_separated_in_mpmath():
@@ -259,9 +266,7 @@ def test_roots_a_count_encloses_but_float64_cannot_find_are_separated_in_mpmath(
     now reported at the middle and recorded as unseparated; in mpmath det changes sign
     inside and the bracketed root is found there (findroot had checked det(root)² ~ 1e218
     against its tolerance and always failed)."""
-    import mpmath
-
-    from linmstmm.precision import mp_determinant, separated_cluster
+    from linmstmm.precision import separated_cluster
 
     m = model("ring", 12)
     deduction, finder, _ = frequency_finder(m)
@@ -271,9 +276,7 @@ def test_roots_a_count_encloses_but_float64_cannot_find_are_separated_in_mpmath(
     assert finder.unseparated == {middle: (1, (hi - lo) / 2)}
     (root,) = separated_cluster(deduction, m, middle, 1, (hi - lo) / 2, 20)
     assert lo < root < hi
-    with mpmath.workdps(80):
-        below, above = (mp_determinant(deduction, root * (1 + s * mpmath.mpf(10) ** -18)) for s in (-1, 1))
-    assert below * above < 0
+    assert mp_det_changes_sign(deduction, root, 1e-18, 80)
 
 
 def test_a_point_newton_settled_on_is_dropped_where_the_count_finds_no_root():

@@ -661,15 +661,15 @@ class RootFinder:
             found = self._recounted(found, doubtful)
 
     def _count_top(self, found: list[float], count: int | None, omega_max: float | None):
-        """Top of the closing count: omega_max, or midway between the count-th root
-        and the next one found (1 % above it if none); None if fewer than ``count``."""
-        if omega_max is not None:
+        """Top of the closing count: midway between the count-th root and the next one
+        found (1 % above it if none), or omega_max, whichever is lower; omega_max with
+        fewer than ``count`` found, None without it."""
+        if count is None or len(found) < count:
             return omega_max
-        if len(found) < count:
-            return None
         top = found[count - 1]
         above = [r for r in found if r > top * (1 + self.SAME_ROOT)]
-        return (top + above[0]) / 2 if above else top * 1.01
+        by_count = (top + above[0]) / 2 if above else top * 1.01
+        return by_count if omega_max is None else min(by_count, omega_max)
 
     def _recovered(self, found: list[float], upper: float, count: int | None = None):
         """(``found`` with the roots below ``upper`` that the closing count says are
@@ -786,9 +786,9 @@ class RootFinder:
             # share a scan step) may make up the count, where scanning on for more would
             # polish roots far above it (MLRS 40 modes: up to 240 Hz for a 43.5 Hz count).
             new = len(brackets) + len(minima) - waiting
-            stalled = omega_max is None and waiting > 0 and new <= (len(found) + waiting) / 4
+            stalled = count is not None and waiting > 0 and new <= (len(found) + waiting) / 4
             if (omega_max is not None and hi >= omega_max or stalled
-                    or omega_max is None and len(found) + len(brackets) + len(minima) >= count):
+                    or count is not None and len(found) + len(brackets) + len(minima) >= count):
                 if count is not None:  # only the lowest candidates matter
                     keep = sorted([(b[0], b) for b in brackets] + [(m, None) for m in minima])[:count - len(found)]
                     brackets = [b for _, b in keep if b is not None]
@@ -802,7 +802,7 @@ class RootFinder:
                 brackets, minima = [], []
                 if count is not None and found and len(found) < count:  # pairs hidden in one scan step?
                     found = self._with_members(found, found[-1])
-                if omega_max is not None or len(found) >= count:
+                if omega_max is not None and hi >= omega_max or count is not None and len(found) >= count:
                     return self._closed(found, count, omega_max, scans)
             # fewer roots than count? (sign changes only: a shallow quiet minimum far
             # below the first root is no evidence that the roots have run out)

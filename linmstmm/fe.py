@@ -79,6 +79,7 @@ import scipy.sparse as sp
 from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import LinearOperator, eigsh, splu
 
+from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Beam, Model
 
 #: A substituted constraint row whose entries all fall below this fraction of
@@ -905,6 +906,8 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
     started = perf_counter()
     if count is None and fmax is None:
         count = 10
+    if count is None:
+        check_range_request(model, fmax)
     lam_max = None if fmax is None else (_TWO_PI * fmax) ** 2
     if not model.beams:
         fe = assemble(model, 1)

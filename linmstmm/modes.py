@@ -34,6 +34,7 @@ import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
+from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
 from linmstmm.nullspace import NULL_TOLERANCE, equilibration
 from linmstmm.solve import frequency_finder
@@ -193,6 +194,8 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         raise ValueError(f"normalization must be one of {NORMALIZATIONS}, got {normalization!r}")
     if stations < 2:
         raise ValueError(f"stations must be >= 2, got {stations}")
+    if fmax is not None and count is None:
+        check_range_request(model, fmax)
     deduction, finder, _ = frequency_finder(model, root)
     omega_max = None if fmax is None else 2 * np.pi * fmax
     eigenspaces = _group(finder.find(None if count is None else count + EIGENSPACE_MARGIN, omega_max))

@@ -8,6 +8,7 @@ import mpmath
 import numpy as np
 
 from linmstmm.deduction import Deduction
+from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
 from linmstmm.nullspace import release_indeterminate
 from linmstmm.precision import refine_roots, separated_cluster
@@ -97,6 +98,8 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     from; used with ``count`` only, and checked by a root count either way.
     """
     start = time.perf_counter()
+    if fmax is not None and count is None:
+        check_range_request(model, fmax)
     deduction, finder, released = frequency_finder(model, root)
     rigid = finder.rigid_body_modes()
     omega_max = None if fmax is None else 2 * np.pi * fmax

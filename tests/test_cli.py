@@ -74,3 +74,19 @@ def test_bad_options_exit_2_with_one_line(args):
     result = run(*args)
     assert result.returncode == 2
     assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
+
+
+@pytest.mark.parametrize("args, says", [
+    (("freqs", "--fmax", "inf"), "--fmax: must be a positive finite number, got inf"),
+    (("freqs", "--fmax", "nan"), "--fmax: must be a positive finite number, got nan"),
+    (("freqs", "--count", "1e3"), "--count: must be a positive integer, got 1e3"),
+    # a beam has infinitely many: these searched without end
+    (("freqs", "--fmax", "1e30"), "fmax = 1e+30 Hz: at least"),
+    (("modes", "--fmax", "1e7"), "fmax = 1e+07 Hz: at least 21363 natural frequencies lie below it"),
+    (("fe", "--fmax", "1e7"), "fmax = 1e+07 Hz: at least 21363 natural frequencies lie below it"),
+])
+def test_requests_without_end_exit_2_naming_the_option(args, says):
+    command, *options = args
+    result = run(command, "models/cantilever_tip_mass.toml", *options)
+    assert result.returncode == 2 and result.stdout == ""
+    assert result.stderr.count("\n") == 1 and says in result.stderr

@@ -123,8 +123,8 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
               f"{w / (2 * np.pi):.10g} Hz: it is reported there")
              for w, (m, radius) in unseparated.items()]
     if count is not None and omegas.size < count and fmax is None:
-        notes.append(finder.note or f"only {omegas.size} elastic natural frequencies exist below "
-                                    f"{OMEGA_CEILING:.3g} rad/s")
+        notes.append(f"only {omegas.size} elastic natural frequencies were found: {finder.note}" if finder.note else
+                     f"only {omegas.size} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s")
     note = "; ".join(notes)
     return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.full_order,
                            time.perf_counter() - start, precision=precision, note=note,

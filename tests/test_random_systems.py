@@ -306,3 +306,17 @@ def test_brackets_left_out_above_the_count_are_taken_before_scanning_on():
     finder.matrix = lambda omega: highest.append(np.max(np.abs(omega))) or matrix(omega)
     roots = finder.find(80, None)
     assert len(roots) == 80 and max(highest) < 10 * roots[-1]
+
+
+def test_a_model_without_beams_asked_for_more_modes_than_it_has_says_how_many_were_found():
+    """Random ring 5 (three bodies, three springs) has 11 elastic modes by the FE route,
+    exact for bodies and springs; 80 asked for: the 11, and a note that says so and why
+    the search stopped (it read "search stopped at 1.064e+08 rad/s (...)")."""
+    ring = model("ring", 5)
+    assert not ring.beams
+    result = natural_frequencies(ring, 80)
+    reference = fe_frequencies(ring, count=80).frequencies_hz
+    assert len(reference) == 11
+    np.testing.assert_allclose(result.frequencies_hz, reference, rtol=1e-9)
+    assert result.note.startswith("only 11 elastic natural frequencies were found: the search stopped at")
+    assert "times the highest" in result.note

@@ -46,15 +46,17 @@ def clamped_modes_below(model: Model, omega: float) -> int:
     return total
 
 
-def check_range_request(model: Model, fmax: float) -> None:
+def check_range_request(model: Model, fmax: float, request: str | None = None,
+                        instead: str = "ask for a lower fmax, or for the lowest N by count") -> None:
     """Raise ModelError if every frequency up to ``fmax`` (Hz) is asked for and
     :func:`clamped_modes_below` puts more than MAX_RANGE_MODES there, or fmax is not
-    a positive finite number."""
-    where = model.source or model.name
+    a positive finite number. request : how the message names the request
+    (default ``fmax = … Hz``); instead : what it advises."""
+    where, request = model.source or model.name, request or f"fmax = {fmax:g} Hz"
     if not (math.isfinite(fmax) and fmax > 0):
-        raise ModelError(where, f"fmax = {fmax:g} Hz: must be a positive finite frequency")
+        raise ModelError(where, f"{request}: must be a positive finite frequency")
     at_least = clamped_modes_below(model, 2 * math.pi * fmax)
     if at_least > MAX_RANGE_MODES:
-        raise ModelError(where, f"fmax = {fmax:g} Hz: at least {at_least} natural frequencies lie below "
-                                f"it (the beams' clamped-end modes alone); a range is searched for at most "
-                                f"{MAX_RANGE_MODES}: ask for a lower fmax, or for the lowest N by count")
+        raise ModelError(where, f"{request}: at least {at_least} natural frequencies lie below {fmax:g} Hz "
+                                f"(the beams' clamped-end modes alone); a range is searched for at most "
+                                f"{MAX_RANGE_MODES}: {instead}")

@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from linmstmm.mode_bound import check_range_request
 from linmstmm.model import COMPONENTS, Model, ModelError, _did_you_mean, load_model
 from linmstmm.modes import ModalResult, mac_matrix, mode_shapes
 
@@ -249,6 +250,7 @@ def run_scan(args) -> int:
     from linmstmm.solve import frequency_finder
 
     model = load_model(args.model)
+    check_range_request(model, args.fmax)
     deduction, finder, _ = frequency_finder(model)
     omega_max = 2 * np.pi * args.fmax
     grid = omega_max * np.arange(1, args.points + 1) / args.points
@@ -349,6 +351,9 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
     if direction not in COMPONENTS:
         raise ModelError(model.source or model.name, f"direction must be one of {', '.join(COMPONENTS)}, "
                          f"got {direction!r}", key="--direction")
+    if not modes:
+        check_range_request(model, FRF_MODE_REACH * fmax, f"--fmax {fmax:g} Hz (the modal sum takes every mode "
+                            f"up to {FRF_MODE_REACH:g} x fmax)", "ask for a lower fmax, or for N modes by --modes")
     shapes = _mode_shapes(model, modes, None if modes else FRF_MODE_REACH * fmax)
     sweep = fmax * np.arange(1, frequencies + 1) / frequencies
     result = frf(shapes, point, np.eye(6)[COMPONENTS.index(direction)], sweep, targets, model.damping)

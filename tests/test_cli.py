@@ -82,8 +82,12 @@ def test_bad_options_exit_2_with_one_line(args):
     (("freqs", "--count", "1e3"), "--count: must be a positive integer, got 1e3"),
     # a beam has infinitely many: these searched without end
     (("freqs", "--fmax", "1e30"), "fmax = 1e+30 Hz: at least"),
-    (("modes", "--fmax", "1e7"), "fmax = 1e+07 Hz: at least 21363 natural frequencies lie below it"),
-    (("fe", "--fmax", "1e7"), "fmax = 1e+07 Hz: at least 21363 natural frequencies lie below it"),
+    (("modes", "--fmax", "1e7"), "fmax = 1e+07 Hz: at least 21363 natural frequencies lie below 1e+07 Hz"),
+    (("fe", "--fmax", "1e7"), "fmax = 1e+07 Hz: at least 21363 natural frequencies lie below 1e+07 Hz"),
+    (("scan", "--fmax", "1e7", "--plot", "never-written.png"), "fmax = 1e+07 Hz: at least 21363"),
+    (("frf", "--point", "tip", "--direction", "y", "--fmax", "1e7", "--plot", "never-written.png"),
+     "--fmax 1e+07 Hz (the modal sum takes every mode up to 2 x fmax): at least 42037 natural frequencies "
+     "lie below 2e+07 Hz"),
 ])
 def test_requests_without_end_exit_2_naming_the_option(args, says):
     command, *options = args

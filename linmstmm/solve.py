@@ -122,9 +122,10 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
              (f"float64 could not locate the root a count encloses within ±{radius / (2 * np.pi):.3g} Hz of "
               f"{w / (2 * np.pi):.10g} Hz: it is reported there")
              for w, (m, radius) in unseparated.items()]
-    if count is not None and omegas.size < count and fmax is None:
-        notes.append(f"only {omegas.size} elastic natural frequencies were found: {finder.note}" if finder.note else
-                     f"only {omegas.size} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s")
+    if finder.note:  # the search stopped short of what was asked (count or fmax)
+        notes.append(f"only {omegas.size} elastic natural frequencies were found: {finder.note}")
+    elif count is not None and omegas.size < count and fmax is None:
+        notes.append(f"only {omegas.size} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s")
     note = "; ".join(notes)
     return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.full_order,
                            time.perf_counter() - start, precision=precision, note=note,

@@ -320,3 +320,14 @@ def test_a_model_without_beams_asked_for_more_modes_than_it_has_says_how_many_we
     np.testing.assert_allclose(result.frequencies_hz, reference, rtol=1e-9)
     assert result.note.startswith("only 11 elastic natural frequencies were found: the search stopped at")
     assert "times the highest" in result.note
+
+
+def test_a_range_the_search_could_not_finish_says_where_it_stopped():
+    """Random ring 5 up to 2e7 Hz (1.26e8 rad/s): det Ū_all cannot be counted above
+    1.05e8 rad/s, where inertia swamps it, so the search stops there. The 11 found are
+    the FE route's 11, and the note says where it stopped (it said nothing, as if
+    the range had been searched to its end)."""
+    result = natural_frequencies(model("ring", 5), count=None, fmax=2e7)
+    np.testing.assert_allclose(result.frequencies_hz, fe_frequencies(model("ring", 5), count=80).frequencies_hz,
+                               rtol=1e-9)
+    assert result.note.startswith("only 11 elastic natural frequencies were found: the search stopped at 1.05")

@@ -901,7 +901,8 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
     mode_shapes : also return mass-normalised full mode vectors.
 
     Zero-frequency rigid-body modes are counted structurally (see the module
-    notes), not by a threshold on computed eigenvalues.
+    notes), not by a threshold on computed eigenvalues. ``fmax`` alone is checked
+    as :func:`linmstmm.solve.natural_frequencies` checks it (ModelError).
     """
     started = perf_counter()
     if count is None and fmax is None:

@@ -189,6 +189,7 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         made positive either way.
     rigid_body : include the zero-frequency modes first.
     root : boundary end to use as the root of the transfer tree.
+    ``fmax`` alone is checked as :func:`linmstmm.solve.natural_frequencies` checks it.
     """
     if normalization not in NORMALIZATIONS:
         raise ValueError(f"normalization must be one of {NORMALIZATIONS}, got {normalization!r}")

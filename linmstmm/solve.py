@@ -96,6 +96,9 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     root : boundary end (point name) to use as the root of the transfer tree.
     guess_hz : frequencies of a similar model (a neighbouring scene) to start
     from; used with ``count`` only, and checked by a root count either way.
+    Raises ModelError for ``fmax`` alone that is not finite, or below which the
+    beams have more modes than a range is searched for
+    (:func:`~linmstmm.mode_bound.check_range_request`).
     """
     start = time.perf_counter()
     if fmax is not None and count is None:

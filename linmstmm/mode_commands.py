@@ -144,7 +144,8 @@ def modes_summary(result: ModalResult, model: Model) -> dict:
     keys = ("model", "natural_freq_hz", "rigid_body_modes", "normalization", "modal_mass",
             "modal_stiffness", "mass_orthogonality_error", "stiffness_orthogonality_error",
             "point_displacements")
-    return {key: full[key] for key in keys} | {"points": list(model.points)}
+    return {key: full[key] for key in keys} | {"points": list(model.points)} | (
+        {"note": result.note} if result.note else {})
 
 
 def _print_modes(data: dict) -> None:
@@ -163,6 +164,8 @@ def _print_modes(data: dict) -> None:
         elastic = data["natural_freq_hz"][data["rigid_body_modes"]:]
         for f, row in zip(elastic, matrix):
             print(f"  {f:>14.6g}  " + "".join(f"{value:>9.4f}" for value in row))
+    if data.get("note"):
+        print(f"  note: {data['note']}")
     for file in data["files"]:
         print(f"  wrote {file}")
 

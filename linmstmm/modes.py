@@ -37,7 +37,7 @@ from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
 from linmstmm.nullspace import NULL_TOLERANCE, equilibration
-from linmstmm.solve import frequency_finder
+from linmstmm.solve import frequency_finder, search_note
 
 #: Normalisations of the modes: unit modal mass, or unit largest translation.
 NORMALIZATIONS = ("mass", "max")
@@ -87,6 +87,7 @@ class ModalResult:
     com_displacements : rigid body -> (n, 6) at its mass centre.
     beam_fields : beam -> :class:`BeamField`.
     normalization : "mass" or "max" (largest translation of each mode = 1 m).
+    note : what the search must say ("" if nothing; see :func:`linmstmm.solve.search_note`).
     """
 
     model: str
@@ -103,6 +104,7 @@ class ModalResult:
     com_displacements: dict[str, np.ndarray]
     beam_fields: dict[str, BeamField]
     normalization: str
+    note: str = ""
 
     @property
     def natural_freq(self) -> np.ndarray:
@@ -150,6 +152,7 @@ class ModalResult:
             "omega": self.omega.tolist(),
             "rigid_body_modes": self.rigid_body_modes,
             "normalization": self.normalization,
+            **({"note": self.note} if self.note else {}),
             "modal_mass": self.modal_mass.tolist(),
             "modal_stiffness": self.modal_stiffness.tolist(),
             "mass_orthogonality_error": self.mass_orthogonality_error,
@@ -203,6 +206,9 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
     if count is not None:  # whole eigenspaces that start within the first ``count`` modes
         starts = np.cumsum([0] + [m for _, m in eigenspaces])
         eigenspaces = eigenspaces[:int(np.searchsorted(starts, count))]
+    elastic = sum(m for _, m in eigenspaces)
+    note = search_note(finder, elastic, {w: finder.unseparated[w] for w, _ in eigenspaces if w in finder.unseparated},
+                       count, fmax)
     if rigid_body and (rigid := finder.rigid_body_modes()):
         eigenspaces.insert(0, (0.0, rigid))
     omega = np.repeat([w for w, _ in eigenspaces], [m for _, m in eigenspaces])
@@ -223,7 +229,7 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         {beam.name: BeamField(raw.stations[beam.name], _station_positions(model, beam, raw),
                               fields.station_states[beam.name][..., :6])
          for beam in model.beams},
-        normalization)
+        normalization, note)
 
 
 # --- eigenspaces ------------------------------------------------------------

@@ -119,20 +119,29 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         omegas, precision, text, omega_text = _refined_in_mpmath(
             deduction, model, finder, omegas, [w for w in omegas if w not in unseparated and (every or w in uncertain)],
             unseparated, wanted, cut_by_count=count is not None)
+    note = search_note(finder, omegas.size, unseparated, count, fmax)
+    return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.full_order,
+                           time.perf_counter() - start, precision=precision, note=note,
+                           indeterminate_released=released, frequencies_text=text, omegas_text=omega_text)
+
+
+def search_note(finder: RootFinder, found: int, unseparated: dict, count: int | None, fmax: float | None) -> str:
+    """What a result of ``found`` elastic roots, asked for by ``count`` and/or ``fmax``,
+    must say about its search ("" if nothing): each cluster float64 could not separate
+    (``unseparated``: root rad/s -> (multiplicity, radius rad/s)), a search that stopped
+    short of what was asked (:attr:`RootFinder.note`), or that fewer than ``count`` exist."""
     notes = [(f"float64 could not tell {m} roots within ±{radius / (2 * np.pi):.3g} Hz of {w / (2 * np.pi):.10g} Hz "
               "apart (a cluster, or a multiple root it could not confirm): they are reported together there")
              if m > 1 else
              (f"float64 could not locate the root a count encloses within ±{radius / (2 * np.pi):.3g} Hz of "
               f"{w / (2 * np.pi):.10g} Hz: it is reported there")
              for w, (m, radius) in unseparated.items()]
-    if finder.note:  # the search stopped short of what was asked (count or fmax)
-        notes.append(f"only {omegas.size} elastic natural frequencies were found: {finder.note}")
-    elif count is not None and omegas.size < count and fmax is None:
-        notes.append(f"only {omegas.size} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s")
-    note = "; ".join(notes)
-    return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.full_order,
-                           time.perf_counter() - start, precision=precision, note=note,
-                           indeterminate_released=released, frequencies_text=text, omegas_text=omega_text)
+    fewer = count is not None and found < count
+    if finder.note and (fewer or count is None):  # the search stopped short of what was asked
+        notes.append(f"only {found} elastic natural frequencies were found: {finder.note}")
+    elif fewer and fmax is None:
+        notes.append(f"only {found} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s")
+    return "; ".join(notes)
 
 
 def _refined_in_mpmath(deduction, model, finder, omegas, chosen, unseparated, digits, cut_by_count):

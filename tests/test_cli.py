@@ -38,6 +38,15 @@ def test_freqs_says_when_fewer_modes_exist_than_asked_for():
     assert len(data["frequencies_hz"]) == 6 and data["note"].startswith("only 6 elastic")
 
 
+def test_modes_say_when_fewer_modes_exist_than_asked_for():
+    """As freqs does: the table and the JSON of ``modes`` both carry the note."""
+    table = run("modes", "models/spring_mass_chain.toml", "--count", "10")
+    assert table.returncode == 0, table.stderr
+    assert "note: only 6 elastic natural frequencies exist" in table.stdout
+    data = json.loads(run("modes", "models/spring_mass_chain.toml", "--count", "10", "--json").stdout)
+    assert len(data["natural_freq_hz"]) == 6 and data["note"].startswith("only 6 elastic")
+
+
 def test_freqs_fmax_and_count_stop_at_whichever_comes_first():
     by_fmax = json.loads(run("freqs", "models/cantilever_tip_mass.toml", "--json", "--fmax", "100").stdout)
     assert by_fmax["frequencies_hz"] == sorted(by_fmax["frequencies_hz"])

@@ -331,3 +331,17 @@ def test_a_range_the_search_could_not_finish_says_where_it_stopped():
     np.testing.assert_allclose(result.frequencies_hz, fe_frequencies(model("ring", 5), count=80).frequencies_hz,
                                rtol=1e-9)
     assert result.note.startswith("only 11 elastic natural frequencies were found: the search stopped at 1.05")
+
+
+def test_mode_shapes_say_what_the_frequencies_say():
+    """The same ring 5, 80 modes asked for by mode_shapes: the 11, with the note
+    natural_frequencies gives (mode shapes came back with no word of the 69 missing;
+    where the search stopped depends on how many it looked for); 11 asked for: the 11
+    and no note."""
+    from linmstmm.modes import mode_shapes
+
+    short = mode_shapes(model("ring", 5), 80)
+    assert short.omega.size - short.rigid_body_modes == 11
+    assert short.note.startswith("only 11 elastic natural frequencies were found: the search stopped at")
+    assert short.to_dict()["note"] == short.note
+    assert mode_shapes(model("ring", 5), 11).note == ""

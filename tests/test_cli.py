@@ -29,22 +29,14 @@ def test_freqs_json_follows_the_contract():
     np.testing.assert_allclose(data["frequencies_hz"], expected, rtol=1e-12)
 
 
-def test_freqs_says_when_fewer_modes_exist_than_asked_for():
+@pytest.mark.parametrize("command, key", [("freqs", "frequencies_hz"), ("modes", "natural_freq_hz")])
+def test_fewer_modes_than_asked_for_are_noted(command, key):
     """6 degrees of freedom, 10 asked: the table and the JSON both carry the note."""
-    table = run("freqs", "models/spring_mass_chain.toml", "--count", "10")
+    table = run(command, "models/spring_mass_chain.toml", "--count", "10")
     assert table.returncode == 0, table.stderr
     assert "note: only 6 elastic natural frequencies exist" in table.stdout
-    data = json.loads(run("freqs", "models/spring_mass_chain.toml", "--count", "10", "--json").stdout)
-    assert len(data["frequencies_hz"]) == 6 and data["note"].startswith("only 6 elastic")
-
-
-def test_modes_say_when_fewer_modes_exist_than_asked_for():
-    """As freqs does: the table and the JSON of ``modes`` both carry the note."""
-    table = run("modes", "models/spring_mass_chain.toml", "--count", "10")
-    assert table.returncode == 0, table.stderr
-    assert "note: only 6 elastic natural frequencies exist" in table.stdout
-    data = json.loads(run("modes", "models/spring_mass_chain.toml", "--count", "10", "--json").stdout)
-    assert len(data["natural_freq_hz"]) == 6 and data["note"].startswith("only 6 elastic")
+    data = json.loads(run(command, "models/spring_mass_chain.toml", "--count", "10", "--json").stdout)
+    assert len(data[key]) == 6 and data["note"].startswith("only 6 elastic")
 
 
 def test_freqs_fmax_and_count_stop_at_whichever_comes_first():

@@ -250,7 +250,7 @@ def _mac_figure(result: ModalResult, model: Model, comparison, directory: Path) 
 def run_scan(args) -> int:
     """Run ``linmstmm scan``; returns the exit status 0."""
     from linmstmm.plot import plot_scan
-    from linmstmm.solve import frequency_finder
+    from linmstmm.solve import frequency_finder, search_note
 
     model = load_model(args.model)
     check_range_request(model, args.fmax)
@@ -262,15 +262,20 @@ def run_scan(args) -> int:
     with _writing(model, "--plot", args.plot):
         plot_scan(grid, sign, log_abs, roots, np.searchsorted(roots, grid, side="right"), args.plot,
                   title=f"{model.name}: det Ū_all, {roots.size} natural frequencies up to {args.fmax:g} Hz")
+    note = search_note(finder, roots.size, {w: finder.unseparated[w] for w in set(roots) if w in finder.unseparated},
+                       None, args.fmax)
     data = {"model": model.name, "fmax_hz": args.fmax, "points": args.points,
             "ubar_order": deduction.full_order, "rigid_body_modes": finder.rigid_body_modes(),
-            "frequencies_hz": (roots / (2 * np.pi)).tolist(), "plot": str(args.plot)}
+            "frequencies_hz": (roots / (2 * np.pi)).tolist(), "plot": str(args.plot),
+            **({"note": note} if note else {})}
     if args.json:
         print(json.dumps(data))
     else:
         print(f"{model.name}: det Ubar_all (order {data['ubar_order']}) scanned at {args.points} "
               f"frequencies up to {args.fmax:g} Hz")
         print(f"  natural frequencies [Hz]: {', '.join(f'{f:.8g}' for f in data['frequencies_hz']) or 'none'}")
+        if note:
+            print(f"  note: {note}")
         print(f"  wrote {args.plot}")
     return 0
 

@@ -345,3 +345,19 @@ def test_mode_shapes_say_what_the_frequencies_say():
     assert short.note.startswith("only 11 elastic natural frequencies were found: the search stopped at")
     assert short.to_dict()["note"] == short.note
     assert mode_shapes(model("ring", 5), 11).note == ""
+
+
+def test_scan_says_where_its_search_stopped(tmp_path, capsys):
+    """``linmstmm scan`` of ring 5 up to 2e7 Hz: the 11 frequencies, and the note of the
+    search that stopped at 1.05e8 rad/s (it printed the 11 as if the range were done)."""
+    import json
+
+    from linmstmm.cli import main
+
+    path = tmp_path / "ring5.toml"
+    path.write_text(to_toml(model("ring", 5)))
+    assert main(["scan", str(path), "--fmax", "2e7", "--points", "50", "--plot", str(tmp_path / "s.png"),
+                 "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert len(data["frequencies_hz"]) == 11
+    assert data["note"].startswith("only 11 elastic natural frequencies were found: the search stopped at")

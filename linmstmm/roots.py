@@ -641,8 +641,12 @@ class RootFinder:
 
     def _polished(self, starts, found: list[float], confirm: bool = True) -> list[float]:
         """``found`` with the roots (and their clusters) Newton reaches from ``starts``."""
+        return self._with_groups(found, self.clusters(starts, confirm))
+
+    def _with_groups(self, found: list[float], groups) -> list[float]:
+        """``found`` (left as it is) with each group's roots merged in (:meth:`_merge`), ascending."""
         found = list(found)
-        for members in self.clusters(starts, confirm):
+        for members in groups:
             self._merge(found, members, OMEGA_FLOOR, np.inf)
         return sorted(found)
 
@@ -816,10 +820,8 @@ class RootFinder:
                     minima = [m for m, b in keep if b is None]
                 found = self._polished(minima, found, confirm=False)
                 if brackets:
-                    for members in self._bracketed(*map(np.array, zip(*brackets)), confirm=False,
-                                                   needed=count, known=found):
-                        self._merge(found, members, OMEGA_FLOOR, np.inf)
-                    found.sort()
+                    found = self._with_groups(found, self._bracketed(*map(np.array, zip(*brackets)), confirm=False,
+                                                                     needed=count, known=found))
                 brackets, minima = [], []
                 if count is not None and found and len(found) < count:  # pairs hidden in one scan step?
                     found = self._with_members(found, found[-1])
@@ -900,10 +902,7 @@ class RootFinder:
         self.left_out.sort()
         lo, hi = map(np.array, zip(*self.left_out[:missing]))
         self.left_out = self.left_out[missing:]
-        found = list(found)
-        for members in self._narrowed_groups(lo, hi, [found], confirm=False):
-            self._merge(found, members, OMEGA_FLOOR, np.inf)
-        return sorted(found)
+        return self._with_groups(found, self._narrowed_groups(lo, hi, [found], confirm=False))
 
     def _member_starts(self, found: list[float], upper: float = np.inf) -> list[float]:
         """The :attr:`deferred_members` below ``upper`` that may lead to a root not in
@@ -953,10 +952,10 @@ class RootFinder:
             brackets += zip(grid[change], grid[change + 1])
             minima += list(grid[_quiet_minima(piece_sign, piece_log)])
         found = self._polished(minima, found, confirm=False)
-        if brackets:
-            for root in self._bracket_roots(*map(np.array, zip(*brackets)), log_det=reduced):
-                self._merge(found, [root], OMEGA_FLOOR, np.inf)
-        return sorted(found)
+        if not brackets:
+            return found
+        return self._with_groups(found, [[root] for root in self._bracket_roots(*map(np.array, zip(*brackets)),
+                                                                                  log_det=reduced)])
 
     def _recounted(self, found: list[float], roots) -> list[float]:
         """``found`` with the multiplicity of each of ``roots`` (distinct, in ``found``)

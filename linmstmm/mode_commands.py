@@ -262,8 +262,7 @@ def run_scan(args) -> int:
     with _writing(model, "--plot", args.plot):
         plot_scan(grid, sign, log_abs, roots, np.searchsorted(roots, grid, side="right"), args.plot,
                   title=f"{model.name}: det Ū_all, {roots.size} natural frequencies up to {args.fmax:g} Hz")
-    note = search_note(finder, roots.size, {w: finder.unseparated[w] for w in set(roots) if w in finder.unseparated},
-                       None, args.fmax)
+    note = search_note(finder, roots.size, finder.unseparated_among(roots), None, args.fmax)
     data = {"model": model.name, "fmax_hz": args.fmax, "points": args.points,
             "ubar_order": deduction.full_order, "rigid_body_modes": finder.rigid_body_modes(),
             "frequencies_hz": (roots / (2 * np.pi)).tolist(), "plot": str(args.plot),

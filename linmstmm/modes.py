@@ -207,8 +207,7 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         starts = np.cumsum([0] + [m for _, m in eigenspaces])
         eigenspaces = eigenspaces[:int(np.searchsorted(starts, count))]
     elastic = sum(m for _, m in eigenspaces)
-    note = search_note(finder, elastic, {w: finder.unseparated[w] for w, _ in eigenspaces if w in finder.unseparated},
-                       count, fmax)
+    note = search_note(finder, elastic, finder.unseparated_among([w for w, _ in eigenspaces]), count, fmax)
     if rigid_body and (rigid := finder.rigid_body_modes()):
         eigenspaces.insert(0, (0.0, rigid))
     omega = np.repeat([w for w, _ in eigenspaces], [m for _, m in eigenspaces])

@@ -989,6 +989,10 @@ class RootFinder:
                                   initial_points=17)
         return [None if isinstance(c, RuntimeError) else max(c, 1) for c in counts]
 
+    def unseparated_among(self, roots) -> dict:
+        """The :attr:`unseparated` entries of ``roots`` (rad/s), ascending."""
+        return {r: self.unseparated[r] for r in sorted(set(roots)) if r in self.unseparated}
+
     def multiplicity(self, root: float, others=()) -> int | None:
         """How many roots sit at ``root``: the circle count already made for it while
         finding the roots, else one made now (:meth:`multiplicities`)."""

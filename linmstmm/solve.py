@@ -111,7 +111,7 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     else:
         omegas = np.array(finder.find(count, omega_max))
     precision, text, omega_text = "float64", None, None
-    unseparated = {w: finder.unseparated[w] for w in sorted(set(omegas)) if w in finder.unseparated}
+    unseparated = finder.unseparated_among(omegas)
     uncertain = sorted({w for w in omegas if finder.last_step.get(w, 0.0) > CERTIFIED_STEP} - set(unseparated))
     every = bool(digits and digits > FLOAT64_DIGITS)
     wanted = digits if every else (ESCALATION_DIGITS if uncertain or unseparated else None)

@@ -59,13 +59,16 @@ OMEGA_FLOOR = 1e-3
 #: The scan for ``count`` roots gives up above this circular frequency, rad/s.
 OMEGA_CEILING = 1e9
 #: Starting points of a half-ellipse count with the known roots divided out.
-DEFLATED_POINTS = 33
+DEFLATED_POINTS = 17
+#: Starting points of a count over a small circle (a multiplicity).
+CIRCLE_POINTS = 9
 #: Points a count with the known roots divided out may take before it fails. Such a
-#: phase hardly turns: the fast path's took at most 423 on 40 random models at 80 modes.
-#: One that did not settle took 20,000 (the default limit) twice over, and random
+#: phase hardly turns: the fast path's took at most 423 on 40 random models at 80 modes
+#: (before each point carried its derivative, at twice the evaluations: half as many now).
+#: One that did not settle took 20,000 (the limit then) twice over, and random
 #: floating_loops 70 at 80 modes spent 100 s on it before the segment search found
 #: all 80 in 2 s.
-DEFLATED_MAX_POINTS = 2000
+DEFLATED_MAX_POINTS = 1000
 
 
 class RootFinder:
@@ -362,7 +365,7 @@ class RootFinder:
         counts share one evaluation per refinement round. The circle holds one
         root (of some multiplicity m) at its centre and no other within twice
         its radius, so the phase turns smoothly by mπ over the half circle and
-        17 starting points (refined where a step exceeds π/4) suffice.
+        CIRCLE_POINTS starting points (refined where log det changes fast) suffice.
         Without ``confirm`` the number of offsets below SPLIT·ω is taken as it
         is: for a caller that counts all its roots at the end anyway.
         """
@@ -379,7 +382,7 @@ class RootFinder:
             radius = min(self.SPLIT * centre, farther.min() / 2 if farther.size else np.inf)
             asked.append(i)
             intervals.append((centre - radius, centre + radius))
-        counts = count_zeros_many(self.log_det, intervals, initial_points=17) if asked else []
+        counts = count_zeros_many(self.log_det, intervals, initial_points=CIRCLE_POINTS) if asked else []
         for i, count in zip(asked, counts):
             multiplicities[i] = 1 if isinstance(count, RuntimeError) else max(count, 1)
         self._counted.update((polished[i][0], multiplicities[i]) for i in asked)
@@ -754,7 +757,7 @@ class RootFinder:
         The count runs on det with the known roots divided out (:func:`~linmstmm.counting.deflated`),
         so its phase turns only for zeros not in ``known`` (or by −π for a
         ``known`` one that is not a zero) and DEFLATED_POINTS starting points
-        suffice where counting them all took 65 and a refinement round. Known
+        suffice where counting them all took four times as many. Known
         roots above ``upper`` are divided out too: outside the contour they
         change nothing, and the next root just above ``upper`` no longer turns
         the phase fast near the contour's end (MLRS 20 modes: three refinement
@@ -986,7 +989,7 @@ class RootFinder:
             return []
         radii = [self._circle_radius(r, others) for r in roots]
         counts = count_zeros_many(self.log_det, [(r - radius, r + radius) for r, radius in zip(roots, radii)],
-                                  initial_points=17)
+                                  initial_points=CIRCLE_POINTS)
         return [None if isinstance(c, RuntimeError) else max(c, 1) for c in counts]
 
     def unseparated_among(self, roots) -> dict:
@@ -1065,7 +1068,7 @@ class RootFinder:
             return roots
         radii = [self._circle_radius(r, distinct) for r in multiple]
         tight = count_zeros_many(self.log_det, [(r - radius / 100, r + radius / 100)
-                                                for r, radius in zip(multiple, radii)], initial_points=17)
+                                                for r, radius in zip(multiple, radii)], initial_points=CIRCLE_POINTS)
         separated = list(roots)
         for r, radius, count in zip(multiple, radii, tight):
             m = self._counted.get(r, roots.count(r))  # (``roots`` may end inside a multiple root)

@@ -185,6 +185,19 @@ def test_count_with_known_roots_divided_out_sees_a_missing_or_a_false_one():
     assert count_zeros(deflated(finder.log_det, exact[:3]), 1e-3, upper) == 3
 
 
+@pytest.mark.parametrize("zeros", [80, 120, 200])
+def test_a_count_sees_every_turn_of_a_steadily_winding_phase(zeros):
+    """sin ω has its zeros at kπ. Along the top of the counting ellipse |sin ω| hardly
+    changes while its phase winds steadily, so samples a whole turn apart look like
+    none: the count of the zeros in (0.5, (n + ½)π) came out 40, 100 and 128 for
+    n = 80, 120 and 200 before each point carried the derivative of log det."""
+    def log_sin(omega):
+        value = np.sin(np.asarray(omega, dtype=complex))
+        return value / np.abs(value), np.log(np.abs(value))
+
+    assert count_zeros(log_sin, 0.5, (zeros + 0.5) * np.pi) == zeros
+
+
 def test_a_count_across_a_phase_jump_fails_fast():
     """Far above a discrete model's last root det is rounding noise and its phase
     can jump; the count must say it cannot count, not bisect towards the jump

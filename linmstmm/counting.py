@@ -38,9 +38,12 @@ MAX_POINTS = 10000
 #: the same fraction of a small circle (a multiplicity count) as of a wide ellipse.
 #: It is no smaller because the difference amplifies the rounding noise of log det by
 #: its inverse: far above a discrete model's last root, where det is rounding noise,
-#: a step of 1e-7 (relative to ω) made counts fail 2.5 times slower, refining on noise.
-#: Features narrower than this are the sampled steps' to see.
-DERIVATIVE_STEP = 1e-3
+#: counts refine on that noise before they fail. Figure 11.7's ring of three masses
+#: asked for 4 modes (tests/test_seed_topologies.py) took 1.6 s before derivatives,
+#: and with steps of 1e-3, 4e-3 (this) and 1e-2: 3.3, 1.8 and 2.5 s (1e-7 relative to
+#: ω, with twice the point limits: 14 s). Features narrower than this are the sampled
+#: steps' to see.
+DERIVATIVE_STEP = 4e-3
 
 
 def deflated(log_det, roots):
@@ -122,10 +125,11 @@ def _half_windings(log_det, paths, wheres, max_points: int, initial_points: int 
     log det (log|det| + i arg det, analytic) along the path at either point (a
     difference, evaluated with the point), and that derivative changes by at most
     LOG_STEP / step (a zero close to the contour makes it swing). The samples alone
-    cannot tell a step that turns the phase by a whole turn from none: along the top
-    of a counting ellipse |det| hardly changes while the phase winds at a steady
-    rate, and random floating_loops 11 counted 88 roots below 30 kHz where there are
-    98 (steps of 5.6–6.2 rad read as −0.65 … −0.10). The count also fails where a step stays
+    cannot tell a step that turns the phase by a whole turn from none: random
+    floating_loops 11 counted 40 roots below 30 kHz where there are 98. Bounding the
+    sampled change of log|det| as well still gave 88: along the top of a counting
+    ellipse |det| hardly changes while the phase winds at a steady rate (steps of
+    5.6–6.2 rad read as −0.65 … −0.10). The count also fails where a step stays
     coarse over a θ interval below PHASE_JUMP (a jump, not a turn: det is rounding
     noise there, as far above a discrete model's last root; halving towards it took
     thousands of one-point rounds).

@@ -34,6 +34,9 @@ INITIAL_POINTS = 33
 #: most 500; one where det is rounding noise (far above a discrete model's last
 #: root) refines until it reaches this.
 MAX_POINTS = 10000
+#: Contour points evaluated in one call of ``log_det``: the stacks of one round of
+#: many counts at once stay a few hundred MB.
+EVALUATION_CHUNK = 2048
 #: θ step (radians) of the difference that gives d log det / dθ at each contour point:
 #: the same fraction of a small circle (a multiplicity count) as of a wide ellipse.
 #: It is no smaller because the difference amplifies the rounding noise of log det by
@@ -140,8 +143,10 @@ def _half_windings(log_det, paths, wheres, max_points: int, initial_points: int 
         steps = np.concatenate([np.where(theta < np.pi / 2, DERIVATIVE_STEP, -DERIVATIVE_STEP) for _, theta in pieces])
         edges = np.cumsum([theta.size for _, theta in pieces])[:-1]
         shifted = np.split(np.concatenate([theta for _, theta in pieces]) + steps, edges)
-        sign, log_abs = log_det(np.concatenate([paths[i](theta) for i, theta in pieces]
-                                               + [paths[i](theta) for (i, _), theta in zip(pieces, shifted)]))
+        points = np.concatenate([paths[i](theta) for i, theta in pieces]
+                                + [paths[i](theta) for (i, _), theta in zip(pieces, shifted)])
+        sign, log_abs = (np.concatenate(parts) for parts in zip(*[
+            log_det(points[start:start + EVALUATION_CHUNK]) for start in range(0, points.size, EVALUATION_CHUNK)]))
         here, there = np.split(log_abs + 1j * np.angle(sign), 2)
         change = (there.real - here.real) + 1j * np.angle(np.exp(1j * (there.imag - here.imag)))
         return (np.split(here, edges), np.split(change / steps, edges),

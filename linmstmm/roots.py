@@ -62,6 +62,13 @@ OMEGA_CEILING = 1e9
 DEFLATED_POINTS = 17
 #: Starting points of a count over a small circle (a multiplicity).
 CIRCLE_POINTS = 9
+#: Points a count over a small circle may take before it fails. One root of
+#: multiplicity m turns the phase by mπ; the test suite's circles (NAFEMS FV2's
+#: sevenfold roots among them) took at most 41. Around "roots" Newton settled on
+#: where det is rounding noise they refine until this: random ring 5 up to 1e9 Hz,
+#: 125 circles in one count, ran out of memory at 117,000 points a round with the
+#: general limit.
+CIRCLE_MAX_POINTS = 200
 #: Points a count with the known roots divided out may take before it fails. Such a
 #: phase hardly turns: the fast path's took at most 423 on 40 random models at 80 modes
 #: (before each point carried its derivative, at twice the evaluations: half as many now).
@@ -382,7 +389,8 @@ class RootFinder:
             radius = min(self.SPLIT * centre, farther.min() / 2 if farther.size else np.inf)
             asked.append(i)
             intervals.append((centre - radius, centre + radius))
-        counts = count_zeros_many(self.log_det, intervals, initial_points=CIRCLE_POINTS) if asked else []
+        counts = (count_zeros_many(self.log_det, intervals, max_points=CIRCLE_MAX_POINTS, initial_points=CIRCLE_POINTS)
+                  if asked else [])
         for i, count in zip(asked, counts):
             multiplicities[i] = 1 if isinstance(count, RuntimeError) else max(count, 1)
         self._counted.update((polished[i][0], multiplicities[i]) for i in asked)
@@ -989,7 +997,7 @@ class RootFinder:
             return []
         radii = [self._circle_radius(r, others) for r in roots]
         counts = count_zeros_many(self.log_det, [(r - radius, r + radius) for r, radius in zip(roots, radii)],
-                                  initial_points=CIRCLE_POINTS)
+                                  max_points=CIRCLE_MAX_POINTS, initial_points=CIRCLE_POINTS)
         return [None if isinstance(c, RuntimeError) else max(c, 1) for c in counts]
 
     def unseparated_among(self, roots) -> dict:
@@ -1068,7 +1076,8 @@ class RootFinder:
             return roots
         radii = [self._circle_radius(r, distinct) for r in multiple]
         tight = count_zeros_many(self.log_det, [(r - radius / 100, r + radius / 100)
-                                                for r, radius in zip(multiple, radii)], initial_points=CIRCLE_POINTS)
+                                                for r, radius in zip(multiple, radii)],
+                                 max_points=CIRCLE_MAX_POINTS, initial_points=CIRCLE_POINTS)
         separated = list(roots)
         for r, radius, count in zip(multiple, radii, tight):
             m = self._counted.get(r, roots.count(r))  # (``roots`` may end inside a multiple root)

@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 from builders import fixed, make_rigid, single_beam_model, spring_mass_chain
 
-from linmstmm.counting import count_zeros, deflated
+from linmstmm.counting import EVALUATION_CHUNK, count_zeros, count_zeros_many, deflated
 from linmstmm.model import Model
 from linmstmm.precision import sparse_determinant
-from linmstmm.roots import RootFinder
+from linmstmm.roots import CIRCLE_MAX_POINTS, CIRCLE_POINTS, RootFinder
 from linmstmm.solve import frequency_finder, natural_frequencies
 
 mp.mp.dps = 30
@@ -196,6 +196,25 @@ def test_a_count_sees_every_turn_of_a_steadily_winding_phase(zeros):
         return value / np.abs(value), np.log(np.abs(value))
 
     assert count_zeros(log_sin, 0.5, (zeros + 0.5) * np.pi) == zeros
+
+
+def test_counts_on_rounding_noise_fail_within_their_limits():
+    """Where det is rounding noise every contour step looks coarse. Many such circles in
+    one count must each fail at their point limit, with log_det never handed more than
+    EVALUATION_CHUNK points at once (random ring 5 up to 1e9 Hz: 125 circles round
+    roots Newton settled on in the noise ran out of memory at 117,000 points a call)."""
+    rng = np.random.default_rng(0)
+    calls = []
+
+    def noise(omega):
+        calls.append(len(omega))
+        return np.exp(2j * np.pi * rng.random(len(omega))), rng.normal(size=len(omega))
+
+    circles = [(k - 1e-3, k + 1e-3) for k in range(1, 126)]
+    counts = count_zeros_many(noise, circles, max_points=CIRCLE_MAX_POINTS, initial_points=CIRCLE_POINTS)
+    assert all(isinstance(c, RuntimeError) for c in counts)
+    assert max(calls) <= EVALUATION_CHUNK
+    assert sum(calls) <= len(circles) * 2 * 2 * CIRCLE_MAX_POINTS  # value and derivative; the last round may double
 
 
 def test_a_count_across_a_phase_jump_fails_fast():

@@ -140,8 +140,8 @@ def test_a_count_over_many_roots_agrees_with_fe():
     """Random floating_loops 11 has 98 elastic frequencies below 30 kHz by the FE route,
     its 98th and 99th clear of 30 kHz by more than their error estimates. The count
     from OMEGA_FLOOR said 40: its samples were whole turns of the phase apart (the
-    120-mode search, which fell back to the segment counts, then returned 16
-    frequencies too few)."""
+    120-mode search, which fell back to the segment counts, then missed 10 of the
+    lowest 120 and returned ten higher ones in their place)."""
     m = model("floating_loops", 11)
     reference = fe_frequencies(m, count=99)
     f, error = reference.frequencies_hz, reference.error_estimate

@@ -202,7 +202,8 @@ def test_counts_on_rounding_noise_fail_within_their_limits():
     """Where det is rounding noise every contour step looks coarse. Many such circles in
     one count must each fail at their point limit, with log_det never handed more than
     EVALUATION_CHUNK points at once (random ring 5 up to 1e9 Hz: 125 circles round
-    roots Newton settled on in the noise ran out of memory at 117,000 contour points in one round, 234,686 evaluations in one call)."""
+    roots Newton settled on in the noise ran out of memory at 117,000 contour points
+    in one round, 234,686 evaluations in one call)."""
     rng = np.random.default_rng(0)
     calls = []
 

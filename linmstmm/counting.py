@@ -31,7 +31,7 @@ LOG_STEP = np.pi / 4
 INITIAL_POINTS = 33
 #: Contour points a count may take before it fails (each costs two evaluations of
 #: det: its value and its derivative). Successful counts of the test suite took at
-#: most 500; one where det is rounding noise (far above a discrete model's last
+#: most 1262; one where det is rounding noise (far above a discrete model's last
 #: root) refines until it reaches this.
 MAX_POINTS = 10000
 #: Contour points evaluated in one call of ``log_det``: the stacks of one round of

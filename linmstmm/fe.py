@@ -297,13 +297,10 @@ def dispersion_error(beam: Beam, h: float, omega: float) -> float:
     1.0 (no digit) where the mesh does not resolve the wave (kh or βh above
     UNRESOLVED_WAVE); 0 for a massless beam.
     """
-    if beam.rho == 0:
-        return 0.0
-    wave_speeds = ([np.sqrt(beam.E / beam.rho)] if beam.axial else []) + \
-        ([np.sqrt(beam.G * beam.J / (beam.rho * beam.Ip))] if beam.torsion else [])
-    errors = [_rod_dispersion(omega * h / c) for c in wave_speeds]
-    errors += [_bending_dispersion((omega ** 2 * beam.rho * beam.A / (beam.E * inertia)) ** 0.25 * h)
-               for inertia in (beam.Iy, beam.Iz)]
+    k = beam.wavenumbers(omega)
+    errors = [_bending_dispersion(k[plane] * h) for plane in ("bending_y", "bending_z")]
+    errors += [_rod_dispersion(k[rod] * h) for rod, deformable in (("axial", beam.axial), ("torsion", beam.torsion))
+               if deformable]
     return float(max(errors))
 
 

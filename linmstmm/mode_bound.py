@@ -34,15 +34,12 @@ def clamped_modes_below(model: Model, omega: float) -> int:
     bending counted from below (⌊βL/π⌋ − 1 per plane): a lower bound on the model's."""
     total = 0
     for beam in model.beams:
-        if beam.rho == 0:
-            continue
-        for I in (beam.Iy, beam.Iz):
-            beta_L = (beam.rho * beam.A * omega ** 2 / (beam.E * I)) ** 0.25 * beam.length
-            total += max(math.floor(beta_L / math.pi) - 1, 0)
-        rods = [(beam.axial, beam.E * beam.A, beam.rho * beam.A), (beam.torsion, beam.G * beam.J, beam.rho * beam.Ip)]
-        for deformable, stiffness, inertia in rods:
+        k = beam.wavenumbers(omega)
+        for plane in ("bending_y", "bending_z"):
+            total += max(math.floor(k[plane] * beam.length / math.pi) - 1, 0)
+        for rod, deformable in (("axial", beam.axial), ("torsion", beam.torsion)):
             if deformable:
-                total += max(math.ceil(omega * beam.length / (math.pi * math.sqrt(stiffness / inertia))) - 1, 0)
+                total += max(math.ceil(k[rod] * beam.length / math.pi) - 1, 0)
     return total
 
 

@@ -104,6 +104,16 @@ class Beam:
         """Total mass, kg."""
         return self.rho * self.A * self.length
 
+    def wavenumbers(self, omega: float) -> dict[str, float]:
+        """Wavenumbers, 1/m, of the beam's waves at ``omega`` (rad/s): bending
+        (ρA ω²/EI)^¼ with Iy ("bending_y") and Iz ("bending_z"), axial ω√(ρ/E) and
+        torsion ω√(ρ Ip/GJ), whether or not a direction is declared rigid (the
+        caller decides); all zero for a massless beam."""
+        return {"bending_y": (self.rho * self.A * omega ** 2 / (self.E * self.Iy)) ** 0.25,
+                "bending_z": (self.rho * self.A * omega ** 2 / (self.E * self.Iz)) ** 0.25,
+                "axial": omega * math.sqrt(self.rho / self.E),
+                "torsion": omega * math.sqrt(self.rho * self.Ip / (self.G * self.J))}
+
 
 @dataclass(frozen=True, eq=False)
 class Model:

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from linmstmm.deduction import Deduction
-from linmstmm.elements.beam import beam_transfer, bending_wavenumber
+from linmstmm.elements.beam import beam_transfer
 from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
 from linmstmm.nullspace import NULL_TOLERANCE, equilibration
@@ -503,10 +503,7 @@ def _quadrature(beam, omega_max: float):
     q = (largest wavenumber at omega_max) × L + EXTRA_QUADRATURE_POINTS, where
     the wavenumbers are bending (ρAω²/EI)^¼, axial ω√(ρ/E), torsion ω√(ρIp/GJ).
     """
-    wavenumbers = [bending_wavenumber(beam, omega_max),
-                   omega_max * np.sqrt(beam.rho / beam.E),
-                   omega_max * np.sqrt(beam.rho * beam.Ip / (beam.G * beam.J))]
-    count = int(np.ceil(max(wavenumbers) * beam.length)) + EXTRA_QUADRATURE_POINTS
+    count = int(np.ceil(max(beam.wavenumbers(omega_max).values()) * beam.length)) + EXTRA_QUADRATURE_POINTS
     nodes, weights = np.polynomial.legendre.leggauss(count)
     half = beam.length / 2
     return half * (nodes + 1), half * weights

@@ -55,9 +55,7 @@ from linmstmm import deduction as deduction_module  # noqa: E402
 from linmstmm.deduction import Deduction  # noqa: E402
 from linmstmm.fe import fe_frequencies  # noqa: E402
 from linmstmm.model import load_model  # noqa: E402
-from linmstmm.counting import count_zeros, deflated  # noqa: E402
-from linmstmm.roots import (DEFLATED_MAX_POINTS, DEFLATED_POINTS, MIN_POINTS_PER_OCTAVE,  # noqa: E402
-                            OMEGA_FLOOR)
+from linmstmm.roots import DEFLATED_POINTS, MIN_POINTS_PER_OCTAVE  # noqa: E402
 from linmstmm.solve import CERTIFIED_STEP, frequency_finder, natural_frequencies  # noqa: E402
 from linmstmm.topology import build_topology  # noqa: E402
 
@@ -304,10 +302,9 @@ def certification_floor(model, rounds: int) -> dict:
 
     build : the deduced system and its root finder (``frequency_finder``:
         topology, deduction, release of indeterminate unknowns, rigid-body count);
-    count : the closing count, given the exact roots: det with them divided out
-        counted over the half-ellipse up to midway to the next root, from the same
-        DEFLATED_POINTS starting points as the solver's (it is what certifies that
-        none is missed).
+    count : the solver's closing count (``RootFinder._no_other_zeros``) given the
+        exact roots: det with them divided out, counted over the half-ellipse up to
+        midway to the next root (it is what certifies that none is missed).
     Also ``one_det``: one stable evaluation of det Ū_all at one frequency, and
     ``fe_mesh``, ``fe_dof``: the finest mesh (elements per beam) and its size that
     the FE route's automatic refinement solves for the same frequencies.
@@ -317,11 +314,10 @@ def certification_floor(model, rounds: int) -> dict:
     top = (omegas[COUNT - 1] + omegas[COUNT]) / 2
 
     def closing_count():
-        return count_zeros(deflated(finder.log_det, omegas[:COUNT]), OMEGA_FLOOR, top,
-                           max_points=DEFLATED_MAX_POINTS, initial_points=DEFLATED_POINTS)
+        return finder._no_other_zeros(list(omegas[:COUNT]), top)
 
-    if closing_count() != 0:
-        raise AssertionError("the closing count of the exact roots is not zero")
+    if not closing_count():
+        raise AssertionError("the closing count does not confirm the exact roots")
     fe = fe_frequencies(model, COUNT)
     return dict(fe_mesh=fe.elements_per_beam, fe_dof=fe.n_dof,
                 build=best_of(lambda: frequency_finder(model), rounds)[0],

@@ -33,7 +33,7 @@ import numpy as np
 import scipy.linalg
 
 from linmstmm.counting import count_in_disc, count_zeros, count_zeros_many, deflated, divided_out
-from linmstmm.nullspace import equilibration, nullity
+from linmstmm.nullspace import equilibration
 
 #: Grid points per octave of the scans (the fast path's above 1 rad/s, an
 #: eighth of it below; every segment's).
@@ -87,6 +87,10 @@ class RootFinder:
     least POINTS_PER_OCTAVE (a denser scan leaves fewer close roots to the
     repairs; a coarser one is refused, see MIN_POINTS_PER_OCTAVE).
     points_per_root : the segment search's scan density per counted root.
+    rigid_body_modes : number of zero-frequency modes, from the model's
+    kinematics (:func:`linmstmm.rigid_motion.rigid_body_mode_count`); their
+    zeros of det Ū_all at ω = 0 are divided out once they are confirmed
+    (:meth:`divide_out_rigid_body_zeros`).
 
     Candidates come from the scan; each is polished by local linearisation
     (Newton for the nonlinear eigenproblem Ū(ω) v = 0): with A = Ū(ω) and
@@ -134,7 +138,8 @@ class RootFinder:
     EARLY = 1e-9
 
     def __init__(self, log_det, matrix, xtol: float = 1e-14,
-                 points_per_octave: int = POINTS_PER_OCTAVE, points_per_root: int = 6):
+                 points_per_octave: int = POINTS_PER_OCTAVE, points_per_root: int = 6,
+                 rigid_body_modes: int = 0):
         if not 0 < xtol <= MAX_XTOL:
             raise ValueError(f"xtol must be in (0, {MAX_XTOL:g}], got {xtol:g}: looser Newton "
                              "tolerances blur distinct roots into one")
@@ -151,7 +156,7 @@ class RootFinder:
         self.last_step: dict[float, float] = {}
         #: why the search ended early, if it did
         self.note = ""
-        self._rigid: int | None = None
+        self._rigid = rigid_body_modes
         #: starts of cluster members not yet polished (see :meth:`clusters`)
         self.deferred_members: list[tuple[float, float]] = []  # (start, the root whose pencil gave it)
         #: sign-change brackets (lo, hi) Newton missed that :meth:`_needed` left out
@@ -178,15 +183,7 @@ class RootFinder:
             self.log_det = deflated(self.log_det, np.zeros(rigid))
 
     def rigid_body_modes(self) -> int:
-        """Nullity of Ū_all at ω = 0: zero-frequency (rigid-body) modes (computed once).
-
-        Balanced with the scales of a generic frequency (1 rad/s): at ω = 0
-        itself, columns that vanish there (a closed ring's T − I) would be
-        blown up and hide the null vectors.
-        """
-        if self._rigid is None:
-            at_zero, generic = self.matrix(np.array([0.0, 1.0]))
-            self._rigid = nullity(at_zero, scales=equilibration(generic))
+        """Number of zero-frequency (rigid-body) modes, as given at construction."""
         return self._rigid
 
     def _pencil(self, omegas, step: float = 1e-7):

@@ -12,6 +12,7 @@ from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
 from linmstmm.nullspace import release_indeterminate
 from linmstmm.precision import refine_roots, separated_cluster
+from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.roots import CERTIFIED_STEP, OMEGA_CEILING, RootFinder
 from linmstmm.topology import build_topology
 
@@ -69,14 +70,16 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), **options
 
     root, cut_at : see :func:`linmstmm.topology.build_topology`. options go to
     :class:`linmstmm.roots.RootFinder` (xtol, points_per_octave, points_per_root).
-    The finder has counted the rigid-body modes and divides their zeros out of
+    The finder knows the rigid-body modes (counted from the model's kinematics,
+    :func:`~linmstmm.rigid_motion.rigid_body_mode_count`) and divides their zeros out of
     det Ū_all (:meth:`~linmstmm.roots.RootFinder.divide_out_rigid_body_zeros`),
     so every caller's counts see the elastic roots only.
     Returns (deduction, finder, number of indeterminate unknowns released).
     """
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
     released = release_indeterminate(deduction)
-    finder = RootFinder(deduction.log_det, lambda omega: deduction.matrix(omega, stable=True)[0], **options)
+    finder = RootFinder(deduction.log_det, lambda omega: deduction.matrix(omega, stable=True)[0],
+                        rigid_body_modes=rigid_body_mode_count(model), **options)
     finder.divide_out_rigid_body_zeros(finder.rigid_body_modes())
     return deduction, finder, released
 

@@ -1,0 +1,148 @@
+"""Rigid-body (zero-frequency) modes from the model's kinematics.
+
+A zero-frequency mode stores no strain energy. Every spring is stiff in all
+six directions (k > 0, or ``inf``) and every beam has E, G > 0, so zero strain
+means that each connected part of the model moves as one rigid body: only
+boundary conditions can stop such a motion. The rigid motions of a part are
+its six unit motions (translations, and rotations about its centroid scaled
+by its extent so that both weigh alike), less those its fixed boundary
+components hold. That is the null space of a small matrix of pure geometry:
+direction cosines and lengths relative to the part's own extent, so its rank
+is decided at a relative tolerance that no choice of units or overall size
+changes (Ū_all(0), by contrast, mixes the stiffness and length scales of the
+model, and its small singular values say little about its null space).
+
+A motion counts as a mode only if it moves mass: a free point mass without
+rotary inertia has three rigid-body modes, not six.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as la
+
+from linmstmm.elements.frames import skew
+from linmstmm.model import Model
+
+#: A boundary row of the geometry matrix is independent of the others above
+#: this fraction of the largest singular value (entries are direction cosines
+#: and ratios of lengths to the part's extent, all of order one).
+GEOMETRIC_RANK = 1e-10
+#: A rigid motion whose kinetic energy is below this fraction of the part's
+#: largest moves no mass (a rotation about a lone point mass).
+MASSLESS_MOTION = 1e-13
+
+
+def connected_parts(model: Model) -> list[list[str]]:
+    """Point names of each connected part of ``model``, in order of first appearance.
+
+    Two points are connected when an element joins them (a rigid body's ports,
+    a beam's or a spring's ends).
+    """
+    parent = {name: name for name in model.points}
+
+    def root(name):
+        while parent[name] != name:
+            parent[name] = parent[parent[name]]
+            name = parent[name]
+        return name
+
+    for element in model.elements:
+        ends = element.ports if element.kind == "rigid" else element.ends
+        for other in ends[1:]:
+            parent[root(other)] = root(ends[0])
+    parts: dict[str, list[str]] = {}
+    for name in model.points:
+        parts.setdefault(root(name), []).append(name)
+    return list(parts.values())
+
+
+def unit_motions(positions: np.ndarray, centre: np.ndarray, size: float) -> np.ndarray:
+    """(n, 6, 6) displacement and rotation of n points under the six unit motions.
+
+    positions : (n, 3) m. centre : (3,) m, the rotation centre. size : m, the
+    length that scales the rotations (a unit rotation turns by 1/size rad).
+    Entry [p, :, k] is point p's (u, θ) under motion k: translations along x,
+    y, z, then rotations about x, y, z through ``centre``.
+    """
+    arm = np.asarray(positions, float) - centre
+    field = np.zeros((len(arm), 6, 6))
+    field[:, :3, :3] = np.eye(3)
+    field[:, :3, 3:] = -skew_stack(arm) / size  # θ × r = −r × θ
+    field[:, 3:, 3:] = np.eye(3) / size
+    return field
+
+
+def skew_stack(vectors: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) cross-product matrices of (n, 3) vectors: skew(r) @ a = r × a."""
+    return np.array([skew(r) for r in vectors]).reshape(-1, 3, 3)
+
+
+def _kinetic_matrix(model: Model, part: set, centre: np.ndarray, size: float) -> np.ndarray:
+    """(6, 6) kinetic-energy matrix (×2/ω²) of the part's six unit motions, kg.
+
+    Rigid bodies by their mass and inertia; beams as rigid rods (mass ρAL at
+    mid-length, ρAL³/12 about axes across, ρ Ip L about their own axis).
+    """
+    kinetic = np.zeros((6, 6))
+    for body in model.rigids:
+        if body.ports[0] in part:
+            kinetic += _body_kinetic(body.mass, body.com, body.inertia, centre, size)
+    for beam in model.beams:
+        if beam.ends[0] in part:
+            axis = beam.axes[0]
+            rod = beam.rho * beam.A * beam.length
+            inertia = rod * beam.length ** 2 / 12 * (np.eye(3) - np.outer(axis, axis))
+            inertia += beam.rho * beam.Ip * beam.length * np.outer(axis, axis)
+            middle = 0.5 * (model.points[beam.ends[0]] + model.points[beam.ends[1]])
+            kinetic += _body_kinetic(rod, middle, inertia, centre, size)
+    return kinetic
+
+
+def _body_kinetic(mass, com, inertia, centre, size) -> np.ndarray:
+    """(6, 6) kinetic-energy matrix of one body under the unit motions (kg)."""
+    at_com = unit_motions(np.asarray(com, float)[None], centre, size)[0]
+    body = np.zeros((6, 6))
+    body[:3, :3] = mass * np.eye(3)
+    body[3:, 3:] = inertia
+    return at_com.T @ body @ at_com
+
+
+def rigid_body_motions(model: Model) -> dict[str, np.ndarray]:
+    """Point motions of every rigid-body mode of ``model``.
+
+    Returns point name -> (6, r): the (u, θ) of that point (m, rad, up to a
+    common scale per mode) in each of the r zero-frequency modes. The modes of
+    each connected part are orthonormal in the part's unit motions and move
+    mass (see :data:`MASSLESS_MOTION`).
+    """
+    columns = []
+    names = list(model.points)
+    for part in connected_parts(model):
+        members = set(part)
+        positions = np.array([model.points[p] for p in part])
+        coms = [body.com for body in model.rigids if body.ports[0] in members]
+        extent = np.vstack([positions] + [np.asarray(c, float)[None] for c in coms])
+        centre = extent.mean(axis=0)
+        size = float(np.abs(extent - centre).max()) or 1.0
+        field = unit_motions(positions, centre, size)
+        held = np.concatenate([field[i][model.fixed_mask(p)] for i, p in enumerate(part)])
+        allowed = la.null_space(held, rcond=GEOMETRIC_RANK) if held.size else np.eye(6)
+        if not allowed.shape[1]:
+            continue
+        kinetic = _kinetic_matrix(model, members, centre, size)
+        energy, directions = la.eigh(allowed.T @ kinetic @ allowed)
+        moving = allowed @ directions[:, energy > MASSLESS_MOTION * max(np.abs(kinetic).max(), 0.0)]
+        if not moving.shape[1]:
+            continue
+        motion = np.zeros((len(names), 6, moving.shape[1]))
+        for i, p in enumerate(part):
+            motion[names.index(p)] = field[i] @ moving
+        columns.append(motion)
+    stacked = np.concatenate(columns, axis=2) if columns else np.zeros((len(names), 6, 0))
+    return {name: stacked[i] for i, name in enumerate(names)}
+
+
+def rigid_body_mode_count(model: Model) -> int:
+    """Number of zero-frequency (rigid-body) modes of ``model``: see the module text."""
+    motions = rigid_body_motions(model)
+    return next(iter(motions.values())).shape[1] if motions else 0

@@ -48,8 +48,39 @@ def nullity(matrix: np.ndarray, tolerance: float = NULL_TOLERANCE, scales=None) 
     return int(np.sum(sigma < tolerance * sigma[0]))
 
 
-def release_indeterminate(deduction, probe=(0.7310, 1.9137, 5.3)) -> int:
+#: Generic frequencies (multiples of the model's :func:`characteristic_frequency`)
+#: at which the constant null space of Ū_all is sought.
+PROBES = (0.07310, 0.19137, 0.53)
+
+
+def characteristic_frequency(topology) -> float:
+    """A frequency of the model's own scale, rad/s, from its elements alone.
+
+    The lowest of: each beam's bending scale √(E I_min / ρA) / L², and
+    √(k / m) for each spring's softest finite translation k against the
+    model's whole mass m. It moves with the model's units and size, so that
+    probes at multiples of it sit at the same place among the model's own
+    frequencies whatever the units (fixed probes at 0.7–5 rad/s sat 40 times
+    above the first mode of a launcher-size star scaled ×1000, where Ū_all's
+    conditioning hid its null space).
+    """
+    records = [element.record for element in topology.elements if element.record is not None]
+    mass = sum(record.mass for record in records if record.kind in ("rigid", "beam"))
+    scales = [np.sqrt(record.E * min(record.Iy, record.Iz) / (record.rho * record.A)) / record.length ** 2
+              for record in records if record.kind == "beam" and record.rho > 0]
+    for record in records:
+        if record.kind == "spring" and mass > 0:
+            finite = record.k[:3][np.isfinite(record.k[:3])]
+            if finite.size:
+                scales.append(np.sqrt(finite.min() / mass))
+    return float(min(scales)) if scales else 1.0
+
+
+def release_indeterminate(deduction, probe=None) -> int:
     """Find and release statically indeterminate unknowns of ``deduction``.
+
+    probe : rad/s, the generic frequencies to look at (default :data:`PROBES`
+    times the model's :func:`characteristic_frequency`).
 
     Redundant rigid constraints (a rigid direction fixed at both ends, ``inf``
     springs closing a loop) make Ū_all singular at every ω, with constant
@@ -59,6 +90,8 @@ def release_indeterminate(deduction, probe=(0.7310, 1.9137, 5.3)) -> int:
     Returns the number released. Raises RuntimeError for a null space that
     moves with ω (a mechanism).
     """
+    if probe is None:
+        probe = np.asarray(PROBES) * characteristic_frequency(deduction.topology)
     samples = deduction.matrix(np.asarray(probe, dtype=float))
     rows, cols = equilibration(samples[0])
     samples = rows[:, None] * samples * cols

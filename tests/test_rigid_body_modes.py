@@ -96,7 +96,7 @@ def test_pinned_star_counts_what_the_fe_route_counts(arms, length, width, height
 
 
 @pytest.mark.parametrize("length, mass, time", [(1e-3, 1e3, 1.0), (1e3, 1e-3, 1.0), (1e-3, 1e-9, 1e-3),
-                                                (1e-3, 1e-9, 1e-3), (1e3, 1e9, 1e3), (0.5, 0.125, 0.5)])
+                                                (1e3, 1e9, 1e3), (0.5, 0.125, 0.5)])
 @pytest.mark.parametrize("model", [pinned_star(8), pinned_star(2, 2.0, 0.2, 0.05), free_chain()],
                          ids=["star8", "star2", "free chain"])
 def test_counts_do_not_depend_on_units_or_size(model, length, mass, time):
@@ -117,4 +117,4 @@ def test_free_chain_has_six_and_a_point_mass_three():
 def test_star_modes_have_no_fake_zero_frequency_shapes():
     modes = mode_shapes(pinned_star(8), count=3)
     assert modes.rigid_body_modes == 0
-    assert modes.stiffness_orthogonality_error() < 1e-6
+    assert modes.stiffness_orthogonality_error < 1e-6

@@ -1,0 +1,436 @@
+"""Compiled kernels: det Ū_all(ω) by replaying a :class:`~linmstmm.program.Program`.
+
+Every kernel here is compiled once by numba (``@njit(cache=True)``: the
+machine code is kept beside this file, so later processes only load it) and
+takes float64/complex128 arrays and integers only. Each mirrors a numpy
+counterpart that stays the readable reference and the test oracle:
+
+* :func:`beam_piece` — :func:`linmstmm.elements.beam.beam_transfer`;
+* :func:`evaluate` — :meth:`linmstmm.deduction.Deduction.matrix` and
+  :meth:`~linmstmm.deduction.Deduction.log_det` with ``stable=True``: the carry
+  with Godunov orthonormalisation (:class:`linmstmm.deduction._Orthonormaliser`),
+  beams cut into pieces of βL ≤ 4, Ū_all assembled, LU.
+
+Frequencies are evaluated in groups of consecutive entries that take the
+same decisions (pieces per beam, orthonormalisations skipped), as one numpy
+stack does: a group of two, ω and ω + δω, gives a smooth difference of the
+orthonormalised Ū_all (Newton's pencil).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, ORTHO, STATE_BLOCK, TIP
+
+#: See linmstmm.deduction: beam pieces, growth between orthonormalisations, far scale.
+BEAM_PIECE_BETA_L = 4.0
+GROWTH = 1e2
+FAR = 1e100
+_SERIES_LIMIT4 = 16.0  # |w| below 2**4: Krylov functions by their power series
+_SERIES_TERMS = 14
+_FACTORIALS = np.array([[1.0 / math.factorial(4 * j + r) for j in range(_SERIES_TERMS)] for r in range(4)])
+_XY = np.array([1, 5, 8, 10])
+_XZ = np.array([2, 4, 7, 11])
+_XZ_SIGNS = np.array([1.0, -1.0, -1.0, 1.0])
+_BENDING_SIGNS = np.outer([1.0, 1.0, -1.0, 1.0], [1.0, 1.0, -1.0, 1.0])
+
+
+@njit(cache=True)
+def _krylov(w, out):
+    """Scaled Krylov functions F_0..F_3 of w into ``out`` (4,): see linmstmm.elements.beam.krylov."""
+    if abs(w) < _SERIES_LIMIT4:
+        for r in range(4):
+            total = 0.0 * w
+            power = 1.0 + 0.0 * w
+            for j in range(_SERIES_TERMS):
+                total += _FACTORIALS[r, j] * power
+                power *= w
+            out[r] = total
+    else:
+        z = np.sqrt(np.sqrt(w))
+        ch, c, sh, s = np.cosh(z), np.cos(z), np.sinh(z), np.sin(z)
+        out[0] = (ch + c) / 2
+        out[1] = (sh + s) / (2 * z)
+        out[2] = (ch - c) / (2 * z * z)
+        out[3] = (sh - s) / (2 * z * z * z)
+
+
+@njit(cache=True)
+def _bending(EI, rhoA, L, omega, local, indices, signs, functions):
+    """The (v, θ, m, q) bending block of one plane into ``local`` at ``indices``."""
+    w = rhoA * omega * omega * L ** 4 / EI
+    _krylov(w, functions)
+    for i in range(4):
+        for j in range(4):
+            value = _BENDING_SIGNS[i, j] * L ** (j - i) * functions[(j - i) % 4]
+            power = (1 if i >= 2 else 0) - (1 if j >= 2 else 0)
+            value *= EI ** power
+            if i > j:
+                value *= w
+            local[indices[i], indices[j]] = signs[i] * signs[j] * value
+
+
+@njit(cache=True)
+def _rod(stiffness, inertia, L, omega, rigid, local, a, b):
+    """(displacement, force) block of an axial rod or shaft into ``local`` at rows/columns a, b."""
+    if rigid:
+        local[a, a] = 1.0
+        local[b, b] = 1.0
+        local[b, a] = inertia * omega * omega * L
+        return
+    kL = omega * L * math.sqrt(inertia / stiffness)
+    sinc = np.sin(kL) / kL if kL != 0 else 1.0 + 0.0 * kL
+    local[a, a] = np.cos(kL)
+    local[b, b] = np.cos(kL)
+    local[a, b] = -L / stiffness * sinc
+    local[b, a] = stiffness / L * kL * kL * sinc
+
+
+@njit(cache=True)
+def beam_piece(beam, rotation, omega, length, out):
+    """Inertial transfer matrix (12, 12) of a beam piece of ``length`` m at ``omega`` into ``out``.
+
+    beam : (10,) (E, G, rho, A, Iy, Iz, J, Ip, length, flags), flags = axial + 2 torsion.
+    rotation : (12, 12) state rotation of the traversal direction.
+    """
+    E, G, rho, A, Iy, Iz, J, Ip = beam[0], beam[1], beam[2], beam[3], beam[4], beam[5], beam[6], beam[7]
+    flags = int(beam[9])
+    local = np.zeros((12, 12), dtype=out.dtype)
+    functions = np.zeros(4, dtype=out.dtype)
+    ones = np.ones(4)
+    _bending(E * Iz, rho * A, length, omega, local, _XY, ones, functions)
+    _bending(E * Iy, rho * A, length, omega, local, _XZ, _XZ_SIGNS, functions)
+    _rod(E * A, rho * A, length, omega, (flags & 1) == 0, local, 0, 9)
+    _rod(G * J, rho * Ip, length, omega, (flags & 2) == 0, local, 3, 6)
+    temp = rotation.astype(out.dtype) @ local
+    out[:, :] = temp @ rotation.T.astype(out.dtype)
+
+
+@njit(cache=True)
+def _size(values):
+    """Largest |Re| + |Im| of ``values``."""
+    largest = 0.0
+    for v in values.ravel():
+        s = abs(v.real) + abs(v.imag)
+        if s > largest:
+            largest = s
+    return largest
+
+
+@njit(cache=True)
+def _view(work, offset, rows, width):
+    return work[offset:offset + rows * width].reshape((rows, width))
+
+
+@njit(cache=True)
+def _multiply_add(matrix, source, target, place, rows):
+    """target[:rows, place] += matrix[:rows] @ source (matrix (12, 12) float, source (12, k))."""
+    for i in range(rows):
+        for j in range(12):
+            a = matrix[i, j]
+            if a != 0.0:
+                for c in range(source.shape[1]):
+                    target[i, place[c]] += a * source[j, c]
+
+
+@njit(cache=True)
+def _multiply(matrix, source, target):
+    """target = matrix @ source, (12, 12) float by (12, k)."""
+    target[:, :] = 0.0
+    for i in range(12):
+        for j in range(12):
+            a = matrix[i, j]
+            if a != 0.0:
+                for c in range(source.shape[1]):
+                    target[i, c] += a * source[j, c]
+
+
+@njit(cache=True)
+def _place_add(source, target, place, sign, rows):
+    for i in range(rows):
+        for c in range(source.shape[1]):
+            target[i, place[c]] += sign * source[i, c]
+
+
+@njit(cache=True)
+def _unit_scale(stacked, kinds, scale):
+    """Row scales of ``stacked`` (rows, k) into ``scale``: one per kind of row (``kinds``:
+    0 displacement, 1 rotation, 2 moment, 3 force), the inverse root-mean-square size
+    of all rows of that kind (:meth:`linmstmm.deduction._Orthonormaliser._unit_scale`)."""
+    rows, width = stacked.shape
+    peak = _size(stacked)
+    if peak == 0.0:
+        peak = 1.0
+    kind_size = np.zeros(4)
+    for i in range(rows):
+        squares = 0.0
+        for c in range(width):
+            v = stacked[i, c] / peak
+            squares += v.real * v.real + v.imag * v.imag
+        kind_size[kinds[i]] += squares
+    largest = 0.0
+    for k in range(4):
+        kind_size[k] = math.sqrt(kind_size[k])
+        largest = max(largest, kind_size[k])
+    for i in range(rows):
+        size = kind_size[kinds[i]] if kind_size[kinds[i]] > 0 else largest
+        scale[i] = 1.0 / (size * peak)
+
+
+@njit(cache=True)
+def _orthonormal_columns(columns, diagonal):
+    """Orthonormalise the rows of ``columns`` (k, m) in place: classical Gram–Schmidt,
+    twice (orthogonal to rounding), the QR of its transpose with R's diagonal real and
+    positive (the basis is smooth in ω). ``diagonal`` (k,) receives R's diagonal.
+    Returns False, leaving ``columns`` partly changed, if a column depends exactly on
+    the ones before it (at a root)."""
+    k, m = columns.shape
+    for j in range(k):
+        norm_before = 0.0
+        for i in range(m):
+            v = columns[j, i]
+            norm_before += v.real * v.real + v.imag * v.imag
+        for _ in range(2):
+            for p in range(j):
+                projection = 0.0 * columns[j, 0]
+                for i in range(m):
+                    projection += np.conj(columns[p, i]) * columns[j, i]
+                for i in range(m):
+                    columns[j, i] -= projection * columns[p, i]
+        norm = 0.0
+        for i in range(m):
+            v = columns[j, i]
+            norm += v.real * v.real + v.imag * v.imag
+        norm = math.sqrt(norm)
+        if norm == 0.0 or norm_before == 0.0:
+            return False
+        diagonal[j] = norm
+        for i in range(m):
+            columns[j, i] /= norm
+    return True
+
+
+@njit(cache=True)
+def _orthonormalise(program, index, work, reference, log_scale, group):
+    """Orthonormalisation record ``index`` for the ``group`` members' workspaces ``work`` (g, W)."""
+    (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
+    first, count, state, width = orthos[index, 0], orthos[index, 1], orthos[index, 2], orthos[index, 3]
+    state_src = blocks[first + state, 0]
+    skip = True
+    for m in range(group if orthos[index, 4] == 0 else 0):
+        ref = reference[m, state_src]
+        if math.isnan(ref):
+            skip = False
+            break
+        growth = _size(_view(work[m], slot_offset[state_src], slot_rows[state_src],
+                             slot_width[state_src])) / ref
+        if not (growth < GROWTH and growth > 1 / GROWTH):
+            skip = False
+            break
+    if skip:  # lay the blocks out on the plan's columns, nothing else
+        for m in range(group):
+            for b in range(first, first + count):
+                src, dst, rows, place_index = blocks[b, 0], blocks[b, 1], blocks[b, 2], blocks[b, 4]
+                if place_index < 0:
+                    continue
+                source = _view(work[m], slot_offset[src], rows, slot_width[src])
+                target = _view(work[m], slot_offset[dst], rows, width)
+                target[:, :] = 0.0
+                place = places[places_start[place_index]:places_start[place_index + 1]]
+                _place_add(source, target, place, 1.0, rows)
+                if blocks[b, 3] == STATE_BLOCK:
+                    reference[m, dst] = reference[m, src]
+        return
+    total = 0
+    for b in range(first, first + count):
+        total += blocks[b, 2]
+    stacked = np.zeros((group, total, width), dtype=work.dtype)
+    kinds = np.zeros(total, dtype=np.int64)
+    for m in range(group):
+        row = 0
+        for b in range(first, first + count):
+            src, rows, place_index = blocks[b, 0], blocks[b, 2], blocks[b, 4]
+            source = _view(work[m], slot_offset[src], rows, slot_width[src])
+            if place_index < 0:
+                stacked[m, row:row + rows, :] = source
+            else:
+                place = places[places_start[place_index]:places_start[place_index + 1]]
+                for i in range(rows):
+                    for c in range(source.shape[1]):
+                        stacked[m, row + i, place[c]] = source[i, c]
+            for i in range(rows):
+                kinds[row + i] = i // 3
+            row += rows
+    factors = np.zeros((group, total, width), dtype=work.dtype)
+    diagonals = np.zeros((group, width))
+    scale = np.zeros(total)
+    columns = np.empty((width, total), dtype=work.dtype)  # the scaled columns, each contiguous
+    for m in range(group):
+        _unit_scale(stacked[m], kinds, scale)
+        for i in range(total):
+            for c in range(width):
+                columns[c, i] = stacked[m, i, c] * scale[i]
+        if not _orthonormal_columns(columns, diagonals[m]):
+            skip = True
+            break
+        for i in range(total):
+            for c in range(width):
+                factors[m, i, c] = columns[c, i] / scale[i]
+    if not skip:  # exactly dependent columns (at a root) are kept as they are
+        for m in range(group):
+            for c in range(width):
+                log_scale[m] += math.log(diagonals[m, c])
+            peak = _size(factors[m])
+            if peak > FAR or peak < 1 / FAR:
+                common = 2.0 ** (-np.round(np.log2(peak)))
+                factors[m] *= common
+                log_scale[m] -= math.log(common) * width
+        stacked = factors
+    for m in range(group):
+        row = 0
+        for b in range(first, first + count):
+            src, dst, rows, kind = blocks[b, 0], blocks[b, 1], blocks[b, 2], blocks[b, 3]
+            target = _view(work[m], slot_offset[dst], rows, width)
+            target[:, :] = stacked[m, row:row + rows, :]
+            if kind == STATE_BLOCK:
+                reference[m, dst] = reference[m, src] if skip else _size(target)
+            row += rows
+
+
+@njit(cache=True)
+def _run(program, omegas, work, reference, log_scale):
+    """Replay the operations for one group of frequencies ``omegas`` (g,)."""
+    (slot_offset, slot_rows, slot_width, operations, terms, places, places_start, matrices,
+     orthos, ortho_blocks, beams, beam_rotation) = program
+    ortho_program = (slot_offset, slot_rows, slot_width, places, places_start, orthos, ortho_blocks)
+    group = omegas.size
+    largest = 0.0
+    for m in range(group):
+        largest = max(largest, abs(omegas[m]))
+    pieces = np.ones(beams.shape[0], dtype=np.int64)
+    piece = np.zeros((group, 12, 12), dtype=omegas.dtype)
+    for op in range(operations.shape[0]):
+        code, a, b, c, d = (operations[op, 0], operations[op, 1], operations[op, 2], operations[op, 3],
+                            operations[op, 4])
+        if code == ORTHO:
+            _orthonormalise(ortho_program, a, work, reference, log_scale, group)
+            continue
+        for m in range(group):
+            if code == TIP:
+                target = _view(work[m], slot_offset[a], 12, slot_width[a])
+                target[:, :] = matrices[b, :, :slot_width[a]]
+                reference[m, a] = 1.0
+            elif code == CARRY:
+                target = _view(work[m], slot_offset[a], 12, slot_width[a])
+                source = _view(work[m], slot_offset[b], 12, slot_width[b])
+                _multiply(matrices[c], source, target)
+                if d >= 0:
+                    w2 = omegas[m] * omegas[m]
+                    inertial = matrices[d]
+                    for i in range(6, 12):
+                        for j in range(6):
+                            coefficient = inertial[i, j]
+                            if coefficient != 0.0:
+                                for k in range(source.shape[1]):
+                                    target[i, k] += w2 * coefficient * source[j, k]
+                reference[m, a] = reference[m, b]
+            elif code == GEOMETRIC:
+                target = _view(work[m], slot_offset[a], 6, slot_width[a])
+                first = _view(work[m], slot_offset[b], 12, slot_width[b])
+                other = _view(work[m], slot_offset[c], 12, slot_width[c])
+                target[:, :] = 0.0
+                place_first = places[places_start[operations[op, 5]]:places_start[operations[op, 5] + 1]]
+                place_other = places[places_start[operations[op, 5] + 1]:places_start[operations[op, 5] + 2]]
+                _place_add(first, target, place_first, -1.0, 6)
+                _multiply_add(matrices[d], other, target, place_other, 6)
+            elif code == COMBINE:
+                target = _view(work[m], slot_offset[a], 12, slot_width[a])
+                target[:, :] = 0.0
+                ref = 0.0
+                known = True
+                for t in range(b, b + c):
+                    src, matrix, place_index = terms[t, 0], terms[t, 1], terms[t, 2]
+                    source = _view(work[m], slot_offset[src], 12, slot_width[src])
+                    place = places[places_start[place_index]:places_start[place_index + 1]]
+                    if matrix < 0:
+                        _place_add(source, target, place, 1.0, 12)
+                    else:
+                        _multiply_add(matrices[matrix], source, target, place, 12)
+                    known = known and not math.isnan(reference[m, src])
+                    ref = max(ref, reference[m, src])
+                reference[m, a] = ref if known else np.nan
+        if code == BEAM:
+            beam = beams[b]
+            if c == 1:
+                softer = min(beam[4], beam[5])
+                beta_L = (beam[2] * beam[3] * largest ** 2 / (beam[0] * softer)) ** 0.25 * beam[8]
+                pieces[b] = max(int(math.ceil(beta_L / BEAM_PIECE_BETA_L)), 1)
+            for m in range(group):
+                beam_piece(beam, beam_rotation[b], omegas[m], beam[8] / pieces[b], piece[m])
+            for repeat in range(1 if c == 1 else pieces[b] - 1):
+                for m in range(group):
+                    state = _view(work[m], slot_offset[a], 12, slot_width[a])
+                    state[:, :] = piece[m] @ state.copy()
+                if c == 0 and d >= 0:
+                    _orthonormalise(ortho_program, d, work, reference, log_scale, group)
+
+
+@njit(cache=True)
+def _assembled(root, root_row, rows, order, kept_rows, kept_columns, work_m, slot_offset, slot_width,
+               slot_columns, slot_columns_start):
+    """Ū_all (N, N) of one frequency from its workspace."""
+    full = np.zeros((order, order), dtype=work_m.dtype)
+    for slot in (root, root_row):
+        block = _view(work_m, slot_offset[slot], 12, slot_width[slot])
+        columns = slot_columns[slot_columns_start[slot]:slot_columns_start[slot + 1]]
+        for i in range(12):
+            for c in range(columns.size):
+                full[i, columns[c]] += block[i, c]
+    start = 12
+    for g in range(rows.size):
+        slot = rows[g]
+        block = _view(work_m, slot_offset[slot], 6, slot_width[slot])
+        columns = slot_columns[slot_columns_start[slot]:slot_columns_start[slot + 1]]
+        for i in range(6):
+            for c in range(columns.size):
+                full[start + i, columns[c]] = block[i, c]
+        start += 6
+    out = np.empty((kept_rows.size, kept_columns.size), dtype=work_m.dtype)
+    for i in range(kept_rows.size):
+        for j in range(kept_columns.size):
+            out[i, j] = full[kept_rows[i], kept_columns[j]]
+    return out
+
+
+@njit(cache=True)
+def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out, log_scale_out):
+    """Stable Ū_all over ``omegas`` (n,) in groups of ``group`` consecutive frequencies.
+
+    matrices_out : (n, N, N) or (0, N, N) to skip storing Ū_all. sign_out,
+    log_abs_out : (n,) sign (phase) and log|det Ū_all| (log-scale included);
+    log_scale_out : (n,) the log-scale alone (det Ū_all = det(matrix) e^log_scale).
+    """
+    (slot_offset, slot_width, slot_columns, slot_columns_start, workspace, n_slots, root, root_row,
+     rows, order, kept_rows, kept_columns) = layout
+    n = omegas.size
+    # every operation writes the whole of its target: the workspace needs no clearing
+    whole = np.empty((min(group, n), workspace), dtype=omegas.dtype)
+    for start in range(0, n, group):
+        stop = min(start + group, n)
+        size = stop - start
+        work = whole[:size]
+        reference = np.full((size, n_slots), np.nan)
+        log_scale = np.zeros(size)
+        _run(program, omegas[start:stop], work, reference, log_scale)
+        for m in range(size):
+            ubar = _assembled(root, root_row, rows, order, kept_rows, kept_columns, work[m], slot_offset,
+                              slot_width, slot_columns, slot_columns_start)
+            if matrices_out.shape[0]:
+                matrices_out[start + m] = ubar
+            sign, log_abs = np.linalg.slogdet(ubar)
+            sign_out[start + m] = sign
+            log_abs_out[start + m] = log_abs + log_scale[m]
+            log_scale_out[start + m] = log_scale[m]

@@ -1,0 +1,129 @@
+"""det Ū_all(ω) of one deduction, by the numpy carry or the compiled kernels.
+
+Both engines answer the same two questions with the same numbers (to
+rounding): ``log_det(ω)`` — sign (phase, for complex ω) and log|det Ū_all| —
+and ``matrix(ω)`` — the orthonormalised Ū_all whose differences are smooth in
+ω (Newton's pencil); both count their evaluations (one per frequency), the
+cost figure the benchmarks report per root.
+
+* :class:`NumpyDeterminant` — :meth:`Deduction.log_det` / :meth:`Deduction.matrix`,
+  vectorised over a stack of frequencies (a run of identical cells by powers of
+  the cell matrix); the readable reference.
+* :class:`CompiledDeterminant` — the deduction compiled once into a program
+  (:mod:`linmstmm.program`) replayed by numba kernels (:mod:`linmstmm._kernels`):
+  about five times cheaper per evaluation, but numba's start-up costs a new
+  process 0.5-1.5 s (its import and the first call that loads the cached
+  machine code), more than a launcher-size solve of 10 to 100 frequencies
+  spends in the numpy carry altogether.
+
+:func:`determinant` chooses: ``engine="auto"`` takes the compiled kernels
+where they are already loaded in this process (a long session, a parameter
+study: :func:`load_kernels`), the numpy carry otherwise.
+"""
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from linmstmm.deduction import Deduction
+from linmstmm.program import compile_program
+
+ENGINES = ("auto", "numpy", "compiled")
+
+
+def kernels_loaded() -> bool:
+    """True once the compiled kernels are loaded in this process."""
+    return "linmstmm._kernels" in sys.modules
+
+
+def load_kernels() -> None:
+    """Import numba and the compiled kernels now (compiling them on the first run
+    on this machine), so that ``engine="auto"`` uses them from here on."""
+    import linmstmm._kernels  # noqa: F401
+
+
+def determinant(deduction: Deduction, engine: str = "auto"):
+    """The determinant of ``deduction`` by ``engine`` ("auto", "numpy" or "compiled")."""
+    if engine not in ENGINES:
+        raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
+    if engine == "compiled" or (engine == "auto" and kernels_loaded()):
+        return CompiledDeterminant(deduction)
+    return NumpyDeterminant(deduction)
+
+
+class NumpyDeterminant:
+    """det Ū_all by the numpy carry of ``deduction`` (stable: orthonormalised)."""
+
+    def __init__(self, deduction: Deduction):
+        self.deduction = deduction
+        #: evaluations of det Ū_all so far (one per frequency)
+        self.evaluations = 0
+
+    def log_det(self, omega):
+        """(sign or phase (n,), log|det Ū_all| (n,)) at each of ``omega`` (n,) rad/s."""
+        omega = np.atleast_1d(omega)
+        self.evaluations += omega.size
+        return self.deduction.log_det(omega)
+
+    def matrix(self, omega):
+        """(Ū_all stack (n, N, N), log_scale (n,)), det Ū_all = det(matrix) · exp(log_scale)."""
+        omega = np.atleast_1d(omega)
+        self.evaluations += omega.size
+        return self.deduction.matrix(omega, stable=True)
+
+
+class CompiledDeterminant:
+    """det Ū_all of one deduction, evaluated by the compiled kernels.
+
+    The same answers as :meth:`Deduction.log_det` and :meth:`Deduction.matrix`
+    with ``stable=True`` (to rounding), without a Python call per element.
+    numba is imported, and the kernels compiled or loaded from their cache, on
+    the first evaluation.
+    """
+
+    def __init__(self, deduction: Deduction):
+        self.program = compile_program(deduction)
+        p = self.program
+        self._operations = (p.slot_offset, p.slot_rows, p.slot_width, p.operations, p.terms, p.places,
+                            p.places_start, p.matrices, p.orthos, p.ortho_blocks, p.beams, p.beam_rotation)
+        self._layout = (p.slot_offset, p.slot_width, p.slot_columns, p.slot_columns_start, p.workspace,
+                        p.slot_rows.size, p.root, p.root_row, p.geometric_rows, p.order, p.kept_rows,
+                        p.kept_columns)
+        #: evaluations of det Ū_all so far (one per frequency)
+        self.evaluations = 0
+
+    @property
+    def order(self) -> int:
+        """Order N of Ū_all (after any release)."""
+        return self.program.kept_columns.size
+
+    def _evaluate(self, omega, group: int | None, with_matrices: bool):
+        from linmstmm import _kernels  # numba loads here, not at import
+
+        omega = np.atleast_1d(np.asarray(omega))
+        omega = omega.astype(complex if np.iscomplexobj(omega) else float)
+        n, order = omega.size, self.order
+        matrices = np.zeros((n if with_matrices else 0, order, order), dtype=omega.dtype)
+        sign = np.zeros(n, dtype=omega.dtype)
+        log_abs, log_scale = np.zeros(n), np.zeros(n)
+        _kernels.evaluate(self._operations, self._layout, np.ascontiguousarray(omega), max(group or n, 1),
+                          matrices, sign, log_abs, log_scale)
+        self.evaluations += n
+        return matrices, sign, log_abs, log_scale
+
+    def log_det(self, omega):
+        """(sign or phase (n,), log|det Ū_all| (n,)) at each of ``omega`` (n,) rad/s, real or complex.
+
+        Each frequency is evaluated on its own (the determinant does not
+        depend on the orthonormalisations chosen).
+        """
+        _, sign, log_abs, _ = self._evaluate(omega, 1, False)
+        return sign, log_abs
+
+    def matrix(self, omega):
+        """(Ū_all stack (n, N, N), log_scale (n,)): the orthonormalised matrix, with
+        det Ū_all = det(matrix) · exp(log_scale). The whole stack takes the same
+        decisions, so that differences between its entries are smooth in ω."""
+        matrices, _, _, log_scale = self._evaluate(omega, None, True)
+        return matrices, log_scale

@@ -1,0 +1,317 @@
+"""The deduction of one model compiled into flat arrays: a straight-line program.
+
+:class:`~linmstmm.deduction.Deduction` carries the boundary states from the
+tips to the root in Python, element by element, orthonormalising on the way.
+What it does depends on the topology alone, except how many pieces each beam
+is cut into and whether an orthonormalisation is needed (both decided per
+frequency). :func:`compile_program` walks that carry once, with every
+orthonormalisation assumed to happen, and writes it down as a list of
+operations on numbered blocks ("slots") of a workspace; the compiled kernels
+(:mod:`linmstmm._kernels`) replay the list for any frequency without a Python
+call per element, deciding the pieces and the skipped orthonormalisations
+themselves. A skipped orthonormalisation still lays its blocks out on the
+columns the plan expects (the columns it would have widened them to, with
+zeros), so the plan holds either way.
+
+Slots: every block a carry forms (a port state, a geometric row, a cut side
+waiting to enter, the root's known side) is stored row-major, ``rows ×
+len(columns)``, at its own offset of the workspace. An operation that widens
+a block's columns writes a new slot; one that keeps them writes in place.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from linmstmm.deduction import Deduction
+from linmstmm.elements.beam import _state_rotation
+
+# Operation codes (first entry of each record in Program.operations).
+#: TIP dst constant: the slot holds a constant (12, k) selection, reference 1.
+TIP = 0
+#: CARRY dst src U0 U2: dst = (U0 + ω² U2) src (U2 = −1: none; only U2[6:, :6] acts).
+CARRY = 1
+#: BEAM slot beam first ortho: the slot carried along the beam; ``first`` = 1: the first
+#: piece only (the piece count decided from the group's largest |ω|); 0: the
+#: other pieces, each followed by orthonormalisation ``ortho`` (in place).
+BEAM = 2
+#: COMBINE dst terms: dst = Σ M_i src_i placed on dst's columns (M_i = −1: identity).
+COMBINE = 3
+#: GEOMETRIC dst first other H: dst = −first[:6] + H other, each placed on dst's columns.
+GEOMETRIC = 4
+#: ORTHO index: orthonormalisation record ``index`` (Program.orthos).
+ORTHO = 5
+
+#: Block kinds in an orthonormalisation: a formed row (no growth reference), or a state.
+ROW_BLOCK, STATE_BLOCK = 0, 1
+#: An orthonormalisation that holds every block there is (all of Ū_all formed so
+#: far) and after which at most this many element carries, and no beam, remain is
+#: left to the final LU: a change of unknowns commutes with the carries that
+#: follow (they multiply rows), and the LU factorises the same matrix. On the
+#: launcher these were the four largest (60 rows, 54 columns) and cost more than
+#: half of an evaluation; log|det| against mpmath at 23 frequencies from 10 to
+#: 3e4 rad/s kept its accuracy (largest error 1.0e-13 relative, against 1.7e-14
+#: to 9.2e-14 of the numpy carry). Not for a model without boundary, whose
+#: closing equation T_loop − I must be orthonormalised with the state carried
+#: round the loop (every block holds the closing cut's unknowns there), lest the I
+#: be lost under T_loop's growth (a ring at 1.3e5 rad/s lost 3e-9 in log|det|).
+FINAL_CARRIES = 4
+
+
+@dataclass(frozen=True)
+class Program:
+    """A compiled deduction: everything the kernels need, as plain arrays.
+
+    Attributes
+    ----------
+    slot_offset, slot_rows, slot_width : (S,) int64, where slot s sits in the
+        workspace, its rows and its number of columns.
+    slot_columns, slot_columns_start : the columns (unknowns) of slot s are
+        ``slot_columns[slot_columns_start[s]:slot_columns_start[s + 1]]``.
+    workspace : int, entries per frequency.
+    operations : (P, 6) int64 records ``(code, a, b, c, d, e)``, see the codes above.
+    terms : (T, 3) int64 ``(src, matrix, place)`` of COMBINE records ``a..a+b``;
+        ``place`` indexes ``places``.
+    places, places_start : column positions of a source slot in a destination slot.
+    matrices : (K, 12, 12) float64 constants (selections padded, U0, U2, U_{j,Ik}, H).
+    orthos : (O, 5) int64 ``(first block, number of blocks, state block, columns, layout only)``;
+        ``layout only`` = 1: the blocks are laid out on the columns, never orthonormalised.
+    ortho_blocks : (B, 5) int64 ``(src, dst, rows, kind, place)``: ``place``
+        indexes ``places`` (src's columns in dst), −1 where dst is src.
+    beams : (nb, 10) float64 ``(E, G, rho, A, Iy, Iz, J, Ip, length, flags)``,
+        flags = axial + 2 torsion; beam_rotation : (nb, 12, 12) its state rotation.
+    root, root_row : slots of the carried root state and of −Z_root.
+    geometric_rows : (g,) slots of the geometric rows, in Ū_all's row order.
+    order, kept_rows, kept_columns : order of Ū_all before release, and the rows and
+        columns that remain after it.
+    """
+
+    slot_offset: np.ndarray
+    slot_rows: np.ndarray
+    slot_width: np.ndarray
+    slot_columns: np.ndarray
+    slot_columns_start: np.ndarray
+    workspace: int
+    operations: np.ndarray
+    terms: np.ndarray
+    places: np.ndarray
+    places_start: np.ndarray
+    matrices: np.ndarray
+    orthos: np.ndarray
+    ortho_blocks: np.ndarray
+    beams: np.ndarray
+    beam_rotation: np.ndarray
+    root: int
+    root_row: int
+    geometric_rows: np.ndarray
+    order: int
+    kept_rows: np.ndarray
+    kept_columns: np.ndarray
+
+
+class _Planner:
+    """Walks :meth:`Deduction._carry` symbolically and records its operations."""
+
+    def __init__(self, deduction: Deduction):
+        self.deduction = deduction
+        self.slots: list[tuple[int, np.ndarray]] = []  # (rows, columns)
+        self.operations: list[tuple] = []
+        self.terms: list[tuple] = []
+        self.places: list[np.ndarray] = []
+        self.matrices: list[np.ndarray] = []
+        self.orthos: list[tuple] = []
+        self.ortho_blocks: list[tuple] = []
+        self.beams: list[tuple] = []
+        self.rotations: list[np.ndarray] = []
+
+    # -- storage ----------------------------------------------------------------------
+    def slot(self, rows: int, columns) -> int:
+        self.slots.append((rows, np.asarray(columns, dtype=np.int64)))
+        return len(self.slots) - 1
+
+    def matrix(self, matrix) -> int:
+        padded = np.zeros((12, 12))
+        matrix = np.asarray(matrix, dtype=float)
+        padded[:matrix.shape[0], :matrix.shape[1]] = matrix
+        self.matrices.append(padded)
+        return len(self.matrices) - 1
+
+    def place(self, columns, onto) -> int:
+        self.places.append(np.searchsorted(onto, columns).astype(np.int64))
+        return len(self.places) - 1
+
+    def emit(self, *record) -> None:
+        self.operations.append(tuple(record) + (0,) * (6 - len(record)))
+
+    # -- blocks -----------------------------------------------------------------------
+    def tip(self, link, negate: bool = False) -> int:
+        """Slot of a boundary end's or cut side's state in its (kept) unknowns."""
+        given = self.deduction.tip_state(link, 1)
+        columns, selection = given.columns, given.matrix[0]
+        slot = self.slot(12, columns)
+        self.emit(TIP, slot, self.matrix(-selection if negate else selection))
+        return slot
+
+    def columns(self, slot) -> np.ndarray:
+        return self.slots[slot][1]
+
+    def combined(self, sources: list[tuple[int, int]]) -> int:
+        """New slot = Σ matrix @ source over the union of the sources' columns."""
+        union = np.unique(np.concatenate([self.columns(s) for s, _ in sources]))
+        dst = self.slot(12, union)
+        first = len(self.terms)
+        for src, matrix in sources:
+            self.terms.append((src, matrix, self.place(self.columns(src), union)))
+        self.emit(COMBINE, dst, first, len(sources))
+        return dst
+
+
+def compile_program(deduction: Deduction) -> Program:
+    """The straight-line program of ``deduction`` (after any release of unknowns)."""
+    plan = _Planner(deduction)
+    topology = deduction.topology
+    elements = topology.elements
+    root_given = topology.root if topology.root[0] == "boundary" else ("cut", topology.root[1], 0)
+    rows: list[list] = [["root", plan.tip(root_given, negate=True), 12]]  # [label, slot, rows]
+    open_states: dict[int, int] = {}
+    waiting: dict[tuple, int] = {}
+
+    def orthonormalise(state: int, emit: bool = True) -> int:
+        """Mirror of :meth:`_Orthonormaliser.apply`; returns the state's new slot.
+
+        emit : False to record it without an ORTHO operation (a beam's pieces
+        after the first run it themselves)."""
+        columns = set(plan.columns(state).tolist())
+        others = ([("row", i, r[1]) for i, r in enumerate(rows)]
+                  + [("state", key, slot) for key, slot in open_states.items()]
+                  + [("waiting", key, slot) for key, slot in waiting.items()])
+        held = [set(plan.columns(slot).tolist()) for *_, slot in others]
+        chosen: set[int] = set()
+        while True:
+            more = {i for i, cs in enumerate(held) if i not in chosen and cs & columns}
+            if not more:
+                break
+            chosen |= more
+            for i in more:
+                columns |= held[i]
+        blocks = [others[i] for i in sorted(chosen)] + [("self", None, state)]
+        union = np.array(sorted(columns), dtype=np.int64)
+        block_rows = [rows[key][2] if kind == "row" else 12 for kind, key, _ in blocks]
+        if sum(block_rows) < union.size:  # fewer rows than columns: never orthonormalised
+            return state
+        first = len(plan.ortho_blocks)
+        new_slots = []
+        for (kind, key, src), count in zip(blocks, block_rows):
+            same = np.array_equal(plan.columns(src), union)
+            dst = src if same else plan.slot(count, union)
+            place = -1 if same else plan.place(plan.columns(src), union)
+            plan.ortho_blocks.append((src, dst, count, ROW_BLOCK if kind == "row" else STATE_BLOCK, place))
+            new_slots.append((kind, key, dst))
+        everything = len(blocks) == len(others) + 1
+        plan.orthos.append((first, len(blocks), len(blocks) - 1, union.size, 0, int(everything)))
+        if emit:
+            plan.emit(ORTHO, len(plan.orthos) - 1)
+        for kind, key, dst in new_slots:
+            if kind == "row":
+                rows[key][1] = dst
+            elif kind == "state":
+                open_states[key] = dst
+            elif kind == "waiting":
+                waiting[key] = dst
+        return new_slots[-1][2]
+
+    def enter_cut_side(link) -> int:
+        _, c, side = link
+        if (c, side) in waiting:
+            return waiting.pop((c, side))
+        waiting[c, 1 - side] = plan.tip(("cut", c, 1 - side))
+        return plan.tip(link)
+
+    for e in topology.order:
+        element = elements[e]
+        inputs = []
+        for p in element.inputs:
+            link = element.ports[p].link
+            if link[0] == "element":
+                inputs.append(open_states.pop(link[1]))
+            elif link[0] == "cut" and not topology.cuts[link[1]].closing:
+                inputs.append(enter_cut_side(link))
+            else:
+                inputs.append(plan.tip(link))
+        if element.kind == "beam":
+            beam = element.record
+            plan.beams.append((beam.E, beam.G, beam.rho, beam.A, beam.Iy, beam.Iz, beam.J, beam.Ip,
+                               beam.length, float(beam.axial) + 2.0 * float(beam.torsion)))
+            plan.rotations.append(_state_rotation(tuple(np.ravel(beam.axes)), element.inputs[0] == 1))
+            index = len(plan.beams) - 1
+            plan.emit(BEAM, inputs[0], index, 1)
+            state = orthonormalise(inputs[0])
+            records = len(plan.orthos)
+            if orthonormalise(state, emit=False) != state:
+                raise AssertionError("a beam's orthonormalisation widened its columns twice")
+            plan.emit(BEAM, state, index, 0, records if len(plan.orthos) > records else -1)
+            terms = [(state, -1)]
+        else:
+            kinematic, inertial = deduction._polynomial_parts(e)
+            carried = plan.slot(12, plan.columns(inputs[0]))
+            plan.emit(CARRY, carried, inputs[0], plan.matrix(kinematic),
+                      -1 if inertial is None else plan.matrix(inertial))
+            terms = [(carried, -1)]
+        for (label, forces, incidence), other in zip(deduction._other_inputs(e), inputs[1:]):
+            terms.append((other, plan.matrix(forces)))
+            first = inputs[0]
+            union = np.unique(np.concatenate([plan.columns(first), plan.columns(other)]))
+            row = plan.slot(6, union)
+            plan.emit(GEOMETRIC, row, first, other, plan.matrix(incidence),
+                      len(plan.places))
+            plan.place(plan.columns(first), union)
+            plan.place(plan.columns(other), union)
+            rows.append([label, row, 6])
+        state = terms[0][0] if len(terms) == 1 else plan.combined(terms)
+        open_states[e] = orthonormalise(state)
+    root = open_states[topology.order[-1]]
+    if topology.root[0] == "boundary":
+        _leave_final_orthos_to_the_lu(plan)
+
+    sizes = np.array([r * len(c) for r, c in plan.slots], dtype=np.int64)
+    starts = np.cumsum([0] + [len(c) for _, c in plan.slots])
+    places_start = np.cumsum([0] + [p.size for p in plan.places])
+    order = deduction.full_order
+    return Program(
+        slot_offset=np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64),
+        slot_rows=np.array([r for r, _ in plan.slots], dtype=np.int64),
+        slot_width=np.array([len(c) for _, c in plan.slots], dtype=np.int64),
+        slot_columns=np.concatenate([c for _, c in plan.slots]).astype(np.int64),
+        slot_columns_start=starts.astype(np.int64),
+        workspace=int(sizes.sum()),
+        operations=np.array(plan.operations, dtype=np.int64).reshape(-1, 6),
+        terms=np.array(plan.terms, dtype=np.int64).reshape(-1, 3),
+        places=np.concatenate(plan.places).astype(np.int64) if plan.places else np.zeros(0, np.int64),
+        places_start=places_start.astype(np.int64),
+        matrices=np.array(plan.matrices).reshape(-1, 12, 12),
+        orthos=np.array(plan.orthos, dtype=np.int64)[:, :5].reshape(-1, 5),
+        ortho_blocks=np.array(plan.ortho_blocks, dtype=np.int64).reshape(-1, 5),
+        beams=np.array(plan.beams, dtype=float).reshape(-1, 10),
+        beam_rotation=np.array(plan.rotations).reshape(-1, 12, 12),
+        root=root,
+        root_row=rows[0][1],
+        geometric_rows=np.array([r[1] for r in rows[1:]], dtype=np.int64),
+        order=order,
+        kept_rows=np.setdiff1d(np.arange(order), deduction.released_rows).astype(np.int64),
+        kept_columns=np.setdiff1d(np.arange(order), deduction.released_columns).astype(np.int64),
+    )
+
+
+def _leave_final_orthos_to_the_lu(plan: _Planner) -> None:
+    """Mark the orthonormalisations :data:`FINAL_CARRIES` describes as layout only."""
+    carries = 0
+    for code, index, *_ in reversed(plan.operations):
+        if code == BEAM:
+            return
+        if code == CARRY:
+            carries += 1
+            if carries > FINAL_CARRIES:
+                return
+        if code == ORTHO and plan.orthos[index][5]:
+            plan.orthos[index] = plan.orthos[index][:4] + (1, 1)

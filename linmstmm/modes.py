@@ -38,6 +38,7 @@ from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
 from linmstmm.nullspace import NULL_TOLERANCE, equilibration
 from linmstmm.solve import frequency_finder, search_note
+from linmstmm.threads import single_blas_thread
 
 #: Normalisations of the modes: unit modal mass, or unit largest translation.
 NORMALIZATIONS = ("mass", "max")
@@ -178,6 +179,7 @@ def mac_matrix(a, b) -> np.ndarray:
     return cross / np.outer(np.sum(np.abs(a) ** 2, axis=1), np.sum(np.abs(b) ** 2, axis=1))
 
 
+@single_blas_thread
 def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = None,
                 stations: int = 21, normalization: str = "mass", rigid_body: bool = True,
                 root: str | None = None) -> ModalResult:

@@ -34,6 +34,7 @@ import scipy.linalg
 
 from linmstmm.counting import count_in_disc, count_zeros, count_zeros_many, deflated, divided_out
 from linmstmm.nullspace import equilibration
+from linmstmm.predicted import predicted_roots
 
 #: Grid points per octave of the scans (the fast path's above 1 rad/s, an
 #: eighth of it below; every segment's).
@@ -56,6 +57,13 @@ MAX_XTOL = 1e-6
 SCAN_OCTAVES = 4
 #: Lowest scanned circular frequency, rad/s.
 OMEGA_FLOOR = 1e-3
+#: A predicted root below this many OMEGA_FLOOR is refused (an error, not a silently
+#: wrong list): a free strip 9.9 m long with Iz = 1e-12 m⁴ has its first bending mode at
+#: 1.4e-3 rad/s, which the counts from OMEGA_FLOOR took for a double root higher up;
+#: its coarse prediction was 4.7e-3. Two free bodies on a spring whose first mode is
+#: at 9.1e-3 rad/s are found exactly. The floor itself is absolute (rad/s): making it
+#: relative to the model's own frequencies is what would remove this limit.
+FLOOR_MARGIN = 5.0
 #: The scan for ``count`` roots gives up above this circular frequency, rad/s.
 OMEGA_CEILING = 1e9
 #: Starting points of a half-ellipse count with the known roots divided out.
@@ -91,6 +99,8 @@ class RootFinder:
     kinematics (:func:`linmstmm.rigid_motion.rigid_body_mode_count`); their
     zeros of det Ū_all at ω = 0 are divided out once they are confirmed
     (:meth:`divide_out_rigid_body_zeros`).
+    predictor : callable n -> (m,) rad/s, the lowest n elastic roots predicted
+    (e.g. :func:`linmstmm.predicted.predict_frequencies` of the model), or None.
 
     Candidates come from the scan; each is polished by local linearisation
     (Newton for the nonlinear eigenproblem Ū(ω) v = 0): with A = Ū(ω) and
@@ -139,7 +149,7 @@ class RootFinder:
 
     def __init__(self, log_det, matrix, xtol: float = 1e-14,
                  points_per_octave: int = POINTS_PER_OCTAVE, points_per_root: int = 6,
-                 rigid_body_modes: int = 0):
+                 rigid_body_modes: int = 0, predictor=None):
         if not 0 < xtol <= MAX_XTOL:
             raise ValueError(f"xtol must be in (0, {MAX_XTOL:g}], got {xtol:g}: looser Newton "
                              "tolerances blur distinct roots into one")
@@ -157,6 +167,11 @@ class RootFinder:
         #: why the search ended early, if it did
         self.note = ""
         self._rigid = rigid_body_modes
+        #: callable n -> (m,) predicted lowest elastic roots, rad/s, or None
+        self.predictor = predictor
+        #: the compiled determinant behind ``log_det`` and ``matrix``, where the
+        #: caller gives one (:mod:`linmstmm.determinant`: it counts evaluations)
+        self.determinant = None
         #: starts of cluster members not yet polished (see :meth:`clusters`)
         self.deferred_members: list[tuple[float, float]] = []  # (start, the root whose pencil gave it)
         #: sign-change brackets (lo, hi) Newton missed that :meth:`_needed` left out
@@ -671,7 +686,7 @@ class RootFinder:
             return None
         upper = min(upper, cap)
         below = [r for r in found if r < upper]
-        return below[:count] if self._no_other_zeros(found, upper) else None
+        return below[:count] if self.confirm_no_other_zeros(found, upper) else None
 
     def _settled(self, found: list[float], count: int | None, omega_max: float | None,
                  cap: float = np.inf) -> list[float]:
@@ -756,7 +771,7 @@ class RootFinder:
             missing_below += missing
         return kept, upper
 
-    def _no_other_zeros(self, known: list[float], upper: float) -> bool:
+    def confirm_no_other_zeros(self, known: list[float], upper: float) -> bool:
         """True if (OMEGA_FLOOR, upper) holds no zeros of det Ū_all but ``known``.
 
         The count runs on det with the known roots divided out (:func:`~linmstmm.counting.deflated`),
@@ -1043,9 +1058,21 @@ class RootFinder:
         """Elastic roots (rad/s) ascending, each repeated per multiplicity.
 
         The lowest ``count``, or all up to ``omega_max``, with none missed:
-        the fast path (:meth:`_scan_ahead`) when one count confirms it, else
-        the segment search (:meth:`_search`).
+        from the predictor's frequencies when one count confirms them
+        (:func:`~linmstmm.predicted.predicted_roots`, with ``count``), else the
+        fast path (:meth:`_scan_ahead`) when one count confirms it, else the
+        segment search (:meth:`_search`).
         """
+        if count is not None and self.predictor is not None:
+            predictions = self.predictor(count + 1)
+            if predictions.size and predictions[0] < FLOOR_MARGIN * OMEGA_FLOOR:
+                raise RuntimeError(
+                    f"the lowest elastic natural frequency is near {predictions[0] / (2 * np.pi):.3g} Hz "
+                    f"(a coarse finite-element model), below what the root search can certify "
+                    f"({FLOOR_MARGIN * OMEGA_FLOOR / (2 * np.pi):.3g} Hz): use `linmstmm fe` for this model")
+            found = predicted_roots(self, predictions, count)
+            if found is not None:  # certified up to above the count-th: complete below omega_max too
+                return [w for w in found if omega_max is None or w <= omega_max]
         found = self._scan_ahead(count, omega_max) if count is not None or omega_max is not None else None
         if found is None:
             found = self._search(count, omega_max, omega_start)

@@ -12,8 +12,11 @@ from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
 from linmstmm.nullspace import release_indeterminate
 from linmstmm.precision import refine_roots, separated_cluster
+from linmstmm.predicted import predict_frequencies
+from linmstmm.determinant import determinant
 from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.roots import CERTIFIED_STEP, OMEGA_CEILING, RootFinder
+from linmstmm.threads import single_blas_thread
 from linmstmm.topology import build_topology
 
 
@@ -35,6 +38,8 @@ class FrequencyResult:
     mpmath (all of them for ``digits`` > 15, else only those float64 could
     not certify). frequencies_text, omegas_text : the frequencies (Hz) and
     circular frequencies (rad/s) as decimal strings at that precision (mpmath only).
+    evaluations : float64 evaluations of det Ū_all (one per frequency) the
+    search and its certifying counts took.
     """
 
     model: str
@@ -47,6 +52,7 @@ class FrequencyResult:
     indeterminate_released: int = 0
     frequencies_text: list | None = None
     omegas_text: list | None = None
+    evaluations: int = 0
 
     def to_dict(self) -> dict:
         """The ``linmstmm freqs --json`` object (``shared/spec/cli.md``)."""
@@ -59,15 +65,20 @@ class FrequencyResult:
             "precision": self.precision,
             "method": "mstmm",
             "indeterminate_released": int(self.indeterminate_released),
+            "evaluations": int(self.evaluations),
             **({"note": self.note} if self.note else {}),
             **({"frequencies_hz_text": self.frequencies_text} if self.frequencies_text else {}),
             **({"omega_rad_s_text": self.omegas_text} if self.omegas_text else {}),
         }
 
 
-def frequency_finder(model: Model, root: str | None = None, cut_at=(), **options):
+def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: str = "auto", **options):
     """The deduced system of ``model`` and a root finder on its stable determinant.
 
+    engine : how det Ū_all is evaluated, "auto", "numpy" or "compiled"
+    (:func:`linmstmm.determinant.determinant`; kept as ``finder.determinant``
+    with its count of evaluations); the deduction's own numpy carry serves
+    mode shapes and the mpmath refinement either way.
     root, cut_at : see :func:`linmstmm.topology.build_topology`. options go to
     :class:`linmstmm.roots.RootFinder` (xtol, points_per_octave, points_per_root).
     The finder knows the rigid-body modes (counted from the model's kinematics,
@@ -78,15 +89,19 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), **options
     """
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
     released = release_indeterminate(deduction)
-    finder = RootFinder(deduction.log_det, lambda omega: deduction.matrix(omega, stable=True)[0],
-                        rigid_body_modes=rigid_body_mode_count(model), **options)
+    evaluator = determinant(deduction, engine)
+    finder = RootFinder(evaluator.log_det, lambda omega: evaluator.matrix(omega)[0],
+                        rigid_body_modes=rigid_body_mode_count(model),
+                        predictor=lambda n: predict_frequencies(model, n), **options)
+    finder.determinant = evaluator
     finder.divide_out_rigid_body_zeros(finder.rigid_body_modes())
     return deduction, finder, released
 
 
+@single_blas_thread
 def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None = None,
                         digits: int | None = None, root: str | None = None,
-                        guess_hz=None) -> FrequencyResult:
+                        guess_hz=None, engine: str = "auto") -> FrequencyResult:
     """Elastic natural frequencies of ``model`` by the transfer matrix method.
 
     count : the lowest N; fmax : Hz, all up to fmax; both: whichever stops first.
@@ -99,6 +114,9 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     root : boundary end (point name) to use as the root of the transfer tree.
     guess_hz : frequencies of a similar model (a neighbouring scene) to start
     from; used with ``count`` only, and checked by a root count either way.
+    engine : how det Ū_all is evaluated: "numpy", "compiled" (numba), or "auto"
+    (compiled where the kernels are already loaded in this process; see
+    :mod:`linmstmm.determinant`). The roots agree to rounding either way.
     Raises ModelError for ``fmax`` alone that is not finite, or below which the
     beams have more modes than a range is searched for
     (:func:`~linmstmm.mode_bound.check_range_request`).
@@ -106,7 +124,7 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     start = time.perf_counter()
     if fmax is not None and count is None:
         check_range_request(model, fmax)
-    deduction, finder, released = frequency_finder(model, root)
+    deduction, finder, released = frequency_finder(model, root, engine=engine)
     rigid = finder.rigid_body_modes()
     omega_max = None if fmax is None else 2 * np.pi * fmax
     if guess_hz is not None and count is not None and fmax is None:
@@ -125,7 +143,8 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     note = search_note(finder, omegas.size, unseparated, count, fmax)
     return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.full_order,
                            time.perf_counter() - start, precision=precision, note=note,
-                           indeterminate_released=released, frequencies_text=text, omegas_text=omega_text)
+                           indeterminate_released=released, frequencies_text=text, omegas_text=omega_text,
+                           evaluations=finder.determinant.evaluations)
 
 
 def search_note(finder: RootFinder, found: int, unseparated: dict, count: int | None, fmax: float | None) -> str:
@@ -170,7 +189,7 @@ def _refined_in_mpmath(deduction, model, finder, omegas, chosen, unseparated, di
             distinct_refined += len(set(members))
             del unseparated[w]
     with mpmath.workdps(digits + 10):  # 2π and the division at the refined precision
-        text = [mpmath.nstr(v / (2 * mpmath.pi), digits) if v is not None else repr(w / (2 * np.pi))
+        text = [mpmath.nstr(v / (2 * mpmath.pi), digits) if v is not None else repr(float(w / (2 * np.pi)))
                 for w, v in zip(omegas, values)]
         omega_text = [mpmath.nstr(v, digits) if v is not None else repr(float(w)) for w, v in zip(omegas, values)]
     omegas = np.array([float(v) if v is not None else w for w, v in zip(omegas, values)])

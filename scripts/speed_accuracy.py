@@ -302,7 +302,7 @@ def certification_floor(model, rounds: int) -> dict:
 
     build : the deduced system and its root finder (``frequency_finder``:
         topology, deduction, release of indeterminate unknowns, rigid-body count);
-    count : the solver's closing count (``RootFinder._no_other_zeros``) given the
+    count : the solver's closing count (``RootFinder.confirm_no_other_zeros``) given the
         exact roots: det with them divided out, counted over the half-ellipse up to
         midway to the next root (it is what certifies that none is missed).
     Also ``one_det``: one stable evaluation of det Ū_all at one frequency, and
@@ -314,7 +314,7 @@ def certification_floor(model, rounds: int) -> dict:
     top = (omegas[COUNT - 1] + omegas[COUNT]) / 2
 
     def closing_count():
-        return finder._no_other_zeros(list(omegas[:COUNT]), top)
+        return finder.confirm_no_other_zeros(list(omegas[:COUNT]), top)
 
     if not closing_count():
         raise AssertionError("the closing count does not confirm the exact roots")

@@ -178,10 +178,10 @@ def test_count_with_known_roots_divided_out_sees_a_missing_or_a_false_one():
     _, finder, _ = frequency_finder(spring_mass_chain(k, m))
     exact = list(np.repeat(np.sqrt(np.array([(4 - np.sqrt(7)) / 3, (4 + np.sqrt(7)) / 3]) * k / m), 3))
     upper = 1.5 * exact[-1]
-    assert finder._no_other_zeros(exact, upper)
-    assert not finder._no_other_zeros(exact[:-1], upper)  # one of the triple root missing
-    assert not finder._no_other_zeros(exact[:3], upper)  # the upper triple missing
-    assert not finder._no_other_zeros(exact + [0.5 * exact[0]], upper)  # a root that is not one
+    assert finder.confirm_no_other_zeros(exact, upper)
+    assert not finder.confirm_no_other_zeros(exact[:-1], upper)  # one of the triple root missing
+    assert not finder.confirm_no_other_zeros(exact[:3], upper)  # the upper triple missing
+    assert not finder.confirm_no_other_zeros(exact + [0.5 * exact[0]], upper)  # a root that is not one
     assert count_zeros(deflated(finder.log_det, exact[:3]), 1e-3, upper) == 3
 
 
@@ -232,7 +232,7 @@ def test_a_count_across_a_phase_jump_fails_fast():
         count_zeros(jumping, 1.0, 10.0)
     assert len(calls) < 60
     # the fast path's closing count then says "not confirmed" (the segment search decides)
-    assert RootFinder(jumping, matrix=None)._no_other_zeros([], 10.0) is False
+    assert RootFinder(jumping, matrix=None).confirm_no_other_zeros([], 10.0) is False
 
 
 @pytest.mark.parametrize("option, match", [(dict(xtol=1e-5), "xtol must be in"),
@@ -297,3 +297,16 @@ def test_sparse_determinant_matches_mpmath_det():
         assert abs(sparse_determinant(matrix) / mp.det(mp.matrix(matrix.tolist())) - 1) < mp.mpf(10) ** -35
         matrix[4] = matrix[2] * 3
         assert sparse_determinant(matrix) == 0
+
+
+def test_roots_not_refined_in_mpmath_are_written_as_plain_numbers():
+    """A result where only some roots went to mpmath writes the others as decimal
+    text too (they came out as "np.float64(40.93…)")."""
+    from linmstmm.solve import _refined_in_mpmath
+
+    model = spring_mass_chain()
+    deduction, finder, _ = frequency_finder(model)
+    omegas = np.array(finder.find(3, None))
+    _, _, text, omega_text = _refined_in_mpmath(deduction, model, finder, omegas, [], {}, 20, False)
+    assert [float(t) for t in text] == list(omegas / (2 * np.pi))
+    assert [float(t) for t in omega_text] == list(omegas)

@@ -1,0 +1,77 @@
+"""Predict, polish, certify: the root search that starts from a coarse FE model.
+
+The predictions only say where to look; completeness is the closing count's.
+Checked here: the search is certified with few evaluations per root on the
+launcher and agrees with the FE route; a prediction list with a root left
+out, or with one root twice, is refused by the count (the caller searches).
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from linmstmm.fe import fe_frequencies
+from linmstmm.model import load_model
+from linmstmm.predicted import predict_frequencies, predicted_roots
+from linmstmm.solve import frequency_finder
+
+LAUNCHER = "models/mlrs/mlrs.toml"
+
+
+@pytest.fixture(scope="module")
+def launcher():
+    return load_model(LAUNCHER)
+
+
+def test_launcher_first_20_in_few_evaluations_agree_with_fe(launcher):
+    _, finder, _ = frequency_finder(launcher)
+    roots = predicted_roots(finder, predict_frequencies(launcher, 21), 20)
+    assert roots is not None
+    assert finder.determinant.evaluations / 20 <= 10
+    fe = fe_frequencies(launcher, 20)
+    np.testing.assert_allclose(np.array(roots) / (2 * np.pi), fe.frequencies_hz,
+                               rtol=max(1e-9, 3 * np.nanmax(fe.error_estimate)))
+
+
+@pytest.mark.parametrize("change", ["leave one out", "one twice"])
+def test_wrong_predictions_are_refused_by_the_count(launcher, change):
+    _, finder, _ = frequency_finder(launcher)
+    predictions = predict_frequencies(launcher, 11)
+    if change == "leave one out":
+        predictions = np.delete(predictions, 4)
+    else:
+        predictions = np.sort(np.r_[predictions, predictions[4] * (1 + 1e-6)])
+    assert predicted_roots(finder, predictions, 10 if change == "one twice" else 9) is None
+
+
+def test_too_few_predictions_are_refused(launcher):
+    _, finder, _ = frequency_finder(launcher)
+    assert predicted_roots(finder, predict_frequencies(launcher, 5), 10) is None
+
+
+def free_strip(Iz: float):
+    from builders import single_beam_model
+
+    return single_beam_model(None, None, length=9.9, A=0.088, Iy=8.9e-4, Iz=Iz, J=1e-9,
+                             material=dict(E=3.9e9, G=1.5e9, rho=1200.0))
+
+
+def test_free_strip_with_a_soft_plane_agrees_with_fe():
+    """Iy/Iz = 6e5: refused as a mechanism before (fixed probe frequencies)."""
+    from linmstmm.solve import natural_frequencies
+
+    model = free_strip(1.4e-9)
+    result, fe = natural_frequencies(model, count=4), fe_frequencies(model, count=4)
+    assert result.rigid_body_modes == fe.rigid_body_modes == 6
+    np.testing.assert_allclose(result.frequencies_hz, fe.frequencies_hz, rtol=1e-6)
+
+
+@pytest.mark.parametrize("Iz", [1e-12, 1e-14])
+def test_modes_below_the_search_floor_are_an_error_not_a_wrong_list(Iz):
+    """Iz = 1e-12 and 1e-14 m⁴ put the first bending mode at 2.2e-4 and 2.2e-5 Hz,
+    below the counts' floor: the search returned a double root at 6.1e-4 Hz, or
+    five wrong values, before."""
+    from linmstmm.solve import natural_frequencies
+
+    with pytest.raises(RuntimeError, match="below what the root search can certify"):
+        natural_frequencies(free_strip(Iz), count=4)

@@ -50,11 +50,20 @@ positive kinetic energy, 1e-13 relative to the largest) are the rigid-body
 modes. They are deflated exactly: K is made invertible by temporary
 statically determinate supports on as many DOFs as there are rigid motions,
 and the solve is projected M-orthogonally off the rigid-body modes.
-Massless DOFs (a point between two springs, a massless beam) need nothing:
-the operator ``K⁺M`` maps them to zero (infinite frequency), which is static
-condensation done implicitly. A rigid motion without mass (a point mass
-without rotary inertia and with nothing holding its rotation) has neither
-mass nor stiffness; it is not a mode and is neither counted nor reported.
+
+Massless DOFs (a point between two springs, a spring's free far end, a
+massless body or beam) are condensed out statically, which is exact since
+their inertia is exactly zero: masses below 1e-13 of the model's own scale
+(its total mass, and for inertias that times its extent squared) are removed
+first (:func:`_negligible_mass_removed`), so such DOFs have zero rows in M.
+The flexibility ``K⁺`` applied to inertial loads moves them statically, and
+the eigenproblem is posed on the directions that carry mass only: the model
+has exactly rank M less its rigid-body modes elastic modes, and a massless
+direction (infinite frequency) is never taken for one. A model whose mass
+all sits in rigid-body motions has no elastic mode. A rigid motion without
+mass (a point mass without rotary inertia and with nothing holding its
+rotation) has neither mass nor stiffness; it is not a mode and is neither
+counted nor reported.
 
 Mesh refinement
 ---------------
@@ -76,7 +85,7 @@ bounds such a mode's own error.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from time import perf_counter
 
 import numpy as np
@@ -93,9 +102,13 @@ from linmstmm.model import Beam, Model
 REDUNDANT_CONSTRAINT = 1e-10
 #: Entries below this fraction of their row's largest are rounding debris.
 NEGLIGIBLE_ENTRY = 1e-14
-#: Rigid motions whose kinetic energy is below this fraction of the largest
-#: one are massless: neither modes nor counted.
-MASSLESS_MOTION = 1e-13
+#: A mass (kg), inertia (kg m²) or kinetic energy below this fraction of the
+#: model's own scale of the same units is rounding, not mass: a body's mass or
+#: principal inertia, a beam, or a rigid motion below it carries none.
+MASSLESS = 1e-13
+#: Eigenvalues of the mass matrix scaled to unit diagonal below this fraction of
+#: the largest are the rounding of an exact zero: directions without mass.
+MASS_RANK = 1e-12
 #: Modes whose operator eigenvalue 1/λ is below this fraction of the largest
 #: are beyond float64 resolution and treated as infinitely stiff.
 UNRESOLVED_STIFFNESS = 1e-13
@@ -372,6 +385,38 @@ def _add_springs(model, layout, strains, stiffness, constraints):
                 stiffness.append([k])
 
 
+def _negligible_mass_removed(model: Model) -> Model:
+    """``model`` with every mass below MASSLESS of the model's own scale set to zero.
+
+    The scales are the total mass m of bodies and beams (kg) and m d² plus every
+    body's largest principal inertia (kg m²), d the largest distance of a point or
+    mass centre from their centroid (m). Each body's mass and principal inertias
+    and each beam's mass are compared with the scale of their units, so the
+    decision does not depend on the units a model is written in; a mass that is
+    kept is exactly as given. A DOF without mass then has an exactly zero row
+    and column in the assembled M.
+    """
+    places = np.array([*model.points.values(), *(body.com for body in model.rigids)], float)
+    extent = np.linalg.norm(places - places.mean(axis=0), axis=1).max()
+    total = sum(body.mass for body in model.rigids) + sum(beam.mass for beam in model.beams)
+    inertia = total * extent ** 2 + sum(la.eigvalsh(body.inertia)[-1] for body in model.rigids)
+    rigids = tuple(replace(body, mass=body.mass if body.mass > MASSLESS * total else 0.0,
+                           inertia=_principal_inertias_kept(body.inertia, MASSLESS * inertia))
+                   for body in model.rigids)
+    beams = tuple(beam if beam.mass > MASSLESS * total else replace(beam, rho=0.0) for beam in model.beams)
+    return replace(model, rigids=rigids, beams=beams)
+
+
+def _principal_inertias_kept(inertia, smallest) -> np.ndarray:
+    """(3, 3) ``inertia`` (kg m²) with its principal inertias at or below ``smallest``
+    made zero; unchanged (not rebuilt) when all of those are zero already."""
+    principal, axes = la.eigh(inertia)
+    kept = principal > smallest
+    if np.all(kept | (principal == 0.0)):
+        return inertia
+    return (axes * np.where(kept, principal, 0.0)) @ axes.T
+
+
 def _add_rigid_masses(model, layout, mass):
     for body in model.rigids:
         dofs = layout.index.rigid(body.name)
@@ -583,6 +628,10 @@ class FEModel:
         (statically determinate temporary supports, used by the solver).
     frames : (n_nodes, 3, 3) rows = the axes of each node's DOFs (identity
         except at interior beam nodes).
+    massive : (n_massive,) reduced DOFs that carry mass, ascending. The others
+        have exactly zero rows and columns in M (masses negligible against the
+        model's own scale are removed first) and are condensed out statically
+        by the eigensolver.
     """
 
     M: sp.csr_matrix
@@ -597,6 +646,7 @@ class FEModel:
     rigid_modes: np.ndarray
     supports: np.ndarray
     frames: np.ndarray
+    massive: np.ndarray
 
     def beam_motion(self, name: str, q_full: np.ndarray) -> np.ndarray:
         """(n+1, 6) inertial displacements and rotations along beam ``name``.
@@ -620,6 +670,7 @@ def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
     n = int(elements_per_beam)
     if n < 1:
         raise ValueError(f"elements_per_beam must be >= 1, got {elements_per_beam}")
+    model = _negligible_mass_removed(model)
     layout = _layout(model, n)
     n_full = 6 * layout.n_nodes
     strains, mass, constraints = _Triplets(), _Triplets(), _Triplets()
@@ -642,7 +693,8 @@ def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
     rigid_modes, supports = _rigid_basis(_rigid_motions(model, layout)[masters], M)
     return FEModel(M=M, K=K, T=T, G=G, D=D, dof_index=layout.index,
                    n_dof=T.shape[1], n_full=n_full, elements_per_beam=n,
-                   rigid_modes=rigid_modes, supports=supports, frames=layout.frames)
+                   rigid_modes=rigid_modes, supports=supports, frames=layout.frames,
+                   massive=np.flatnonzero(M.diagonal()))
 
 
 def _drop_debris(matrix) -> sp.csr_matrix:
@@ -677,7 +729,7 @@ def _rigid_basis(motions, M):
         return np.zeros((n, 0)), np.zeros(0, dtype=int)
     basis = la.orth(motions)
     kinetic, directions = la.eigh(basis.T @ (M @ basis))
-    massive = kinetic > MASSLESS_MOTION * np.abs(kinetic).max()
+    massive = kinetic > MASSLESS * np.abs(kinetic).max()
     modes = basis @ (directions[:, massive] / np.sqrt(kinetic[massive]))
     pivots = la.qr(basis.T, pivoting=True, mode="r")[1]
     return modes, np.sort(pivots[:basis.shape[1]])
@@ -748,19 +800,44 @@ def _rayleigh_ritz(fe: FEModel, Y: np.ndarray):
     return lam[order], X[:, order]
 
 
+def _mass_factor(fe: FEModel) -> np.ndarray:
+    """(n_dof, r) B with ``M = B Bᵀ``, r = rank M: the directions that carry mass.
+
+    Only the massive DOFs enter. Their block of M is scaled to unit diagonal, so
+    that translations (kg) and rotations (kg m²) weigh alike whatever the units;
+    its eigenvalues below MASS_RANK of the largest are the rounding of exact zeros
+    (directions without mass across DOFs, as of a singular inertia tensor in skew
+    axes) and are left out.
+    """
+    block = fe.M[fe.massive][:, fe.massive].toarray()
+    size = np.sqrt(block.diagonal())
+    values, vectors = la.eigh(block / np.outer(size, size))
+    kept = values > MASS_RANK * values.max(initial=0.0)
+    factor = np.zeros((fe.n_dof, np.count_nonzero(kept)))
+    factor[fe.massive] = size[:, None] * vectors[:, kept] * np.sqrt(values[kept])
+    return factor
+
+
 def _dense_start(fe: FEModel, flexibility) -> np.ndarray:
     """All resolvable elastic modes of a small model, approximately, softest first.
 
-    Eigenvectors of the M-symmetric ``K⁺M`` through the symmetric
-    ``M^½ K⁺ M^½ z = z/λ``; the mode is ``x = K⁺ M^½ z λ``.
+    Static condensation of the massless DOFs, which is exact (they have no
+    inertia): with ``M = B Bᵀ`` (:func:`_mass_factor`) the condensed flexibility
+    ``Bᵀ K⁺ B`` (r x r) has eigenvalues 1/λ for the elastic modes and 0 for the
+    rigid-body modes, and a mode is ``x = K⁺ B z λ``, its massless DOFs
+    following statically. There are exactly r − (rigid-body modes) elastic
+    modes, so no eigenvalue of a massless direction is ever mistaken for one.
     """
-    mass_values, mass_vectors = la.eigh(fe.M.toarray())
-    root = (mass_vectors * np.sqrt(np.maximum(mass_values, 0.0))) @ mass_vectors.T
-    flexible = flexibility(np.eye(fe.n_dof))
-    flexible = 0.5 * (flexible + flexible.T)
-    theta, Z = la.eigh(root @ flexible @ root)
-    keep = np.flatnonzero(theta > UNRESOLVED_STIFFNESS * max(theta[-1], 0.0))[::-1]
-    return (flexible @ root @ Z[:, keep]) / theta[keep]
+    factor = _mass_factor(fe)
+    elastic = factor.shape[1] - fe.rigid_modes.shape[1]
+    if elastic <= 0:
+        return np.zeros((fe.n_dof, 0))
+    flexible = flexibility(factor)
+    condensed = factor.T @ flexible
+    theta, Z = la.eigh(0.5 * (condensed + condensed.T))
+    theta, Z = theta[::-1][:elastic], Z[:, ::-1][:, :elastic]
+    keep = theta > UNRESOLVED_STIFFNESS * max(theta[0], 0.0)
+    return (flexible @ Z[:, keep]) / theta[keep]
 
 
 def _lanczos_start(fe: FEModel, flexibility, block: int) -> np.ndarray:
@@ -779,11 +856,12 @@ def _lanczos_vectors(n_dof: int, block: int) -> int:
 
 
 def _massive_dofs(fe: FEModel) -> int:
-    """DOFs that carry mass, less the rigid-body modes: at most the rank of K⁺M. A
-    Krylov space of K⁺M cannot grow past it, so ARPACK asked for more vectors than
-    that stops ("could not build an Arnoldi factorization": random trees at 80
-    modes, 204 DOFs of which 198 carry mass, 201 vectors)."""
-    return int(np.count_nonzero(fe.M.diagonal())) - fe.rigid_modes.shape[1]
+    """DOFs that carry mass, less the rigid-body modes: at least the number of
+    elastic modes and the rank of K⁺M. A Krylov space of K⁺M cannot grow past
+    that rank, so ARPACK asked for more vectors than that stops ("could not build
+    an Arnoldi factorization": random trees at 80 modes, 204 DOFs of which 198
+    carry mass, 201 vectors)."""
+    return len(fe.massive) - fe.rigid_modes.shape[1]
 
 
 def _block_size(wanted: int) -> int:
@@ -803,7 +881,7 @@ def _lowest_modes(fe: FEModel, flexibility, wanted: int, sweeps: int = 8):
     error estimate). m is below the block size when the model has fewer
     elastic modes.
     """
-    block = min(_block_size(wanted), fe.n_dof - fe.rigid_modes.shape[1])
+    block = min(_block_size(wanted), _massive_dofs(fe))
     if block <= 0:
         X = np.zeros((fe.n_dof, 0))
     elif fe.n_dof <= DENSE_LIMIT or _lanczos_vectors(fe.n_dof, block) >= _massive_dofs(fe):

@@ -116,6 +116,9 @@ UNRESOLVED_STIFFNESS = 1e-13
 DENSE_LIMIT = 120
 #: Polishing sweeps stop when no wanted λ changes by more than this (relative).
 SWEEP_TOLERANCE = 1e-14
+#: A frequency whose estimated relative error is at or above this is not
+#: reported (its own estimate leaves not even its first digit assured).
+UNSETTLED = 0.1
 #: Floor of every relative error estimate of λ (rounding of the last digits).
 ROUNDOFF = 4 * np.finfo(float).eps
 
@@ -947,9 +950,12 @@ class FEResult:
     n_dof : reduced DOFs of that mesh. seconds : wall time of the whole solve.
     mode_shapes : (n_full, m) mass-normalised full vectors on that mesh (see
         :class:`DofIndex` for the layout), or None.
-    note : empty, or why some frequencies are less accurate than asked: the
+    note : empty, or, joined by "; ": the computed values not reported because
+        their estimated relative error is UNSETTLED (10 %) or more, with all
+        above them; the frequencies less accurate than asked where the
         refinement stopped at ``max_elements_per_beam`` with their estimated
-        error above ``rtol``.
+        error above ``rtol``; that a model without beams has fewer elastic
+        modes than asked for.
     """
 
     model: str
@@ -1041,7 +1047,9 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
     mode_shapes : also return mass-normalised full mode vectors.
 
     Zero-frequency rigid-body modes are counted structurally (see the module
-    notes), not by a threshold on computed eigenvalues. ``fmax`` alone is checked
+    notes), not by a threshold on computed eigenvalues. No value whose estimated
+    relative error is UNSETTLED (10 %) or more is reported as a frequency, nor
+    any above it: the result stops before it and its note names them. ``fmax`` alone is checked
     as :func:`linmstmm.solve.natural_frequencies` checks it (ModelError).
     """
     started = perf_counter()
@@ -1065,6 +1073,14 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
     refined = bool(model.beams) and elements_per_beam is None
     if refined:
         error_estimate = _with_dispersion(model, fe.elements_per_beam, frequencies_hz, error_estimate, rtol)
+    settled = _settled_count(error_estimate)
+    notes = [_unsettled(frequencies_hz[settled:], error_estimate[settled:])]
+    frequencies_hz, error_estimate, order = frequencies_hz[:settled], error_estimate[:settled], order[:settled]
+    if refined:
+        notes.append(_short_of_rtol(frequencies_hz, error_estimate, rtol, fe.elements_per_beam))
+    if not model.beams and fmax is None and len(lam) < count:
+        notes.append(f"only {len(lam)} elastic natural frequencies exist (directions with mass "
+                     f"less the {fe.rigid_modes.shape[1]} rigid-body modes)")
     return FEResult(model=model.name,
                     frequencies_hz=frequencies_hz,
                     rigid_body_modes=fe.rigid_modes.shape[1],
@@ -1073,7 +1089,26 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
                     n_dof=fe.n_dof,
                     seconds=perf_counter() - started,
                     mode_shapes=(fe.T @ X[:, order]) if mode_shapes else None,
-                    note=_short_of_rtol(frequencies_hz, error_estimate, rtol, fe.elements_per_beam) if refined else "")
+                    note="; ".join(note for note in notes if note))
+
+
+def _settled_count(error_estimate) -> int:
+    """How many of the ascending frequencies are reported: those before the first
+    whose estimated relative error is UNSETTLED or more. The ones above it are not
+    reported either, since a list with a gap would misstate their ranks. A NaN
+    estimate (not asked for) does not stop the list."""
+    unsettled = np.flatnonzero(error_estimate >= UNSETTLED)
+    return int(unsettled[0]) if len(unsettled) else len(error_estimate)
+
+
+def _unsettled(frequencies_hz, error_estimate) -> str:
+    """The note naming frequencies left out of a result (empty if none is)."""
+    if not len(frequencies_hz):
+        return ""
+    listed = ", ".join(f"{f:.6g} Hz ({e:.1e})" for f, e in zip(frequencies_hz[:5], error_estimate[:5]))
+    more = f" and {len(frequencies_hz) - 5} more" if len(frequencies_hz) > 5 else ""
+    return (f"{len(frequencies_hz)} computed values not reported as frequencies, from the first whose "
+            f"estimated relative error is {UNSETTLED:.0%} or more: {listed}{more}")
 
 
 def _with_dispersion(model, elements_per_beam, frequencies_hz, error_estimate, rtol):

@@ -29,7 +29,8 @@ def test_freqs_json_follows_the_contract():
     np.testing.assert_allclose(data["frequencies_hz"], expected, rtol=1e-12)
 
 
-@pytest.mark.parametrize("command, key", [("freqs", "frequencies_hz"), ("modes", "natural_freq_hz")])
+@pytest.mark.parametrize("command, key", [("freqs", "frequencies_hz"), ("modes", "natural_freq_hz"),
+                                          ("fe", "frequencies_hz")])
 def test_fewer_modes_than_asked_for_are_noted(command, key):
     """6 degrees of freedom, 10 asked: the table and the JSON both carry the note."""
     table = run(command, "models/spring_mass_chain.toml", "--count", "10")

@@ -568,9 +568,14 @@ def _rigid_field(positions, frames) -> np.ndarray:
 
     Rotations are about the nodes' centroid and scaled by their extent, so
     translations and rotations weigh alike; each node's DOFs are in its frame.
+    Nodes that coincide to rounding (an extent below NEGLIGIBLE_ENTRY of their
+    coordinates: the rounding of the centroid) have no arm, and any scale
+    weighs the two alike.
     """
     arm = positions - positions.mean(axis=0)
-    size = np.abs(arm).max() or 1.0
+    size = np.abs(arm).max()
+    if size <= NEGLIGIBLE_ENTRY * np.abs(positions).max():
+        arm, size = np.zeros_like(arm), 1.0
     field = np.zeros((len(positions), 6, 6))
     for k, unit in enumerate(np.eye(3)):
         field[:, :3, k] = frames @ unit

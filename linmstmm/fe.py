@@ -95,7 +95,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import LinearOperator, eigsh, splu
 
 from linmstmm.mode_bound import check_range_request
-from linmstmm.model import Beam, Model
+from linmstmm.model import Beam, Model, Rigid
 
 #: A substituted constraint row whose entries all fall below this fraction of
 #: the largest term that entered it is redundant (implied by earlier rows).
@@ -391,33 +391,38 @@ def _add_springs(model, layout, strains, stiffness, constraints):
 def _negligible_mass_removed(model: Model) -> Model:
     """``model`` with every mass below MASSLESS of the model's own scale set to zero.
 
-    The scales are the total mass m of bodies and beams (kg) and m d² plus every
-    body's largest principal inertia (kg m²), d the largest distance of a point or
-    mass centre from their centroid (m). Each body's mass and principal inertias
-    and each beam's mass are compared with the scale of their units, so the
-    decision does not depend on the units a model is written in; a mass that is
-    kept is exactly as given. A DOF without mass then has an exactly zero row
+    The scales are the total mass m of bodies and beams (kg) and m d² plus the
+    traces of the bodies' inertia tensors (kg m²), d the largest distance of a
+    point or mass centre from their centroid (m). Each body's mass and principal
+    inertias and each beam's mass are compared with the scale of their units, so
+    the decision does not depend on the units a model is written in; a mass that
+    is kept is exactly as given. A DOF without mass then has an exactly zero row
     and column in the assembled M.
     """
     places = np.array([*model.points.values(), *(body.com for body in model.rigids)], float)
     extent = np.linalg.norm(places - places.mean(axis=0), axis=1).max()
     total = sum(body.mass for body in model.rigids) + sum(beam.mass for beam in model.beams)
-    inertia = total * extent ** 2 + sum(la.eigvalsh(body.inertia)[-1] for body in model.rigids)
-    rigids = tuple(replace(body, mass=body.mass if body.mass > MASSLESS * total else 0.0,
-                           inertia=_principal_inertias_kept(body.inertia, MASSLESS * inertia))
-                   for body in model.rigids)
+    inertia = total * extent ** 2 + sum(np.trace(body.inertia) for body in model.rigids)
+    rigids = tuple(_body_mass_kept(body, MASSLESS * total, MASSLESS * inertia) for body in model.rigids)
     beams = tuple(beam if beam.mass > MASSLESS * total else replace(beam, rho=0.0) for beam in model.beams)
     return replace(model, rigids=rigids, beams=beams)
 
 
-def _principal_inertias_kept(inertia, smallest) -> np.ndarray:
-    """(3, 3) ``inertia`` (kg m²) with its principal inertias at or below ``smallest``
-    made zero; unchanged (not rebuilt) when all of those are zero already."""
-    principal, axes = la.eigh(inertia)
-    kept = principal > smallest
-    if np.all(kept | (principal == 0.0)):
-        return inertia
-    return (axes * np.where(kept, principal, 0.0)) @ axes.T
+def _body_mass_kept(body: Rigid, least_mass: float, least_inertia: float) -> Rigid:
+    """``body`` with its mass (kg) made zero unless above ``least_mass``, and its
+    principal inertias (kg m²) unless above ``least_inertia``; the same record when
+    nothing changes."""
+    mass = body.mass if body.mass > least_mass else 0.0
+    inertia, diagonal = body.inertia, body.inertia.diagonal()
+    gershgorin = diagonal - (np.abs(inertia).sum(axis=1) - np.abs(diagonal))   # the least bounds the principal ones below
+    if diagonal.any() and gershgorin.min() <= least_inertia:
+        principal, axes = la.eigh(inertia)
+        kept = principal > least_inertia
+        if not np.all(kept | (principal == 0.0)):
+            inertia = (axes * np.where(kept, principal, 0.0)) @ axes.T
+    if mass == body.mass and inertia is body.inertia:
+        return body
+    return replace(body, mass=mass, inertia=inertia)
 
 
 def _add_rigid_masses(model, layout, mass):

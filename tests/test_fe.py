@@ -562,6 +562,21 @@ def test_massless_junctions_between_springs_in_series(junctions):
     assert relative_error(result.frequencies_hz, exact).max() <= 1e-12
 
 
+def test_singular_inertia_in_skew_axes_has_a_direction_without_mass():
+    """A body whose inertia tensor is singular in axes skew to the model's (a
+    direction without mass that no DOF is aligned with) on a spring to ground, a
+    spring dangling from it: five elastic modes, as the transfer-matrix route finds."""
+    skew = 0.1 * np.array([[1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    points = {"ground": np.zeros(3), "port": np.zeros(3)}
+    model = with_dangling_spring(Model(name="skew", points=points,
+                                       rigids=(make_body("body", ["port"], [0.1, 0.0, 0.0], 2.0, skew),),
+                                       springs=(make_spring("hold", "ground", "port", SPRING),),
+                                       boundary={"ground": mask(CLAMPED)}), "port")
+    fe, mstmm = fe_frequencies(model, count=10), natural_frequencies(model, count=10)
+    assert len(fe.frequencies_hz) == len(mstmm.frequencies_hz) == 5
+    assert relative_error(fe.frequencies_hz, mstmm.frequencies_hz).max() <= 1e-10
+
+
 def in_millimetres_and_grams(model) -> Model:
     """``model`` with lengths in mm and masses in g (spring stiffness in g/s² and
     g mm²/s² per rad): the same physics, so the same frequencies."""

@@ -414,7 +414,8 @@ def _body_mass_kept(body: Rigid, least_mass: float, least_inertia: float) -> Rig
     nothing changes."""
     mass = body.mass if body.mass > least_mass else 0.0
     inertia, diagonal = body.inertia, body.inertia.diagonal()
-    gershgorin = diagonal - (np.abs(inertia).sum(axis=1) - np.abs(diagonal))   # the least bounds the principal ones below
+    # Gershgorin: the least of these is at most the smallest principal inertia
+    gershgorin = diagonal - (np.abs(inertia).sum(axis=1) - np.abs(diagonal))
     if diagonal.any() and gershgorin.min() <= least_inertia:
         principal, axes = la.eigh(inertia)
         kept = principal > least_inertia

@@ -1,4 +1,4 @@
-"""The ``linmstmm`` command line against its contract (shared/spec/cli.md)."""
+"""The ``linmstmm`` command line against its contract (README, "Usage")."""
 from __future__ import annotations
 
 import json

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-from linmstmm.fe import assemble, beam_element, dispersion_error, fe_frequencies, fe_modes
+from linmstmm.fe import DENSE_LIMIT, assemble, beam_element, dispersion_error, fe_frequencies, fe_modes
 from linmstmm.model import Beam, Model, Rigid, Spring
 from linmstmm.solve import natural_frequencies
 from random_models import random_model
@@ -575,6 +575,31 @@ def test_singular_inertia_in_skew_axes_has_a_direction_without_mass():
     fe, mstmm = fe_frequencies(model, count=10), natural_frequencies(model, count=10)
     assert len(fe.frequencies_hz) == len(mstmm.frequencies_hz) == 5
     assert relative_error(fe.frequencies_hz, mstmm.frequencies_hz).max() <= 1e-10
+
+
+def with_junctions(model) -> Model:
+    """``model`` with every spring cut into two of its stiffness in series, joined
+    at a new massless point (the pair is half as stiff)."""
+    points, springs = dict(model.points), []
+    for spring in model.springs:
+        a, b = spring.ends
+        points[f"{spring.name}_junction"] = np.asarray(points[a], float).copy()
+        springs += [replace(spring, name=f"{spring.name}_a", ends=(a, f"{spring.name}_junction")),
+                    replace(spring, name=f"{spring.name}_b", ends=(f"{spring.name}_junction", b))]
+    return replace(model, points=points, springs=tuple(springs))
+
+
+def test_long_chain_with_massless_junctions_matches_the_lattice_formula():
+    """300 equal masses fixed at both ends, each spring k made of two springs in
+    series (301 massless junctions, solved by Lanczos): the lattice of k/2,
+    ω_j = 2 sqrt(k / 2m) sin(jπ / (2(N+1)))."""
+    n, k, m = 300, 3.0, 0.5
+    model = with_junctions(spring_chain([m] * n, k))
+    result = fe_frequencies(model, count=10)
+    j = np.arange(1, 11)
+    exact = 2 * np.sqrt(k / (2 * m)) * np.sin(j * np.pi / (2 * (n + 1))) / (2 * np.pi)
+    assert result.n_dof == 2 * n + 1 and result.n_dof > DENSE_LIMIT
+    assert relative_error(result.frequencies_hz, exact).max() <= 1e-9
 
 
 def in_millimetres_and_grams(model) -> Model:

@@ -182,6 +182,8 @@ _ABS_TOL = 1e-12
 _ORTHO_TOL = 1e-9
 #: Inertia eigenvalues must be >= -_PSD_TOL * max |I_ij|.
 _PSD_TOL = 1e-12
+#: Principal moments must keep I3 <= I1 + I2 within this fraction of the trace.
+_TRIANGLE_TOL = 1e-9
 #: A direction whose part normal to the beam axis is this small (relative) is parallel.
 _PARALLEL_TOL = 1e-9
 
@@ -207,6 +209,9 @@ def _read_toml(path, file):
         if str(error).startswith("Cannot overwrite a value"):
             hint = " (a key given twice, e.g. a duplicate point name)"
         raise ModelError(file, f"invalid TOML: {error}{hint}") from error
+    except RecursionError as error:
+        raise ModelError(file, "invalid TOML: arrays or tables nested too deeply "
+                               "for the TOML reader") from error
 
 
 def _describe(value):
@@ -407,10 +412,11 @@ def _check_rigid(t, points, tol):
 
 
 def _check_inertia(t):
-    """(3, 3) inertia tensor from [Ixx, Iyy, Izz] or a symmetric PSD 3x3 array."""
+    """(3, 3) inertia tensor from [Ixx, Iyy, Izz] or a symmetric 3x3 array, kg m^2,
+    whose principal moments are those of a real body."""
     value = t.table["inertia"]
     if isinstance(value, list) and len(value) == 3 and not any(isinstance(v, list) for v in value):
-        return np.diag(t.vector("inertia", 3, ">= 0"))
+        return _check_principal_moments(t, np.diag(t.vector("inertia", 3, ">= 0")))
     tensor = t.matrix("inertia", "[Ixx, Iyy, Izz] or a 3x3 array of arrays")
     scale = np.abs(tensor).max()
     asymmetry = np.abs(tensor - tensor.T)
@@ -423,6 +429,17 @@ def _check_inertia(t):
     if lowest < -_PSD_TOL * scale:
         raise t.error("inertia", f"tensor is not positive semidefinite "
                                  f"(smallest eigenvalue {lowest:g})")
+    return _check_principal_moments(t, tensor)
+
+
+def _check_principal_moments(t, tensor):
+    """``tensor`` if its principal moments I1 <= I2 <= I3 keep I3 <= I1 + I2 (every
+    real body does: equality for a flat plate); the tolerance is relative to the trace."""
+    low, middle, high = np.linalg.eigvalsh(tensor)
+    if high - (low + middle) > _TRIANGLE_TOL * (low + middle + high):
+        raise t.error("inertia", f"principal moments {low:g}, {middle:g}, {high:g} kg m^2 break "
+                                 f"the triangle inequality ({high:g} > {low:g} + {middle:g}): "
+                                 f"no real body has them")
     return tensor
 
 

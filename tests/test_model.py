@@ -144,6 +144,13 @@ def test_duplicate_point_name(tmp_path):
     model_error(tmp_path, text, None, None, "invalid TOML", "line 9", "duplicate point name")
 
 
+@pytest.mark.parametrize("opening, closing", [("[", "]"), ("{a = ", "}")])
+def test_nesting_too_deep_for_the_reader(tmp_path, opening, closing):
+    depth = 5000
+    text = edit(('name = "base"', f'name = "base"\nx = {opening * depth}1{closing * depth}'))
+    model_error(tmp_path, text, None, None, "invalid TOML", "nested too deeply")
+
+
 def test_not_utf8(tmp_path):
     path = tmp_path / "model.toml"
     path.write_bytes(BASE.encode().replace(b'"base"', b'"b\xffse"'))
@@ -311,6 +318,42 @@ def test_inertia_not_positive_semidefinite(tmp_path):
 def test_inertia_diagonal_with_negative_entry(tmp_path):
     text = edit(("inertia = [0.1, 0.2, 0.3]", "inertia = [0.1, -0.2, 0.3]"))
     model_error(tmp_path, text, "rigid 'payload'", "inertia", "inertia[1] must be >= 0")
+
+
+@pytest.mark.parametrize("inertia", [
+    "[0.1, 0.2, 0.5]",                                              # Izz > Ixx + Iyy
+    "[0.5, 0.1, 0.2]",                                              # Ixx > Iyy + Izz
+    "[[0.3, 0.2, 0.0], [0.2, 0.3, 0.0], [0.0, 0.0, 0.05]]",         # principal 0.05, 0.1, 0.5
+])
+def test_inertia_breaking_the_triangle_inequality(tmp_path, inertia):
+    text = edit(("inertia = [0.1, 0.2, 0.3]", f"inertia = {inertia}"))
+    model_error(tmp_path, text, "rigid 'payload'", "inertia", "triangle inequality", "no real body")
+
+
+def _rotated_plate(scale):
+    """Inertia tensor, kg m^2 x ``scale``, of a flat plate (Izz = Ixx + Iyy) turned about
+    an oblique axis: the equality holds only to rounding."""
+    angle, axis = 0.7, np.array([1.0, 2.0, 2.0]) / 3.0
+    cross = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    rotation = np.eye(3) + math.sin(angle) * cross + (1 - math.cos(angle)) * cross @ cross
+    return scale * rotation @ np.diag([0.1, 0.25, 0.35]) @ rotation.T
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e-6, 1e6])
+@pytest.mark.parametrize("principal", [[0.0, 0.0, 0.0], [0.0, 0.2, 0.2], [0.2, 0.2, 0.4], None])
+def test_inertia_on_the_triangle_boundary_is_accepted(tmp_path, principal, scale):
+    # point mass, thin rod, flat plates (None: turned): equality, in any units of mass and length.
+    tensor = _rotated_plate(scale) if principal is None else scale * np.diag(principal)
+    text = edit(("inertia = [0.1, 0.2, 0.3]", f"inertia = {tensor.tolist()}"))
+    np.testing.assert_allclose(load_text(tmp_path, text).element("payload").inertia, tensor, rtol=1e-15)
+
+
+@pytest.mark.parametrize("scale", [1e-6, 1.0, 1e6])
+def test_triangle_check_does_not_depend_on_units(tmp_path, scale):
+    # a plate whose Izz exceeds Ixx + Iyy by 1e-6 of the trace is refused at every scale.
+    tensor = _rotated_plate(scale) + scale * 1e-6 * 0.7 * np.diag([0.0, 0.0, 1.0])
+    text = edit(("inertia = [0.1, 0.2, 0.3]", f"inertia = {tensor.tolist()}"))
+    model_error(tmp_path, text, "rigid 'payload'", "inertia", "triangle inequality")
 
 
 def test_negative_mass(tmp_path):
@@ -558,3 +601,12 @@ def test_cli_reports_bad_model_in_one_line(name, words):
     assert "Traceback" not in done.stderr and done.stdout == ""
     for word in [relative, *words]:
         assert word in lines[0]
+
+
+def test_cli_reports_too_deep_nesting_in_one_line(tmp_path):
+    path = write(tmp_path, f"name = {'[' * 5000}{']' * 5000}\n")
+    done = subprocess.run([sys.executable, "-m", "linmstmm", "freqs", str(path)],
+                          cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2 and done.stdout == "", done.stderr
+    assert done.stderr.splitlines() == [f"linmstmm: error: {path}: invalid TOML: arrays or tables "
+                                        f"nested too deeply for the TOML reader"]

@@ -111,7 +111,7 @@ def tree():
         beams=(make_beam("post", "g", "p1", points, A=2e-3, Iy=8e-7, Iz=6e-7, J=1e-6),
                make_beam("arm", "p2", "tip", points, Iy=1e-7, Iz=2e-7, J=2e-7)),
         springs=(make_spring("mount", "p3", "q3", [2e5, 3e5, 1e5, 4e3, np.inf, 5e3],
-                             axes=np.array([[0.0, 0.6, 0.8], [0.0, 0.8, -0.6], [1.0, 0.0, 0.0]])),),
+                             axes=np.array([[0.0, 0.6, 0.8], [0.0, 0.8, -0.6], [-1.0, 0.0, 0.0]])),),
         boundary={"g": fixed()})
 
 
@@ -249,3 +249,4 @@ def test_shapes_match_the_finite_element_route():
                           for k in range(lam.size)])
     np.testing.assert_allclose(modes.omega, np.sqrt(lam), rtol=1e-6)
     assert np.diag(modes.mac(fe_shapes, points)).min() > 0.9999
+

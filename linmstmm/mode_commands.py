@@ -1,9 +1,10 @@
 """Commands ``linmstmm modes``, ``scan``, ``response`` and ``frf``: figures and data out.
 
 * ``modes MODEL [--count N] [--fmax HZ] [--json] [--plot DIR] [--animate]
-  [--uff FILE] [--mac-fe]``: frequencies, modal masses and orthogonality
-  errors of the modes (shapes scaled to a largest translation of 1 m, so the
-  modal masses are comparable); one PNG per mode (and a GIF with
+  [--uff FILE] [--mac-fe] [--normalization mass|max]``: frequencies, modal
+  masses and orthogonality errors of the modes (shapes mass-normalised by
+  default, modal mass 1 kg; ``max``: largest translation 1 m, so the modal
+  masses are comparable); one PNG per mode (and a GIF with
   ``--animate``) in DIR; the shapes as a universal file (:mod:`linmstmm.uff`);
   the MAC matrix against the finite-element route's modes.
 * ``scan MODEL --fmax HZ [--points N] --plot FILE [--json]``: log|det Ū_all|
@@ -27,7 +28,7 @@ import numpy as np
 
 from linmstmm.mode_bound import check_range_request
 from linmstmm.model import COMPONENTS, Model, ModelError, _did_you_mean, load_model
-from linmstmm.modes import ModalResult, mac_matrix, mode_shapes
+from linmstmm.modes import DEFAULT_NORMALIZATION, NORMALIZATIONS, ModalResult, mac_matrix, mode_shapes
 
 #: Frequencies in a scan and in an FRF sweep, by default.
 DEFAULT_SCAN_POINTS = 2000
@@ -57,6 +58,9 @@ def add_mode_commands(subparsers) -> None:
                        help="write the shapes as a universal file (datasets 15 and 55)")
     modes.add_argument("--mac-fe", action="store_true",
                        help="MAC matrix against the finite-element route's modes")
+    modes.add_argument("--normalization", choices=NORMALIZATIONS, default=DEFAULT_NORMALIZATION,
+                       help=f"mode scaling: mass = unit modal mass (1 kg), max = largest translation "
+                            f"1 m (default {DEFAULT_NORMALIZATION}, as in linmstmm.modes.mode_shapes)")
     modes.set_defaults(run=run_modes)
 
     scan = subparsers.add_parser("scan", help="plot log|det Ubar_all| and the root count over frequency")
@@ -104,7 +108,7 @@ def run_modes(args) -> int:
     if args.animate and args.plot is None:
         raise ModelError(args.model, "--animate needs --plot DIR", key="--animate")
     count, fmax = _request(args)
-    result = _mode_shapes(model, count, fmax, normalization="max")
+    result = _mode_shapes(model, count, fmax, normalization=args.normalization)
     files = _mode_figures(result, model, args.plot, args.animate) if args.plot else []
     if args.uff:
         from linmstmm.uff import write_uff
@@ -149,7 +153,8 @@ def modes_summary(result: ModalResult, model: Model) -> dict:
 
 
 def _print_modes(data: dict) -> None:
-    print(f"{data['model']}: modes (MSTMM), shapes scaled to a largest translation of 1 m")
+    scaling = {"mass": "mass-normalised (modal mass 1 kg)", "max": "scaled to a largest translation of 1 m"}
+    print(f"{data['model']}: modes (MSTMM), shapes {scaling[data['normalization']]}")
     print(f"  {'mode':>4}  {'f [Hz]':>16}  {'modal mass [kg]':>16}  {'modal stiffness [N/m]':>22}")
     for n, (f, m, k) in enumerate(zip(data["natural_freq_hz"], data["modal_mass"], data["modal_stiffness"]),
                                   start=1):

@@ -399,9 +399,11 @@ def run_check(args) -> int:
     if args.plot is not None:
         _write_figure(topology, model, args.plot)
     if args.json:
-        print(json.dumps({"model": model.name, **report.to_dict()}))
+        print(json.dumps({"model": model.name, "description": model.description, **report.to_dict()}))
     else:
         print(f"{model.name}: deduced transfer structure")
+        if model.description:
+            print(f"  {model.description}")
         print(report.to_text())
     return 0
 

@@ -15,12 +15,17 @@ function is a sequence of segments; on segment j (from ``start_j`` to the
 next start) g obeys g'' = −ν_j g, i.e. it is linear (ν = 0) or sinusoidal
 (ν = Ω²), from given g and g' at its start; a segment may also open with a
 Dirac impulse. The modal oscillator and the load generator together form a
-linear system y' = G y, y = (q, q̇, g, g'), so the state is carried across a
-segment by the matrix exponential expm(G τ): Duhamel's integral in closed
-form, exact to rounding for every damping (under-, over-, critically damped,
-zero-frequency rigid-body modes). Step, impulse, harmonic and half-sine loads
-are one or two segments; tabulated samples are linear between samples (the
-exact piecewise-linear-load recurrence).
+linear system y' = G y, y = (q, q̇, g, g'), so the state is carried by the
+exact propagator exp(G τ): Duhamel's integral in closed form, exact to
+rounding for every damping (under-, over-, critically damped,
+zero-frequency rigid-body modes). The output times are equally spaced, so
+a segment needs three propagators per mode (to its first output time, over
+one output step, to its end), computed once; the states at all output times
+of the segment follow by doubling (the first m states times P^m give the
+next m), log2(n_t) products over all modes and times at once. Step,
+impulse, harmonic and half-sine loads are one or two segments; tabulated
+samples are linear between samples (the exact piecewise-linear-load
+recurrence).
 
 The frequency response (receptance) between a load and the points is the
 modal sum H(Ω) = Σ_k φ^k (d · φ^k_load) / (M_k (ω_k² − Ω² + i Ω c_k)).
@@ -77,6 +82,9 @@ from linmstmm.modes import ModalResult, mode_shapes
 DEFAULT_DURATION = 1.0
 DEFAULT_STEPS = 1000
 DEFAULT_MODES = 20
+#: Output times count as equally spaced when every step is within this
+#: fraction of their mean step (rounding of ``start + i * step``).
+SPACING_TOLERANCE = 1e-9
 
 
 # --- time functions -----------------------------------------------------------
@@ -245,47 +253,91 @@ def participation(modes: ModalResult, point: str, vector) -> np.ndarray:
 def unit_response(omega, damping_rate, function: TimeFunction, times):
     """Exact response of q̈ + c q̇ + ω² q = g(t) from rest, for each mode.
 
-    omega, damping_rate : (n,) rad/s and 1/s. times : (n_t,) s.
-    Returns (q, q̇, q̈), each (n_t, n).
+    Parameters
+    ----------
+    omega, damping_rate : (n,) ω_k, rad/s, and c_k, 1/s.
+    function : the load's time function g.
+    times : (n_t,) s, increasing and equally spaced.
+
+    Returns
+    -------
+    (q, q̇, q̈), each (n_t, n), in s², s and 1 per unit of g.
     """
     omega, rate = np.asarray(omega, float), np.asarray(damping_rate, float)
     times = np.asarray(times, dtype=float)
-    generators = _generators(omega, rate, function.nu)  # (E, n, 4, 4)
-    states = np.zeros((function.starts.size, omega.size, 4))
+    spacing = _spacing(times)
+    ends = np.r_[function.starts[1:], np.inf]
+    out = np.zeros((times.size, omega.size, 4))
     state = np.zeros((omega.size, 4))
-    for j, start in enumerate(function.starts):
-        if j:
-            carry = scipy.linalg.expm(generators[j - 1] * (start - function.starts[j - 1]))
-            state = np.einsum("nij,nj->ni", carry, state)
+    for j, (start, end) in enumerate(zip(function.starts, ends)):
         state[:, 1] += function.kicks[j]
         state[:, 2], state[:, 3] = function.values[j], function.slopes[j]
-        states[j] = state
-    segment = np.searchsorted(function.starts, times, side="right") - 1
-    active = segment >= 0
-    out = np.zeros((times.size, omega.size, 4))
-    tau = (times[active] - function.starts[segment[active]])[:, None, None, None]
-    carry = scipy.linalg.expm(generators[segment[active]] * tau)
-    out[active] = np.einsum("tnij,tnj->tni", carry, states[segment[active]])
+        generator = _generator(omega, rate, function.nu[j])
+        first, stop = np.searchsorted(times, [start, end], side="left")
+        if stop > first:
+            lead, step_ = _propagators(generator, [times[first] - start, spacing])
+            out[first:stop] = _march(step_, _apply(lead, state), stop - first)
+        if np.isfinite(end):
+            state = _apply(_propagators(generator, [end - start])[0], state)
     q, velocity, load = out[..., 0], out[..., 1], out[..., 2]
     return q, velocity, load - rate * velocity - omega**2 * q
 
 
-def _generators(omega, rate, nu) -> np.ndarray:
-    """(E, n, 4, 4) G of y' = G y, y = (q, q̇, g, g'), per segment and mode."""
-    G = np.zeros((nu.size, omega.size, 4, 4))
-    G[:, :, 0, 1] = 1.0
-    G[:, :, 1, 0] = -omega**2
-    G[:, :, 1, 1] = -rate
-    G[:, :, 1, 2] = 1.0
-    G[:, :, 2, 3] = 1.0
-    G[:, :, 3, 2] = -nu[:, None]
+def _spacing(times: np.ndarray) -> float:
+    """The step (s) of equally spaced ``times`` (0 for a single time); ValueError otherwise."""
+    if times.size < 2:
+        return 0.0
+    steps = np.diff(times)
+    spacing = (times[-1] - times[0]) / (times.size - 1)
+    if not spacing > 0 or np.abs(steps - spacing).max() > SPACING_TOLERANCE * spacing:
+        raise ValueError("times must increase in equal steps")
+    return spacing
+
+
+def _generator(omega, rate, nu: float) -> np.ndarray:
+    """(n, 4, 4) G of y' = G y, y = (q, q̇, g, g'), per mode, for g'' = −ν g."""
+    G = np.zeros((omega.size, 4, 4))
+    G[:, 0, 1] = 1.0
+    G[:, 1, 0] = -omega**2
+    G[:, 1, 1] = -rate
+    G[:, 1, 2] = 1.0
+    G[:, 2, 3] = 1.0
+    G[:, 3, 2] = -nu
     return G
+
+
+def _propagators(generator: np.ndarray, durations) -> np.ndarray:
+    """(len(durations), n, 4, 4) exp(G τ) for each duration τ (s): the exact Duhamel integral."""
+    durations = np.asarray(durations, dtype=float)
+    return scipy.linalg.expm(generator[None] * durations[:, None, None, None])
+
+
+def _apply(propagator: np.ndarray, state: np.ndarray) -> np.ndarray:
+    """(n, 4) propagator (n, 4, 4) times state (n, 4), mode by mode."""
+    return np.einsum("nij,nj->ni", propagator, state)
+
+
+def _march(propagator: np.ndarray, first: np.ndarray, count: int) -> np.ndarray:
+    """(count, n, 4) states P^i first, i = 0 … count − 1, by doubling.
+
+    Each pass applies P^m to the m states known so far, then squares P^m:
+    log2(count) products, each over all of those states and modes at once.
+    """
+    states = np.empty((count,) + first.shape)
+    states[0] = first
+    power, known = propagator, 1
+    while known < count:
+        new = min(known, count - known)
+        states[known:known + new] = np.einsum("nij,knj->kni", power, states[:new])
+        power, known = power @ power, known + new
+    return states
 
 
 def modal_response(modes: ModalResult, loads, times, points=None, damping=None) -> ResponseResult:
     """Response of the points to ``loads`` (PointLoad) at ``times`` (s) by modal superposition.
 
-    points : names (default: every point of the modes). damping : (α, β) or None.
+    times : (n_t,) s, increasing in equal steps. points : names (default:
+    every point of the modes). damping : (α, β) or None.
     """
     times = np.asarray(times, dtype=float)
     points = tuple(modes.point_displacements) if points is None else tuple(points)

@@ -15,7 +15,7 @@ from builders import fixed, make_rigid, make_spring, spring_mass_chain
 from linmstmm.model import Model, ModelError
 from linmstmm.modes import mode_shapes
 from linmstmm.response import (PointLoad, frf, half_sine, harmonic, impulse, load_loads,
-                               modal_response, respond, step, table)
+                               modal_response, respond, step, table, unit_response)
 
 K_SDOF, M_SDOF, F = 4.0e4, 2.5, 30.0
 OMEGA = np.sqrt(K_SDOF / M_SDOF)
@@ -115,6 +115,62 @@ def test_tabulated_samples_end_at_zero():
     after = TIMES > 0.04
     energy = 0.5 * K_SDOF * x[after] ** 2 + 0.5 * M_SDOF * v[after] ** 2
     assert np.ptp(energy) < 1e-10 * energy.max()
+
+
+def test_undamped_step_between_output_times():
+    """F/k (1 − cos ωτ) from a start that falls between two output times."""
+    start = 0.10037
+    x, v, a = sdof_response(step(start))
+    tau = np.maximum(TIMES - start, 0.0)
+    assert_history(x, F / K_SDOF * (1 - np.cos(OMEGA * tau)))
+    assert_history(v, F / K_SDOF * OMEGA * np.sin(OMEGA * tau))
+    assert_history(a, np.where(TIMES >= start, F / M_SDOF * np.cos(OMEGA * tau), 0.0))
+
+
+def _expm_reference(omega, rate, function, times):
+    """(q, q̇, q̈) by one matrix exponential per output time and mode: y' = G y,
+    y = (q, q̇, g, g'), carried from each segment start (the reference for the
+    propagators applied by doubling)."""
+    def generator(nu):
+        G = np.zeros((omega.size, 4, 4))
+        G[:, 0, 1], G[:, 1, 0], G[:, 1, 1], G[:, 1, 2], G[:, 2, 3], G[:, 3, 2] = 1, -omega**2, -rate, 1, 1, -nu
+        return G
+
+    state, starts = np.zeros((omega.size, 4)), []
+    for j, start in enumerate(function.starts):
+        if j:
+            tau = start - function.starts[j - 1]
+            state = np.einsum("nij,nj->ni", scipy.linalg.expm(generator(function.nu[j - 1]) * tau), state)
+        state[:, 1] += function.kicks[j]
+        state[:, 2], state[:, 3] = function.values[j], function.slopes[j]
+        starts.append(state.copy())
+    out = np.zeros((times.size, omega.size, 4))
+    for i, t in enumerate(times):
+        j = np.searchsorted(function.starts, t, side="right") - 1
+        if j >= 0:
+            carry = scipy.linalg.expm(generator(function.nu[j]) * (t - function.starts[j]))
+            out[i] = np.einsum("nij,nj->ni", carry, starts[j])
+    return out[..., 0], out[..., 1], out[..., 2] - rate * out[..., 1] - omega**2 * out[..., 0]
+
+
+@pytest.mark.parametrize("function", [
+    step(0.0123), impulse(0.3), half_sine(0.05, 0.1), harmonic(40.0 / (2 * np.pi), 0.3, 0.05),
+    table([0.01, 0.2, 0.5, 0.9], [0.0, 1.0, -2.0, 0.5]), table([0.0, 0.2], [1.0, 3.0], hold=True)],
+    ids=lambda function: function.kind)
+def test_propagators_equal_one_exponential_per_time(function):
+    """Rigid-body (ω = 0, with and without damping), undamped, under-, critically and
+    overdamped modes, and a harmonic load at resonance (ω = 40 rad/s, undamped)."""
+    omega = np.array([0.0, 0.0, 3.0, 10.0, 40.0, 40.0, 200.0])
+    rate = np.array([0.0, 0.5, 0.0, 20.0, 80.0, 0.0, 1.0])
+    times = np.linspace(0.0, 2.0, 801)
+    for got, want in zip(unit_response(omega, rate, function, times),
+                         _expm_reference(omega, rate, function, times)):
+        assert np.abs(got - want).max() <= 1e-9 * np.abs(want).max()
+
+
+def test_unequal_output_steps_are_refused():
+    with pytest.raises(ValueError, match="equal steps"):
+        unit_response([OMEGA], [0.0], step(), [0.0, 0.1, 0.3])
 
 
 # --- two-mass chain: hand-written M, K ------------------------------------------

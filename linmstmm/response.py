@@ -351,8 +351,8 @@ def unit_response(omega, damping_rate, function: TimeFunction, times):
         generator = _generator(omega, rate, function.nu[j])
         first, stop = np.searchsorted(times, [start, end], side="left")
         if stop > first:
-            lead, step_ = _propagators(generator, [times[first] - start, spacing])
-            out[first:stop] = _march(step_, _apply(lead, state), stop - first)
+            lead, stride = _propagators(generator, [times[first] - start, spacing])
+            out[first:stop] = _march(stride, _apply(lead, state), stop - first)
         if np.isfinite(end):
             state = _apply(_propagators(generator, [end - start])[0], state)
     q, velocity, load = out[..., 0], out[..., 1], out[..., 2]

@@ -20,8 +20,9 @@ linear system y' = G y, y = (q, q̇, g, g'), so the state is carried by the
 exact propagator exp(G τ): Duhamel's integral in closed form, exact to
 rounding for every damping (under-, over-, critically damped,
 zero-frequency rigid-body modes). The output times are equally spaced, so
-a segment needs three propagators per mode (to its first output time, over
-one output step, to its end), computed once; the states at all output times
+a segment needs two propagators per mode (to its first output time, to its
+end) and each distinct ν one over an output step, all computed in one
+call; the states at all output times
 of the segment follow by doubling (the first m states times P^m give the
 next m), log2(n_t) products over all modes and times at once. Step,
 impulse, harmonic and half-sine loads are one or two segments; tabulated
@@ -341,20 +342,25 @@ def unit_response(omega, damping_rate, function: TimeFunction, times):
     """
     omega, rate = np.asarray(omega, float), np.asarray(damping_rate, float)
     times = np.asarray(times, dtype=float)
-    spacing = _spacing(times)
-    ends = np.r_[function.starts[1:], np.inf]
+    starts, segments = function.starts, function.starts.size
+    bounds = np.searchsorted(times, np.r_[starts, np.inf], side="left")  # output times [bounds[j], bounds[j+1])
+    reached = bounds[:-1] < times.size
+    leads = np.zeros(segments)  # from each start to its first output time
+    leads[reached] = times[bounds[:-1][reached]] - starts[reached]
+    nus, kind = np.unique(function.nu, return_inverse=True)
+    generators = _generators(omega, rate, nus)  # (U, n, 4, 4), one per distinct ν
+    lead, carry, stride = np.split(_propagators(
+        np.concatenate([generators[kind], generators[kind], generators]),
+        np.r_[leads, np.diff(starts), 0.0, np.full(nus.size, _spacing(times))]), [segments, 2 * segments])
     out = np.zeros((times.size, omega.size, 4))
     state = np.zeros((omega.size, 4))
-    for j, (start, end) in enumerate(zip(function.starts, ends)):
+    for j in range(segments):
         state[:, 1] += function.kicks[j]
         state[:, 2], state[:, 3] = function.values[j], function.slopes[j]
-        generator = _generator(omega, rate, function.nu[j])
-        first, stop = np.searchsorted(times, [start, end], side="left")
+        first, stop = bounds[j], bounds[j + 1]
         if stop > first:
-            lead, stride = _propagators(generator, [times[first] - start, spacing])
-            out[first:stop] = _march(stride, _apply(lead, state), stop - first)
-        if np.isfinite(end):
-            state = _apply(_propagators(generator, [end - start])[0], state)
+            out[first:stop] = _march(stride[kind[j]], _apply(lead[j], state), stop - first)
+        state = _apply(carry[j], state)
     q, velocity, load = out[..., 0], out[..., 1], out[..., 2]
     return q, velocity, load - rate * velocity - omega**2 * q
 
@@ -370,22 +376,24 @@ def _spacing(times: np.ndarray) -> float:
     return spacing
 
 
-def _generator(omega, rate, nu: float) -> np.ndarray:
-    """(n, 4, 4) G of y' = G y, y = (q, q̇, g, g'), per mode, for g'' = −ν g."""
-    G = np.zeros((omega.size, 4, 4))
-    G[:, 0, 1] = 1.0
-    G[:, 1, 0] = -omega**2
-    G[:, 1, 1] = -rate
-    G[:, 1, 2] = 1.0
-    G[:, 2, 3] = 1.0
-    G[:, 3, 2] = -nu
+def _generators(omega, rate, nus) -> np.ndarray:
+    """(U, n, 4, 4) G of y' = G y, y = (q, q̇, g, g'), per mode, for each g'' = −ν g of ``nus`` (U,)."""
+    G = np.zeros((nus.size, omega.size, 4, 4))
+    G[..., 0, 1] = 1.0
+    G[..., 1, 0] = -omega**2
+    G[..., 1, 1] = -rate
+    G[..., 1, 2] = 1.0
+    G[..., 2, 3] = 1.0
+    G[..., 3, 2] = -nus[:, None]
     return G
 
 
-def _propagators(generator: np.ndarray, durations) -> np.ndarray:
-    """(len(durations), n, 4, 4) exp(G τ) for each duration τ (s): the exact Duhamel integral."""
-    durations = np.asarray(durations, dtype=float)
-    return scipy.linalg.expm(generator[None] * durations[:, None, None, None])
+def _propagators(generators: np.ndarray, durations: np.ndarray) -> np.ndarray:
+    """(m, n, 4, 4) exp(G_i τ_i), the exact Duhamel integral over each duration, in one call.
+
+    generators : (m, n, 4, 4). durations : (m,) s.
+    """
+    return scipy.linalg.expm(generators * durations[:, None, None, None])
 
 
 def _apply(propagator: np.ndarray, state: np.ndarray) -> np.ndarray:

@@ -167,10 +167,11 @@ def _expm_reference(omega, rate, function, times):
     ids=lambda function: function.kind)
 def test_propagators_equal_one_exponential_per_time(function):
     """Rigid-body (ω = 0, with and without damping), undamped, under-, critically and
-    overdamped modes, and a harmonic load at resonance (ω = 40 rad/s, undamped)."""
-    omega = np.array([0.0, 0.0, 3.0, 10.0, 40.0, 40.0, 200.0])
-    rate = np.array([0.0, 0.5, 0.0, 20.0, 80.0, 0.0, 1.0])
-    times = np.linspace(0.0, 2.0, 801)
+    overdamped modes, a stiff one (ω² τ up to 2e7), and a harmonic load at resonance
+    (ω = 40 rad/s, undamped)."""
+    omega = np.array([0.0, 0.0, 3.0, 10.0, 40.0, 40.0, 200.0, 3000.0])
+    rate = np.array([0.0, 0.5, 0.0, 20.0, 80.0, 0.0, 1.0, 30.0])
+    times = np.linspace(0.0, 2.0, 201)
     for got, want in zip(unit_response(omega, rate, function, times),
                          _expm_reference(omega, rate, function, times)):
         assert np.abs(got - want).max() <= 1e-9 * np.abs(want).max()

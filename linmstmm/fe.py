@@ -791,6 +791,36 @@ class _Flexibility:
         return y.reshape(np.shape(f))
 
 
+def static_displacements(model: Model, loads, points, elements_per_beam: int = 1) -> np.ndarray:
+    """Elastic static displacements of ``points`` under each point load, K⁺ f.
+
+    Hermite beam elements give the exact static solution at their nodes for
+    point loads, so one element per beam suffices for a held model. A model
+    with rigid-body modes is solved for its elastic part: the load's
+    rigid-body part is removed and so is the rigid-body motion of the result
+    (M-orthogonal to the rigid-body modes, as the elastic modes are); that
+    last step weighs the beams' interpolated fields with the mesh's mass, so
+    with beams it converges with the mesh instead of being exact.
+
+    Parameters
+    ----------
+    model : the model records.
+    loads : sequence of (point name, (6,) [force N, moment N m]) in inertial axes.
+    points : sequence of point names to report.
+    elements_per_beam : int >= 1.
+
+    Returns
+    -------
+    (n_loads, n_points, 6) displacements m and rotations rad, inertial axes.
+    """
+    fe = assemble(model, elements_per_beam)
+    full = np.zeros((fe.n_full, len(loads)))
+    for i, (point, vector) in enumerate(loads):
+        full[fe.dof_index.point(point), i] = vector
+    motion = (fe.T @ _Flexibility(fe)(fe.T.T @ full)).T  # (n_loads, n_full)
+    return np.stack([motion[:, fe.dof_index.point(p)] for p in points], axis=1)
+
+
 def _rayleigh_ritz(fe: FEModel, Y: np.ndarray):
     """Ritz pairs of span(Y), energies from strains.
 

@@ -1,6 +1,6 @@
 """The model contract: immutable element records and the TOML loader.
 
-A model file (``shared/spec/model-format.md``) is read with :mod:`tomllib`,
+A model file (``docs/model-format.md``) is read with :mod:`tomllib`,
 validated completely, and only then turned into the records below. Nothing
 downstream re-validates: a :class:`Model` is always well formed.
 

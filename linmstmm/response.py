@@ -1,4 +1,4 @@
-"""Modal response to point loads, and frequency response functions (seed 002 §3.4).
+"""Modal response to point loads, and frequency response functions (docs/method.md).
 
 With the augmented eigenvectors V^k of :mod:`linmstmm.modes` and proportional
 damping C = αM + βK (the model's ``[damping]``), each modal coordinate obeys

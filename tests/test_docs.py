@@ -26,7 +26,7 @@ from pathlib import Path
 import pytest
 
 from linmstmm.cli import main
-from linmstmm.model import load_model
+from linmstmm.model import ModelError, load_model
 from linmstmm.response import load_loads
 
 REPO = Path(__file__).resolve().parents[1]
@@ -142,3 +142,41 @@ def test_nothing_points_outside_the_repository():
             offenders += [f"{name}:{n}" for n, line in enumerate(path.read_text().splitlines(), 1)
                           if pattern.search(line)]
     assert offenders == []
+
+
+#: (example model of docs/model-format.md, line after which a key is added, its section heading)
+TABLES = [
+    ('name = "cantilever', 'name = "cantilever with tip mass"', "## Top level"),
+    ('name = "cantilever', "[[beam]]", "## Beams: `[[beam]]`"),
+    ('name = "cantilever', "[[rigid]]", "## Rigid bodies: `[[rigid]]`"),
+    ('name = "spring-mass chain', "[[spring]]", "## Springs: `[[spring]]`"),
+    ('name = "portal frame', "[damping]", "## Damping: `[damping]`"),
+]
+
+
+@pytest.mark.parametrize("example, after, heading", TABLES, ids=[t[2] for t in TABLES])
+def test_model_format_documents_every_key_the_loader_allows(example, after, heading, tmp_path):
+    """The loader names its allowed keys when it meets an unknown one; each is in the guide."""
+    guide = REPO / "docs" / "model-format.md"
+    lines = next(b for b in blocks(guide, "toml") if b.startswith(example)).splitlines()
+    at = lines.index(after) + 1
+    file = tmp_path / "unknown_key.toml"
+    file.write_text("\n".join(lines[:at] + ["bogus_key = 1"] + lines[at:]) + "\n")
+    with pytest.raises(ModelError, match="allowed keys") as error:
+        load_model(file)
+    section = guide.read_text().split(heading + "\n", 1)[1].split("\n## ", 1)[0]
+    for key in error.value.message.split("allowed keys: ")[1].split(", "):
+        assert re.search(rf"`(\[\[?)?{key}(\]\]?)?`", section), f"{heading}: {key}"
+
+
+def test_cli_guide_documents_every_option():
+    """Each command's options, as the parser registers them, appear in its section of docs/cli.md."""
+    from linmstmm.cli import build_parser
+
+    (commands,) = [a for a in build_parser()._actions if a.dest == "command"]
+    for name, parser in commands.choices.items():
+        section = cli_section(name)
+        for action in parser._actions:
+            for option in action.option_strings:
+                if option not in ("-h", "--help"):
+                    assert option in section, f"linmstmm {name} {option}"

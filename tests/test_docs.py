@@ -134,7 +134,7 @@ def test_relative_links_resolve(path):
 def test_nothing_points_outside_the_repository():
     tracked = subprocess.run(["git", "ls-files"], cwd=REPO, capture_output=True, text=True,
                              check=True).stdout.split()
-    pattern = re.compile(r"(\.\./)+shared|shared/(spec|seeds)")
+    pattern = re.compile(r"(\.\.[/\\])+shared|shared[/\\](spec|seeds)")
     offenders = []
     for name in tracked:
         path = REPO / name

@@ -69,4 +69,5 @@ def __getattr__(name: str):
 
 
 def __dir__() -> list[str]:
+    """The module's names, the public ones included before their first use."""
     return sorted(set(globals()) | set(__all__))

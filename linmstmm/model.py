@@ -3,7 +3,8 @@
 A model file is read with :mod:`tomllib`, validated completely, and only then
 turned into the records below; a :class:`Model` built in code runs the same
 checks on construction. Nothing downstream re-validates: a :class:`Model` is
-always well formed. Examples: ``models/*.toml``. The keys of a file:
+always well formed. Examples: ``models/*.toml``; the full reference is
+docs/model-format.md. The keys of a file, in brief:
 
 * top level: ``name`` (non-empty string), ``description`` (optional string);
 * ``[points]``: ``point = [x, y, z]``, m; every point is used by an element;

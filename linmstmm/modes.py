@@ -1,4 +1,4 @@
-"""Mode shapes, augmented eigenvectors and their orthogonality.
+"""Mode shapes, augmented eigenvectors and their orthogonality (docs/method.md).
 
 At a natural frequency ω the null space of Ū_all(ω) holds the boundary
 unknowns z̄ of the modes (a whole basis for a repeated frequency). The element

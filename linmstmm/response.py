@@ -1,4 +1,4 @@
-"""Modal response to point loads, and frequency response functions.
+"""Modal response to point loads, and frequency response functions (docs/method.md).
 
 With the augmented eigenvectors V^k of :mod:`linmstmm.modes` and proportional
 damping C = αM + βK (the model's ``[damping]``) or modal damping ratios ζ_k,

@@ -4,7 +4,8 @@
 :class:`StructureReport`: the root, the tips, the junctions, the multi-input
 bodies with their inputs, the loop cuts, the order of Ū_all, and the block
 layout of U_all as the automatic deduction theorem writes it
-(``seeds/001`` §11.4–11.6, ``seeds/003``), so an engineer can compare the
+(Rui, Wang and Zhang's book, 2018, §11.4–11.6, and the
+multiple launch rocket system study; ``docs/method.md``), so an engineer can compare the
 deduction with a derivation by hand.
 
 Block layout of ``U_all Z_all = 0``:

@@ -1,4 +1,4 @@
-"""The ``linmstmm`` command line against its contract (README, "Usage")."""
+"""The ``linmstmm`` command line against its contract (docs/cli.md)."""
 from __future__ import annotations
 
 import json
@@ -136,3 +136,48 @@ def test_fe_finds_no_elastic_mode_where_none_exists(tmp_path):
     assert "  rigid-body modes: 6" in lines and table.stdout.count("note: only 0 elastic") == 1
     header = next(i for i, line in enumerate(lines) if line.split()[:2] == ["mode", "f"])
     assert lines[header + 1].lstrip().startswith("solve time")
+
+
+def test_version_is_the_package_version():
+    import tomllib
+
+    import linmstmm
+
+    result = run("--version")
+    assert result.returncode == 0, result.stderr
+    declared = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    assert result.stdout.strip() == f"linmstmm {linmstmm.__version__}" == f"linmstmm {declared}"
+
+
+def _commands():
+    """The names of the registered subcommands."""
+    from linmstmm.cli import build_parser
+
+    parser = build_parser()
+    (sub,) = [action for action in parser._actions if action.dest == "command"]
+    return list(sub.choices)
+
+
+@pytest.mark.parametrize("args", [(), ("-h",), ("--help",)])
+def test_bare_and_help_list_every_command_with_an_example(args):
+    from linmstmm.cli import COMMAND_EXAMPLES
+
+    result = run(*args)
+    assert result.returncode == 0, result.stderr
+    assert sorted(COMMAND_EXAMPLES) == sorted(_commands())
+    for name, example in COMMAND_EXAMPLES.items():
+        assert f"  {name} " in result.stdout and example in result.stdout, name
+
+
+def test_help_examples_are_valid_invocations():
+    """Each example parses (its command, options and bundled files exist)."""
+    from linmstmm.cli import COMMAND_EXAMPLES, build_parser
+
+    for name, example in COMMAND_EXAMPLES.items():
+        words = example.split()
+        assert words[:2] == ["linmstmm", name]
+        args = build_parser().parse_args(words[1:])
+        assert args.command == name
+        for value in vars(args).values():
+            if isinstance(value, str) and value.startswith("models/"):
+                assert (ROOT / value).is_file(), value

@@ -1,4 +1,4 @@
-"""The model loader (``linmstmm.model.load_model``) against the model format (``linmstmm.model``).
+"""The model loader (``linmstmm.model.load_model``) against docs/model-format.md.
 
 Error tests start from ``BASE`` (a valid model using every kind of element and
 section), change one thing, and check that the ModelError names the file, the

@@ -1,5 +1,73 @@
 """linmstmm: natural frequencies, mode shapes and modal response of
 multi-rigid-flexible-body systems by the linear transfer matrix method for
-multibody systems (MSTMM, the "Rui method")."""
+multibody systems (MSTMM, the "Rui method").
+
+Quick start::
+
+    import linmstmm as lm
+
+    model = lm.load_model("models/cantilever_tip_mass.toml")
+    lm.natural_frequencies(model, count=3).frequencies_hz   # Hz, (3,)
+
+Public names (each documented where it is defined):
+
+* models: :func:`load_model`, :class:`Model`, :class:`ModelError`, and the
+  builders of :mod:`linmstmm.builders` (models in Python, without a file);
+* frequencies: :func:`natural_frequencies` -> :class:`FrequencyResult`
+  (transfer matrix method), :func:`fe_frequencies` -> :class:`FEResult`
+  (the independent finite-element route);
+* modes: :func:`mode_shapes` -> :class:`ModalResult`, :func:`mac_matrix`;
+* response: :func:`load_loads` -> :class:`LoadCase`, :func:`respond` and
+  :func:`modal_response` -> :class:`ResponseResult` (time histories),
+  :func:`frf` -> :class:`FRFResult` (receptance), :class:`PointLoad`.
+
+The names are imported on first use, so ``import linmstmm`` stays light
+(in particular, matplotlib is only imported by the plotting functions).
+Guides: ``docs/api.md``, ``docs/model-format.md``, ``docs/cli.md``,
+``docs/method.md``.
+"""
+from __future__ import annotations
+
+import importlib
 
 __version__ = "0.1.0"
+
+#: Public name -> the module that defines it.
+_SOURCES = {
+    "load_model": "linmstmm.model",
+    "Model": "linmstmm.model",
+    "ModelError": "linmstmm.model",
+    "natural_frequencies": "linmstmm.solve",
+    "FrequencyResult": "linmstmm.solve",
+    "mode_shapes": "linmstmm.modes",
+    "ModalResult": "linmstmm.modes",
+    "mac_matrix": "linmstmm.modes",
+    "fe_frequencies": "linmstmm.fe",
+    "FEResult": "linmstmm.fe",
+    "load_loads": "linmstmm.response",
+    "respond": "linmstmm.response",
+    "modal_response": "linmstmm.response",
+    "frf": "linmstmm.response",
+    "LoadCase": "linmstmm.response",
+    "PointLoad": "linmstmm.response",
+    "ResponseResult": "linmstmm.response",
+    "FRFResult": "linmstmm.response",
+    "builders": "linmstmm.builders",
+}
+
+__all__ = list(_SOURCES)
+
+
+def __getattr__(name: str):
+    """Import a public name from its module on first use (PEP 562)."""
+    if name not in _SOURCES:
+        raise AttributeError(f"module 'linmstmm' has no attribute {name!r}")
+    module = importlib.import_module(_SOURCES[name])
+    value = module if name == "builders" else getattr(module, name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    """The module's names, the public ones included before their first use."""
+    return sorted(set(globals()) | set(__all__))

@@ -1,4 +1,4 @@
-"""The ``linmstmm`` command line (contract: ``shared/spec/cli.md``).
+"""The ``linmstmm`` command line (every command and its JSON: ``docs/cli.md``).
 
 Exit status: 0 done; 1 the computation itself failed (clear message);
 2 bad model file, bad option or impossible request (one line on stderr,
@@ -11,6 +11,7 @@ import json
 import math
 import sys
 
+from linmstmm import __version__
 from linmstmm.model import ModelError, load_model
 from linmstmm.fe_command import add_fe_command
 from linmstmm.mode_commands import add_mode_commands
@@ -61,8 +62,34 @@ def _add_request_options(parser):
     parser.add_argument("--json", action="store_true", help="one JSON object on stdout")
 
 
+#: Every command with one example on the bundled models (shown by ``linmstmm -h``).
+COMMAND_EXAMPLES = {
+    "freqs": "linmstmm freqs models/mlrs/mlrs.toml --count 10",
+    "check": "linmstmm check models/mlrs/mlrs.toml",
+    "fe": "linmstmm fe models/cantilever_tip_mass.toml --count 6",
+    "modes": "linmstmm modes models/cantilever_tip_mass.toml --count 4 --plot modes",
+    "scan": "linmstmm scan models/cantilever_tip_mass.toml --fmax 200 --plot scan.png",
+    "response": "linmstmm response models/cantilever_tip_mass.toml models/loads/cantilever_step.toml",
+    "frf": "linmstmm frf models/cantilever_tip_mass.toml --point tip --direction z --fmax 100",
+}
+
+
+def _examples() -> str:
+    """The help's closing text: one example per command."""
+    width = max(map(len, COMMAND_EXAMPLES))
+    lines = [f"  {name:<{width}}  {example}" for name, example in COMMAND_EXAMPLES.items()]
+    return "\n".join(["examples:", *lines, "",
+                      "Most commands take --json for one JSON object on stdout.",
+                      "'linmstmm COMMAND -h' lists a command's options; the guides are in docs/."])
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="linmstmm", description=__doc__.splitlines()[0])
+    """The argument parser of every command (each sets ``run`` to its function)."""
+    parser = _Parser(prog="linmstmm", description="Natural frequencies, mode shapes and modal response of\n"
+                     "multi-rigid-flexible-body systems by the transfer matrix method for\n"
+                     "multibody systems (MSTMM).", epilog=_examples(),
+                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"linmstmm {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     freqs = sub.add_parser("freqs", help="natural frequencies by the transfer matrix method")
@@ -119,7 +146,11 @@ def _run_freqs(args):
 
 def main(argv=None) -> int:
     """Run the command line; return the exit status."""
+    argv = sys.argv[1:] if argv is None else list(argv)
     try:
+        if not argv:  # bare ``linmstmm``: what there is to do
+            build_parser().print_help()
+            return 0
         args = build_parser().parse_args(argv)
         return args.run(args)
     except (ModelError, UsageError) as error:

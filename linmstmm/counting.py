@@ -42,7 +42,7 @@ EVALUATION_CHUNK = 2048
 #: It is no smaller because the difference amplifies the rounding noise of log det by
 #: its inverse: far above a discrete model's last root, where det is rounding noise,
 #: counts refine on that noise before they fail. Figure 11.7's ring of three masses
-#: asked for 4 modes (tests/test_seed_topologies.py) took 1.6 s before derivatives,
+#: asked for 4 modes (tests/test_book_topologies.py) took 1.6 s before derivatives,
 #: and with steps of 1e-3, 4e-3 (this) and 1e-2: 3.3, 1.8 and 2.5 s (1e-7 relative to
 #: ω, with twice the point limits: 14 s). Features narrower than this are the sampled
 #: steps' to see.

@@ -50,11 +50,20 @@ positive kinetic energy, 1e-13 relative to the largest) are the rigid-body
 modes. They are deflated exactly: K is made invertible by temporary
 statically determinate supports on as many DOFs as there are rigid motions,
 and the solve is projected M-orthogonally off the rigid-body modes.
-Massless DOFs (a point between two springs, a massless beam) need nothing:
-the operator ``K⁺M`` maps them to zero (infinite frequency), which is static
-condensation done implicitly. A rigid motion without mass (a point mass
-without rotary inertia and with nothing holding its rotation) has neither
-mass nor stiffness; it is not a mode and is neither counted nor reported.
+
+Massless DOFs (a point between two springs, a spring's free far end, a
+massless body or beam) are condensed out statically, which is exact since
+their inertia is exactly zero: masses below 1e-13 of the model's own scale
+(its total mass, and for inertias that times its extent squared) are removed
+first (:func:`_negligible_mass_removed`), so such DOFs have zero rows in M.
+The flexibility ``K⁺`` applied to inertial loads moves them statically, and
+the eigenproblem is posed on the directions that carry mass only: the model
+has exactly rank M less its rigid-body modes elastic modes, and a massless
+direction (infinite frequency) is never taken for one. A model whose mass
+all sits in rigid-body motions has no elastic mode. A rigid motion without
+mass (a point mass without rotary inertia and with nothing holding its
+rotation) has neither mass nor stiffness; it is not a mode and is neither
+counted nor reported.
 
 Mesh refinement
 ---------------
@@ -76,7 +85,7 @@ bounds such a mode's own error.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from time import perf_counter
 
 import numpy as np
@@ -86,16 +95,20 @@ from scipy.sparse.csgraph import connected_components
 from scipy.sparse.linalg import LinearOperator, eigsh, splu
 
 from linmstmm.mode_bound import check_range_request
-from linmstmm.model import Beam, Model
+from linmstmm.model import Beam, Model, Rigid
 
 #: A substituted constraint row whose entries all fall below this fraction of
 #: the largest term that entered it is redundant (implied by earlier rows).
 REDUNDANT_CONSTRAINT = 1e-10
 #: Entries below this fraction of their row's largest are rounding debris.
 NEGLIGIBLE_ENTRY = 1e-14
-#: Rigid motions whose kinetic energy is below this fraction of the largest
-#: one are massless: neither modes nor counted.
-MASSLESS_MOTION = 1e-13
+#: A mass (kg), inertia (kg m²) or kinetic energy below this fraction of the
+#: model's own scale of the same units is rounding, not mass: a body's mass or
+#: principal inertia, a beam, or a rigid motion below it carries none.
+MASSLESS = 1e-13
+#: Eigenvalues of the mass matrix scaled to unit diagonal below this fraction of
+#: the largest are the rounding of an exact zero: directions without mass.
+MASS_RANK = 1e-12
 #: Modes whose operator eigenvalue 1/λ is below this fraction of the largest
 #: are beyond float64 resolution and treated as infinitely stiff.
 UNRESOLVED_STIFFNESS = 1e-13
@@ -103,6 +116,9 @@ UNRESOLVED_STIFFNESS = 1e-13
 DENSE_LIMIT = 120
 #: Polishing sweeps stop when no wanted λ changes by more than this (relative).
 SWEEP_TOLERANCE = 1e-14
+#: A frequency whose estimated relative error is at or above this is not
+#: reported (its own estimate leaves not even its first digit assured).
+UNSETTLED = 0.1
 #: Floor of every relative error estimate of λ (rounding of the last digits).
 ROUNDOFF = 4 * np.finfo(float).eps
 
@@ -372,6 +388,44 @@ def _add_springs(model, layout, strains, stiffness, constraints):
                 stiffness.append([k])
 
 
+def _negligible_mass_removed(model: Model) -> Model:
+    """``model`` with every mass below MASSLESS of the model's own scale set to zero.
+
+    The scales are the total mass m of bodies and beams (kg) and m d² plus the
+    traces of the bodies' inertia tensors (kg m²), d the largest distance of a
+    point or mass centre from their centroid (m). Each body's mass and principal
+    inertias and each beam's mass are compared with the scale of their units, so
+    the decision does not depend on the units a model is written in; a mass that
+    is kept is exactly as given. A DOF without mass then has an exactly zero row
+    and column in the assembled M.
+    """
+    places = np.array([*model.points.values(), *(body.com for body in model.rigids)], float)
+    extent = np.linalg.norm(places - places.mean(axis=0), axis=1).max()
+    total = sum(body.mass for body in model.rigids) + sum(beam.mass for beam in model.beams)
+    inertia = total * extent ** 2 + sum(np.trace(body.inertia) for body in model.rigids)
+    rigids = tuple(_body_mass_kept(body, MASSLESS * total, MASSLESS * inertia) for body in model.rigids)
+    beams = tuple(beam if beam.mass > MASSLESS * total else replace(beam, rho=0.0) for beam in model.beams)
+    return replace(model, rigids=rigids, beams=beams)
+
+
+def _body_mass_kept(body: Rigid, least_mass: float, least_inertia: float) -> Rigid:
+    """``body`` with its mass (kg) made zero unless above ``least_mass``, and its
+    principal inertias (kg m²) unless above ``least_inertia``; the same record when
+    nothing changes."""
+    mass = body.mass if body.mass > least_mass else 0.0
+    inertia, diagonal = body.inertia, body.inertia.diagonal()
+    # Gershgorin: the least of these is at most the smallest principal inertia
+    gershgorin = diagonal - (np.abs(inertia).sum(axis=1) - np.abs(diagonal))
+    if diagonal.any() and gershgorin.min() <= least_inertia:
+        principal, axes = la.eigh(inertia)
+        kept = principal > least_inertia
+        if not np.all(kept | (principal == 0.0)):
+            inertia = (axes * np.where(kept, principal, 0.0)) @ axes.T
+    if mass == body.mass and inertia is body.inertia:
+        return body
+    return replace(body, mass=mass, inertia=inertia)
+
+
 def _add_rigid_masses(model, layout, mass):
     for body in model.rigids:
         dofs = layout.index.rigid(body.name)
@@ -520,9 +574,14 @@ def _rigid_field(positions, frames) -> np.ndarray:
 
     Rotations are about the nodes' centroid and scaled by their extent, so
     translations and rotations weigh alike; each node's DOFs are in its frame.
+    Nodes that coincide to rounding (an extent below NEGLIGIBLE_ENTRY of their
+    coordinates: the rounding of the centroid) have no arm, and any scale
+    weighs the two alike.
     """
     arm = positions - positions.mean(axis=0)
-    size = np.abs(arm).max() or 1.0
+    size = np.abs(arm).max()
+    if size <= NEGLIGIBLE_ENTRY * np.abs(positions).max():
+        arm, size = np.zeros_like(arm), 1.0
     field = np.zeros((len(positions), 6, 6))
     for k, unit in enumerate(np.eye(3)):
         field[:, :3, k] = frames @ unit
@@ -583,6 +642,10 @@ class FEModel:
         (statically determinate temporary supports, used by the solver).
     frames : (n_nodes, 3, 3) rows = the axes of each node's DOFs (identity
         except at interior beam nodes).
+    massive : (n_massive,) reduced DOFs that carry mass, ascending. The others
+        have exactly zero rows and columns in M (masses negligible against the
+        model's own scale are removed first) and are condensed out statically
+        by the eigensolver.
     """
 
     M: sp.csr_matrix
@@ -597,6 +660,7 @@ class FEModel:
     rigid_modes: np.ndarray
     supports: np.ndarray
     frames: np.ndarray
+    massive: np.ndarray
 
     def beam_motion(self, name: str, q_full: np.ndarray) -> np.ndarray:
         """(n+1, 6) inertial displacements and rotations along beam ``name``.
@@ -620,6 +684,7 @@ def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
     n = int(elements_per_beam)
     if n < 1:
         raise ValueError(f"elements_per_beam must be >= 1, got {elements_per_beam}")
+    model = _negligible_mass_removed(model)
     layout = _layout(model, n)
     n_full = 6 * layout.n_nodes
     strains, mass, constraints = _Triplets(), _Triplets(), _Triplets()
@@ -642,7 +707,8 @@ def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
     rigid_modes, supports = _rigid_basis(_rigid_motions(model, layout)[masters], M)
     return FEModel(M=M, K=K, T=T, G=G, D=D, dof_index=layout.index,
                    n_dof=T.shape[1], n_full=n_full, elements_per_beam=n,
-                   rigid_modes=rigid_modes, supports=supports, frames=layout.frames)
+                   rigid_modes=rigid_modes, supports=supports, frames=layout.frames,
+                   massive=np.flatnonzero(M.diagonal()))
 
 
 def _drop_debris(matrix) -> sp.csr_matrix:
@@ -677,7 +743,7 @@ def _rigid_basis(motions, M):
         return np.zeros((n, 0)), np.zeros(0, dtype=int)
     basis = la.orth(motions)
     kinetic, directions = la.eigh(basis.T @ (M @ basis))
-    massive = kinetic > MASSLESS_MOTION * np.abs(kinetic).max()
+    massive = kinetic > MASSLESS * np.abs(kinetic).max()
     modes = basis @ (directions[:, massive] / np.sqrt(kinetic[massive]))
     pivots = la.qr(basis.T, pivoting=True, mode="r")[1]
     return modes, np.sort(pivots[:basis.shape[1]])
@@ -725,6 +791,36 @@ class _Flexibility:
         return y.reshape(np.shape(f))
 
 
+def static_displacements(model: Model, loads, points, elements_per_beam: int = 1) -> np.ndarray:
+    """Elastic static displacements of ``points`` under each point load, K⁺ f.
+
+    Hermite beam elements give the exact static solution at their nodes for
+    point loads, so one element per beam suffices for a held model. A model
+    with rigid-body modes is solved for its elastic part: the load's
+    rigid-body part is removed and so is the rigid-body motion of the result
+    (M-orthogonal to the rigid-body modes, as the elastic modes are); that
+    last step weighs the beams' interpolated fields with the mesh's mass, so
+    with beams it converges with the mesh instead of being exact.
+
+    Parameters
+    ----------
+    model : the model records.
+    loads : sequence of (point name, (6,) [force N, moment N m]) in inertial axes.
+    points : sequence of point names to report.
+    elements_per_beam : int >= 1.
+
+    Returns
+    -------
+    (n_loads, n_points, 6) displacements m and rotations rad, inertial axes.
+    """
+    fe = assemble(model, elements_per_beam)
+    full = np.zeros((fe.n_full, len(loads)))
+    for i, (point, vector) in enumerate(loads):
+        full[fe.dof_index.point(point), i] = vector
+    motion = (fe.T @ _Flexibility(fe)(fe.T.T @ full)).T  # (n_loads, n_full)
+    return np.stack([motion[:, fe.dof_index.point(p)] for p in points], axis=1)
+
+
 def _rayleigh_ritz(fe: FEModel, Y: np.ndarray):
     """Ritz pairs of span(Y), energies from strains.
 
@@ -748,19 +844,44 @@ def _rayleigh_ritz(fe: FEModel, Y: np.ndarray):
     return lam[order], X[:, order]
 
 
+def _mass_factor(fe: FEModel) -> np.ndarray:
+    """(n_dof, r) B with ``M = B Bᵀ``, r = rank M: the directions that carry mass.
+
+    Only the massive DOFs enter. Their block of M is scaled to unit diagonal, so
+    that translations (kg) and rotations (kg m²) weigh alike whatever the units;
+    its eigenvalues below MASS_RANK of the largest are the rounding of exact zeros
+    (directions without mass across DOFs, as of a singular inertia tensor in skew
+    axes) and are left out.
+    """
+    block = fe.M[fe.massive][:, fe.massive].toarray()
+    size = np.sqrt(block.diagonal())
+    values, vectors = la.eigh(block / np.outer(size, size))
+    kept = values > MASS_RANK * values.max(initial=0.0)
+    factor = np.zeros((fe.n_dof, np.count_nonzero(kept)))
+    factor[fe.massive] = size[:, None] * vectors[:, kept] * np.sqrt(values[kept])
+    return factor
+
+
 def _dense_start(fe: FEModel, flexibility) -> np.ndarray:
     """All resolvable elastic modes of a small model, approximately, softest first.
 
-    Eigenvectors of the M-symmetric ``K⁺M`` through the symmetric
-    ``M^½ K⁺ M^½ z = z/λ``; the mode is ``x = K⁺ M^½ z λ``.
+    Static condensation of the massless DOFs, which is exact (they have no
+    inertia): with ``M = B Bᵀ`` (:func:`_mass_factor`) the condensed flexibility
+    ``Bᵀ K⁺ B`` (r x r) has eigenvalues 1/λ for the elastic modes and 0 for the
+    rigid-body modes, and a mode is ``x = K⁺ B z λ``, its massless DOFs
+    following statically. There are exactly r − (rigid-body modes) elastic
+    modes, so no eigenvalue of a massless direction is ever mistaken for one.
     """
-    mass_values, mass_vectors = la.eigh(fe.M.toarray())
-    root = (mass_vectors * np.sqrt(np.maximum(mass_values, 0.0))) @ mass_vectors.T
-    flexible = flexibility(np.eye(fe.n_dof))
-    flexible = 0.5 * (flexible + flexible.T)
-    theta, Z = la.eigh(root @ flexible @ root)
-    keep = np.flatnonzero(theta > UNRESOLVED_STIFFNESS * max(theta[-1], 0.0))[::-1]
-    return (flexible @ root @ Z[:, keep]) / theta[keep]
+    factor = _mass_factor(fe)
+    elastic = factor.shape[1] - fe.rigid_modes.shape[1]
+    if elastic <= 0:
+        return np.zeros((fe.n_dof, 0))
+    flexible = flexibility(factor)
+    condensed = factor.T @ flexible
+    theta, Z = la.eigh(0.5 * (condensed + condensed.T))
+    theta, Z = theta[::-1][:elastic], Z[:, ::-1][:, :elastic]
+    keep = theta > UNRESOLVED_STIFFNESS * max(theta[0], 0.0)
+    return (flexible @ Z[:, keep]) / theta[keep]
 
 
 def _lanczos_start(fe: FEModel, flexibility, block: int) -> np.ndarray:
@@ -779,11 +900,12 @@ def _lanczos_vectors(n_dof: int, block: int) -> int:
 
 
 def _massive_dofs(fe: FEModel) -> int:
-    """DOFs that carry mass, less the rigid-body modes: at most the rank of K⁺M. A
-    Krylov space of K⁺M cannot grow past it, so ARPACK asked for more vectors than
-    that stops ("could not build an Arnoldi factorization": random trees at 80
-    modes, 204 DOFs of which 198 carry mass, 201 vectors)."""
-    return int(np.count_nonzero(fe.M.diagonal())) - fe.rigid_modes.shape[1]
+    """DOFs that carry mass, less the rigid-body modes: at least the number of
+    elastic modes and the rank of K⁺M. A Krylov space of K⁺M cannot grow past
+    that rank, so ARPACK asked for more vectors than that stops ("could not build
+    an Arnoldi factorization": random trees at 80 modes, 204 DOFs of which 198
+    carry mass, 201 vectors)."""
+    return len(fe.massive) - fe.rigid_modes.shape[1]
 
 
 def _block_size(wanted: int) -> int:
@@ -803,7 +925,7 @@ def _lowest_modes(fe: FEModel, flexibility, wanted: int, sweeps: int = 8):
     error estimate). m is below the block size when the model has fewer
     elastic modes.
     """
-    block = min(_block_size(wanted), fe.n_dof - fe.rigid_modes.shape[1])
+    block = min(_block_size(wanted), _massive_dofs(fe))
     if block <= 0:
         X = np.zeros((fe.n_dof, 0))
     elif fe.n_dof <= DENSE_LIMIT or _lanczos_vectors(fe.n_dof, block) >= _massive_dofs(fe):
@@ -869,9 +991,12 @@ class FEResult:
     n_dof : reduced DOFs of that mesh. seconds : wall time of the whole solve.
     mode_shapes : (n_full, m) mass-normalised full vectors on that mesh (see
         :class:`DofIndex` for the layout), or None.
-    note : empty, or why some frequencies are less accurate than asked: the
+    note : empty, or, joined by "; ": the computed values not reported because
+        their estimated relative error is UNSETTLED (10 %) or more, with all
+        above them; the frequencies less accurate than asked where the
         refinement stopped at ``max_elements_per_beam`` with their estimated
-        error above ``rtol``.
+        error above ``rtol``; that a model without beams has fewer elastic
+        modes than asked for.
     """
 
     model: str
@@ -963,7 +1088,9 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
     mode_shapes : also return mass-normalised full mode vectors.
 
     Zero-frequency rigid-body modes are counted structurally (see the module
-    notes), not by a threshold on computed eigenvalues. ``fmax`` alone is checked
+    notes), not by a threshold on computed eigenvalues. No value whose estimated
+    relative error is UNSETTLED (10 %) or more is reported as a frequency, nor
+    any above it: the result stops before it and its note names them. ``fmax`` alone is checked
     as :func:`linmstmm.solve.natural_frequencies` checks it (ModelError).
     """
     started = perf_counter()
@@ -987,6 +1114,14 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
     refined = bool(model.beams) and elements_per_beam is None
     if refined:
         error_estimate = _with_dispersion(model, fe.elements_per_beam, frequencies_hz, error_estimate, rtol)
+    settled = _settled_count(error_estimate)
+    notes = [_unsettled(frequencies_hz[settled:], error_estimate[settled:])]
+    frequencies_hz, error_estimate, order = frequencies_hz[:settled], error_estimate[:settled], order[:settled]
+    if refined:
+        notes.append(_short_of_rtol(frequencies_hz, error_estimate, rtol, fe.elements_per_beam))
+    if not model.beams and fmax is None and len(lam) < count:
+        notes.append(f"only {len(lam)} elastic natural frequencies exist (directions with mass "
+                     f"less the {fe.rigid_modes.shape[1]} rigid-body modes)")
     return FEResult(model=model.name,
                     frequencies_hz=frequencies_hz,
                     rigid_body_modes=fe.rigid_modes.shape[1],
@@ -995,7 +1130,26 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
                     n_dof=fe.n_dof,
                     seconds=perf_counter() - started,
                     mode_shapes=(fe.T @ X[:, order]) if mode_shapes else None,
-                    note=_short_of_rtol(frequencies_hz, error_estimate, rtol, fe.elements_per_beam) if refined else "")
+                    note="; ".join(note for note in notes if note))
+
+
+def _settled_count(error_estimate) -> int:
+    """How many of the ascending frequencies are reported: those before the first
+    whose estimated relative error is UNSETTLED or more. The ones above it are not
+    reported either, since a list with a gap would misstate their ranks. A NaN
+    estimate (not asked for) does not stop the list."""
+    unsettled = np.flatnonzero(error_estimate >= UNSETTLED)
+    return int(unsettled[0]) if len(unsettled) else len(error_estimate)
+
+
+def _unsettled(frequencies_hz, error_estimate) -> str:
+    """The note naming frequencies left out of a result (empty if none is)."""
+    if not len(frequencies_hz):
+        return ""
+    listed = ", ".join(f"{f:.6g} Hz ({e:.1e})" for f, e in zip(frequencies_hz[:5], error_estimate[:5]))
+    more = f" and {len(frequencies_hz) - 5} more" if len(frequencies_hz) > 5 else ""
+    return (f"{len(frequencies_hz)} computed values not reported as frequencies, from the first whose "
+            f"estimated relative error is {UNSETTLED:.0%} or more: {listed}{more}")
 
 
 def _with_dispersion(model, elements_per_beam, frequencies_hz, error_estimate, rtol):

@@ -7,7 +7,8 @@ extrapolation unless ``--elements-per-beam`` fixes the mesh). ``--json``
 prints :meth:`linmstmm.fe.FEResult.to_dict`: the ``freqs`` keys ``model``,
 ``frequencies_hz``, ``rigid_body_modes``, ``seconds`` plus ``error_estimate``
 (relative, per frequency), ``elements_per_beam``, ``n_dof`` and
-``"method": "fe"``.
+``"method": "fe"`` and, when set, ``note``. The table prints the note once,
+after the frequencies.
 
 Errors follow the CLI contract: a bad model or option exits 2 (raised as
 ModelError / UsageError); a failed computation exits 1 (ComputationError).
@@ -62,6 +63,4 @@ def run_fe(args) -> int:
     print(f"  mesh: {mesh}, {result.n_dof} DOFs")
     if np.isfinite(result.error_estimate).any():
         print(f"  largest estimated relative error: {np.nanmax(result.error_estimate):.1e}")
-    if result.note:
-        print(f"  note: {result.note}")
     return 0

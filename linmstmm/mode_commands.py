@@ -1,25 +1,35 @@
 """Commands ``linmstmm modes``, ``scan``, ``response`` and ``frf``: figures and data out.
 
 * ``modes MODEL [--count N] [--fmax HZ] [--json] [--plot DIR] [--animate]
-  [--uff FILE] [--mac-fe]``: frequencies, modal masses and orthogonality
-  errors of the modes (shapes scaled to a largest translation of 1 m, so the
-  modal masses are comparable); one PNG per mode (and a GIF with
+  [--uff FILE] [--mac-fe] [--normalization mass|max]``: frequencies, modal
+  masses and orthogonality errors of the modes (shapes mass-normalised by
+  default, modal mass 1 kg; ``max``: largest translation 1 m, so the modal
+  masses are comparable); one PNG per mode (and a GIF with
   ``--animate``) in DIR; the shapes as a universal file (:mod:`linmstmm.uff`);
   the MAC matrix against the finite-element route's modes.
 * ``scan MODEL --fmax HZ [--points N] --plot FILE [--json]``: log|det Ū_all|
   over a frequency grid and the root count N(f) from the natural frequencies found.
-* ``response MODEL LOADS [--json] [--plot FILE] [--quantity Q]``: the modal
-  response to a load file (format: :mod:`linmstmm.response`) and its peaks.
+* ``response MODEL LOADS [--json] [--plot FILE] [--quantity Q] [--zeta Z]``:
+  the modal response to a load file (format: :mod:`linmstmm.response`), with
+  the static correction, and its peaks.
 * ``frf MODEL --point P --direction D --fmax HZ [--response-points P ...]
-  [--frequencies N] [--modes N] [--plot FILE] [--json]``: receptance between
-  a unit load at P along D and the response points.
+  [--frequencies N] [--modes N] [--zeta Z] [--plot FILE] [--json]``:
+  receptance between a unit load at P along D and the response points.
+
+``--zeta`` gives modal damping ratios: one for every elastic mode, or a comma
+list with one per elastic mode in the sum. They replace the model's
+``[damping]`` (Rayleigh α, β) for that run; the output names the damping used.
+Both commands refuse a model with a spring dashpot ``c`` (the modal route
+cannot honour it).
 
 Bad input raises :class:`linmstmm.model.ModelError` (exit status 2, one line);
 a file that cannot be written is a ModelError on the option that named it.
 """
 from __future__ import annotations
 
+import argparse
 import json
+import math
 from contextlib import contextmanager
 from pathlib import Path
 
@@ -27,7 +37,7 @@ import numpy as np
 
 from linmstmm.mode_bound import check_range_request
 from linmstmm.model import COMPONENTS, Model, ModelError, _did_you_mean, load_model
-from linmstmm.modes import ModalResult, mac_matrix, mode_shapes
+from linmstmm.modes import DEFAULT_NORMALIZATION, NORMALIZATIONS, ModalResult, mac_matrix, mode_shapes
 
 #: Frequencies in a scan and in an FRF sweep, by default.
 DEFAULT_SCAN_POINTS = 2000
@@ -57,6 +67,9 @@ def add_mode_commands(subparsers) -> None:
                        help="write the shapes as a universal file (datasets 15 and 55)")
     modes.add_argument("--mac-fe", action="store_true",
                        help="MAC matrix against the finite-element route's modes")
+    modes.add_argument("--normalization", choices=NORMALIZATIONS, default=DEFAULT_NORMALIZATION,
+                       help=f"mode scaling: mass = unit modal mass (1 kg), max = largest translation "
+                            f"1 m (default {DEFAULT_NORMALIZATION}, as in linmstmm.modes.mode_shapes)")
     modes.set_defaults(run=run_modes)
 
     scan = subparsers.add_parser("scan", help="plot log|det Ubar_all| and the root count over frequency")
@@ -75,6 +88,7 @@ def add_mode_commands(subparsers) -> None:
     response.add_argument("--quantity", choices=("displacement", "velocity", "acceleration"),
                           default="displacement", help="what --plot and the peak table show")
     response.add_argument("--json", action="store_true", help="one JSON object on stdout")
+    _add_zeta_option(response)
     response.set_defaults(run=run_response)
 
     sweep = subparsers.add_parser("frf", help="frequency response between a load point and response points")
@@ -91,7 +105,51 @@ def add_mode_commands(subparsers) -> None:
                        help=f"elastic modes in the sum (default: all up to {FRF_MODE_REACH:g} x fmax)")
     sweep.add_argument("--plot", metavar="FILE", default=None, help="magnitude and phase (PNG)")
     sweep.add_argument("--json", action="store_true", help="one JSON object on stdout")
+    _add_zeta_option(sweep)
     sweep.set_defaults(run=run_frf)
+
+
+def _add_zeta_option(parser) -> None:
+    parser.add_argument("--zeta", type=_damping_ratios, default=None, metavar="Z[,Z...]",
+                        help="modal damping ratios: one for all elastic modes or one per elastic mode "
+                             "(replaces the model's [damping])")
+
+
+def _damping_ratios(text: str) -> list[float]:
+    """``--zeta`` text "0.02" or "0.01,0.02,..." as a list of finite ratios >= 0."""
+    try:
+        ratios = [float(part) for part in text.split(",")]
+    except ValueError:
+        ratios = [math.nan]
+    if not all(math.isfinite(r) and r >= 0 for r in ratios):
+        raise argparse.ArgumentTypeError(f"must be damping ratios >= 0, one or a comma list, got {text}")
+    return ratios
+
+
+def _damping_in_use(model: Model, zeta) -> dict:
+    """{"damping": (α, β) or None, "damping_ratio": list or None}: what a run with ``--zeta`` uses."""
+    return {"damping": model.damping if zeta is None else None, "damping_ratio": zeta}
+
+
+def _damping_text(damping: dict) -> str:
+    """One phrase for the output of :func:`_damping_in_use`, e.g. "modal damping ratio 0.02"."""
+    if damping["damping_ratio"] is not None:
+        ratios = damping["damping_ratio"]
+        return f"modal damping ratio{'s' if len(ratios) > 1 else ''} {', '.join(f'{r:g}' for r in ratios)}"
+    if damping["damping"] is not None:
+        return "Rayleigh damping alpha, beta = {:g} 1/s, {:g} s".format(*damping["damping"])
+    return "undamped"
+
+
+@contextmanager
+def _zeta_option(model: Model):
+    """Turn a DampingRatioError (ratios that do not fit the modes) into a ModelError on ``--zeta``."""
+    from linmstmm.response import DampingRatioError
+
+    try:
+        yield
+    except DampingRatioError as error:
+        raise ModelError(model.source or model.name, str(error), key="--zeta") from error
 
 
 # --- modes --------------------------------------------------------------------------
@@ -104,7 +162,7 @@ def run_modes(args) -> int:
     if args.animate and args.plot is None:
         raise ModelError(args.model, "--animate needs --plot DIR", key="--animate")
     count, fmax = _request(args)
-    result = _mode_shapes(model, count, fmax, normalization="max")
+    result = _mode_shapes(model, count, fmax, normalization=args.normalization)
     files = _mode_figures(result, model, args.plot, args.animate) if args.plot else []
     if args.uff:
         from linmstmm.uff import write_uff
@@ -149,7 +207,8 @@ def modes_summary(result: ModalResult, model: Model) -> dict:
 
 
 def _print_modes(data: dict) -> None:
-    print(f"{data['model']}: modes (MSTMM), shapes scaled to a largest translation of 1 m")
+    scaling = {"mass": "mass-normalised (modal mass 1 kg)", "max": "scaled to a largest translation of 1 m"}
+    print(f"{data['model']}: modes (MSTMM), shapes {scaling[data['normalization']]}")
     print(f"  {'mode':>4}  {'f [Hz]':>16}  {'modal mass [kg]':>16}  {'modal stiffness [N/m]':>22}")
     for n, (f, m, k) in enumerate(zip(data["natural_freq_hz"], data["modal_mass"], data["modal_stiffness"]),
                                   start=1):
@@ -293,7 +352,9 @@ def run_response(args) -> int:
 
     model = load_model(args.model)
     case = load_loads(args.loads, model)
-    result = respond(model, case)
+    with _zeta_option(model):
+        result = respond(model, case, damping_ratio=args.zeta)
+    damping = _damping_in_use(model, args.zeta)
     peaks, times = peak_responses(result, args.quantity)
     if args.plot:
         from linmstmm.plot import plot_response
@@ -301,17 +362,24 @@ def run_response(args) -> int:
         with _writing(model, "--plot", args.plot):
             plot_response(result, args.plot, args.quantity, title=f"{model.name}: {Path(args.loads).name}")
     if args.json:
-        print(json.dumps({"model": model.name, "modes": case.modes, "damping": model.damping,
-                          **result.to_dict(), "quantity": args.quantity,
+        print(json.dumps({"model": model.name, "modes": result.elastic_modes, "modes_asked": case.modes,
+                          **damping, **result.to_dict(), "quantity": args.quantity,
                           "peaks": {p: peaks[i].tolist() for i, p in enumerate(result.points)},
                           "peak_times": {p: times[i].tolist() for i, p in enumerate(result.points)}}))
     else:
-        print(f"{model.name}: response to {args.loads} ({case.modes} elastic modes, "
-              f"{'damping alpha, beta = ' + str(model.damping) if model.damping else 'undamped'})")
+        print(f"{model.name}: response to {args.loads} ({_modes_used_text(result.elastic_modes, case.modes)}, "
+              f"{_damping_text(damping)}, {'with' if result.static_correction else 'no'} static correction)")
+        if result.note:
+            print(f"  note: {result.note}")
         print_peaks(result.points, peaks, times, args.quantity)
         if args.plot:
             print(f"  wrote {args.plot}")
     return 0
+
+
+def _modes_used_text(used: int, asked: int) -> str:
+    """"6 elastic modes" and, when fewer than asked exist, "(20 asked: the model has no more)"."""
+    return f"{used} elastic modes" + (f" ({asked} asked: the model has no more)" if used < asked else "")
 
 
 def peak_responses(result, quantity: str = "displacement"):
@@ -325,9 +393,13 @@ def peak_responses(result, quantity: str = "displacement"):
 
 
 def print_peaks(points, peaks, times, quantity: str = "displacement") -> None:
-    """Print the peak table of :func:`peak_responses` (SI units; time of the peak in brackets)."""
-    print(f"  peak |{quantity}| (translations m, rotations rad; at time s):")
-    print(f"  {'point':<20}" + "".join(f"{name:>22}" for name in COMPONENTS))
+    """Print the peak table of :func:`peak_responses`: each column's SI unit in its
+    header, the time of the peak (s) in brackets."""
+    from linmstmm.response import quantity_units
+
+    print(f"  peak |{quantity}| (at time [s]):")
+    print(f"  {'point':<20}" + "".join(f"{f'{name} [{unit}]':>22}"
+                                       for name, unit in zip(COMPONENTS, quantity_units(quantity))))
     for point, row, at in zip(points, peaks, times):
         print(f"  {point:<20}" + "".join(f"{value:>12.4g} ({t:6.3f})" for value, t in zip(row, at)))
 
@@ -336,22 +408,27 @@ def print_peaks(points, peaks, times, quantity: str = "displacement") -> None:
 
 def frf_study(model: Model, point: str, direction: str, fmax: float, *,
               frequencies: int = DEFAULT_FRF_FREQUENCIES, response_points=None,
-              modes: int | None = None, plot=None):
+              modes: int | None = None, damping_ratio=None, plot=None):
     """Receptance to a unit load at ``point`` along ``direction``, and its figure.
 
     direction : one of COMPONENTS (a force along x, y, z or a moment about them).
     fmax : top of the sweep, Hz; the sweep has ``frequencies`` equal steps from
     fmax / frequencies. response_points : default the load point. modes :
-    elastic modes in the sum (default: all up to FRF_MODE_REACH × fmax). The
-    model's damping is used (undamped without it). plot : PNG to write, or None.
+    elastic modes in the sum (default: all up to FRF_MODE_REACH × fmax).
+    damping_ratio : modal damping ratios (one, or one per elastic mode in the
+    sum); given, they replace the model's damping; without them the model's
+    Rayleigh damping is used (undamped without it). plot : PNG to write, or None.
 
     Returns (FRFResult, summary): summary is JSON-ready (model, load, fmax_hz,
-    damping, modes_in_sum, natural_freq_hz up to fmax, load_unit). Raises
-    ModelError for unknown points (keys ``--point``, ``--response-points``)
-    or a figure that cannot be written (``--plot``).
+    damping, damping_ratio, modes_in_sum, natural_freq_hz up to fmax,
+    load_unit, receptance_units per component). Raises ModelError for
+    unknown points (keys ``--point``, ``--response-points``), ratios that do
+    not fit the modes (``--zeta``), a spring with a dashpot (key ``c``) or a
+    figure that cannot be written (``--plot``).
     """
-    from linmstmm.response import frf
+    from linmstmm.response import frf, refuse_dashpots
 
+    refuse_dashpots(model, "FRF")
     targets = [point] if response_points is None else list(response_points)
     _check_points(model, "--point", [point])
     _check_points(model, "--response-points", targets)
@@ -363,12 +440,16 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
                             f"up to {FRF_MODE_REACH:g} x fmax)", "ask for a lower fmax, or for N modes by --modes")
     shapes = _mode_shapes(model, modes, None if modes else FRF_MODE_REACH * fmax)
     sweep = fmax * np.arange(1, frequencies + 1) / frequencies
-    result = frf(shapes, point, np.eye(6)[COMPONENTS.index(direction)], sweep, targets, model.damping)
+    damping = _damping_in_use(model, damping_ratio)
+    with _zeta_option(model):
+        result = frf(shapes, point, np.eye(6)[COMPONENTS.index(direction)], sweep, targets,
+                     damping["damping"], damping_ratio=damping_ratio)
     elastic = shapes.omega > 0
+    load_unit = "N m" if direction.startswith("r") else "N"
     summary = {"model": model.name, "load": {"point": point, "direction": direction}, "fmax_hz": fmax,
-               "damping": model.damping, "modes_in_sum": int(elastic.sum()),
+               **damping, "modes_in_sum": int(elastic.sum()),
                "natural_freq_hz": shapes.natural_freq[elastic & (shapes.natural_freq <= fmax)].tolist(),
-               "load_unit": "N m" if direction.startswith("r") else "N"}
+               "load_unit": load_unit, "receptance_units": receptance_units(load_unit)}
     if plot:
         from linmstmm.plot import plot_frf
 
@@ -377,6 +458,12 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
             plot_frf(result, plot, summary["natural_freq_hz"], summary["load_unit"],
                      title=f"{model.name}: unit {kind} {direction} at {point}")
     return result, summary
+
+
+def receptance_units(load_unit: str) -> list[str]:
+    """The six component units (x, y, z, rx, ry, rz) of a receptance per ``load_unit`` ("N" or "N m")."""
+    per = load_unit if load_unit == "N" else f"({load_unit})"
+    return [f"m/{per}"] * 3 + [f"rad/{per}"] * 3
 
 
 def _check_points(model: Model, key: str, names) -> None:
@@ -391,25 +478,27 @@ def print_frf(result, summary: dict) -> None:
     from linmstmm.plot import significant_components
 
     load = summary["load"]
-    damping = (f"damping alpha, beta = {summary['damping']}" if summary["damping"]
-               else "undamped (no [damping]: unbounded at the natural frequencies)")
+    damping = _damping_text(summary)
+    if damping == "undamped":
+        damping += " (unbounded at the natural frequencies)"
     print(f"{summary['model']}: receptance to a unit load {load['direction']} at {load['point']} "
           f"[per {summary['load_unit']}], 0-{summary['fmax_hz']:g} Hz, "
           f"{summary['modes_in_sum']} elastic modes in the sum, {damping}")
     print(f"  natural frequencies [Hz]: {', '.join(f'{f:.6g}' for f in summary['natural_freq_hz']) or 'none'}")
     magnitude = np.abs(result.receptance)
-    print(f"  {'point':<20}{'component':>10}{'largest |H|':>14}{'at [Hz]':>12}")
+    print(f"  {'point':<20}{'component':>10}{'largest |H|':>14}{'unit':>12}{'at [Hz]':>12}")
     for p, c in significant_components(result.receptance):
         peak = magnitude[:, p, c].argmax()
         print(f"  {result.points[p]:<20}{COMPONENTS[c]:>10}{magnitude[peak, p, c]:>14.4g}"
-              f"{result.frequencies_hz[peak]:>12.5g}")
+              f"{summary['receptance_units'][c]:>12}{result.frequencies_hz[peak]:>12.5g}")
 
 
 def run_frf(args) -> int:
     """Run ``linmstmm frf``; returns the exit status 0."""
     model = load_model(args.model)
     result, summary = frf_study(model, args.point, args.direction, args.fmax, frequencies=args.frequencies,
-                                response_points=args.response_points, modes=args.modes, plot=args.plot)
+                                response_points=args.response_points, modes=args.modes,
+                                damping_ratio=args.zeta, plot=args.plot)
     if args.json:
         print(json.dumps({**summary, **result.to_dict()}))
     else:

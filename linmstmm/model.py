@@ -1,8 +1,29 @@
 """The model contract: immutable element records and the TOML loader.
 
-A model file (``shared/spec/model-format.md``) is read with :mod:`tomllib`,
-validated completely, and only then turned into the records below. Nothing
-downstream re-validates: a :class:`Model` is always well formed.
+A model file is read with :mod:`tomllib`, validated completely, and only then
+turned into the records below; a :class:`Model` built in code runs the same
+checks on construction. Nothing downstream re-validates: a :class:`Model` is
+always well formed. Examples: ``models/*.toml``; the full reference is
+docs/model-format.md. The keys of a file, in brief:
+
+* top level: ``name`` (non-empty string), ``description`` (optional string);
+* ``[points]``: ``point = [x, y, z]``, m; every point is used by an element;
+* ``[[rigid]]``: ``name``, ``ports`` (point names), ``mass`` kg, ``com``
+  [x, y, z] m, ``inertia`` kg m^2 about the mass centre, inertial axes:
+  [Ixx, Iyy, Izz] or a symmetric 3x3 array whose principal moments keep the
+  triangle inequality of a real body;
+* ``[[beam]]``: ``name``, ``ends`` (two points), ``E``, ``G`` Pa, ``rho``
+  kg/m^3 (0 = massless), ``A`` m^2, ``Iy``, ``Iz``, ``J`` m^4; optional ``Ip``
+  m^4 (default Iy + Iz), ``y_axis`` [x, y, z] (the section's local y,
+  projected normal to the beam; default e_Z x local x, e_Y for a vertical
+  beam), ``axial`` and ``torsion`` (false = rigid in that deformation);
+* ``[[spring]]``: ``name``, ``ends`` (two coinciding points), ``k`` (6
+  stiffnesses, N/m and N m/rad, ``inf`` = rigid); optional ``axes`` (3x3,
+  rows = local x, y, z) and ``c`` (6 dashpots, N s/m and N m s/rad);
+* ``[boundary]``: ``point = "free" | "fixed" | "pinned"`` or a list drawn
+  from x, y, z, rx, ry, rz (the fixed components);
+* ``[damping]``: ``alpha`` 1/s, ``beta`` s of C = alpha M + beta K (each
+  optional, default 0).
 
 Units are SI throughout (m, kg, s, N, rad).
 """
@@ -137,6 +158,15 @@ class Model:
     description: str = ""
     source: str | None = None
 
+    def __post_init__(self):
+        """Run the loader's checks on these records (a Model built in code included).
+
+        Raises :class:`ModelError` naming ``source`` (or ``model 'name'`` for a
+        model built in code), the element and the key, exactly as
+        :func:`load_model` does for the same breach in a file.
+        """
+        _check_records(self)
+
     @property
     def elements(self):
         """All elements: rigid bodies, then beams, then springs, each in file order."""
@@ -158,7 +188,8 @@ def load_model(path) -> Model:
     """Read, validate and build the model in the TOML file ``path``.
 
     Raises :class:`ModelError` (one line: file, element, key) on any breach
-    of the contract; nothing is built before validation is complete.
+    of the contract; no record is built before the file is validated, and the
+    :class:`Model` checks its records again on construction (the same checks).
     """
     file = str(path)
     fields = _validate(_read_toml(path, file), file)
@@ -182,6 +213,8 @@ _ABS_TOL = 1e-12
 _ORTHO_TOL = 1e-9
 #: Inertia eigenvalues must be >= -_PSD_TOL * max |I_ij|.
 _PSD_TOL = 1e-12
+#: Principal moments must keep I3 <= I1 + I2 within this fraction of the trace.
+_TRIANGLE_TOL = 1e-9
 #: A direction whose part normal to the beam axis is this small (relative) is parallel.
 _PARALLEL_TOL = 1e-9
 
@@ -207,6 +240,9 @@ def _read_toml(path, file):
         if str(error).startswith("Cannot overwrite a value"):
             hint = " (a key given twice, e.g. a duplicate point name)"
         raise ModelError(file, f"invalid TOML: {error}{hint}") from error
+    except RecursionError as error:
+        raise ModelError(file, "invalid TOML: arrays or tables nested too deeply "
+                               "for the TOML reader") from error
 
 
 def _describe(value):
@@ -362,6 +398,9 @@ def _validate(data, file):
     boundary = _check_boundary(top.section("boundary"), points)
     damping = _check_damping(top.section("damping")) if "damping" in top else None
 
+    if not any(elements.values()):
+        raise ModelError(file, "model has no elements: give at least one [[rigid]], "
+                               "[[beam]] or [[spring]]")
     used = {p for f in elements["rigid"] for p in f["ports"]}
     used |= {p for kind in ("beam", "spring") for f in elements[kind] for p in f["ends"]}
     for point in points:
@@ -407,10 +446,11 @@ def _check_rigid(t, points, tol):
 
 
 def _check_inertia(t):
-    """(3, 3) inertia tensor from [Ixx, Iyy, Izz] or a symmetric PSD 3x3 array."""
+    """(3, 3) inertia tensor from [Ixx, Iyy, Izz] or a symmetric 3x3 array, kg m^2,
+    whose principal moments are those of a real body."""
     value = t.table["inertia"]
     if isinstance(value, list) and len(value) == 3 and not any(isinstance(v, list) for v in value):
-        return np.diag(t.vector("inertia", 3, ">= 0"))
+        return _check_principal_moments(t, np.diag(t.vector("inertia", 3, ">= 0")))
     tensor = t.matrix("inertia", "[Ixx, Iyy, Izz] or a 3x3 array of arrays")
     scale = np.abs(tensor).max()
     asymmetry = np.abs(tensor - tensor.T)
@@ -423,6 +463,17 @@ def _check_inertia(t):
     if lowest < -_PSD_TOL * scale:
         raise t.error("inertia", f"tensor is not positive semidefinite "
                                  f"(smallest eigenvalue {lowest:g})")
+    return _check_principal_moments(t, tensor)
+
+
+def _check_principal_moments(t, tensor):
+    """``tensor`` if its principal moments I1 <= I2 <= I3 keep I3 <= I1 + I2 (every
+    real body does: equality for a flat plate); the tolerance is relative to the trace."""
+    low, middle, high = np.linalg.eigvalsh(tensor)
+    if high - (low + middle) > _TRIANGLE_TOL * (low + middle + high):
+        raise t.error("inertia", f"principal moments {low:g}, {middle:g}, {high:g} kg m^2 break "
+                                 f"the triangle inequality ({high:g} > {low:g} + {middle:g}): "
+                                 f"no real body has them")
     return tensor
 
 
@@ -528,6 +579,105 @@ def _check_damping(t):
     """(alpha, beta), each >= 0, missing ones 0."""
     t.check_keys((), ("alpha", "beta"))
     return (t.number("alpha", ">= 0", default=0.0), t.number("beta", ">= 0", default=0.0))
+
+
+# --- records built in code ---------------------------------------------------
+
+#: Model attribute -> (element kind in the file, record class).
+_RECORD_KINDS = {"rigids": ("rigid", Rigid), "beams": ("beam", Beam), "springs": ("spring", Spring)}
+
+
+def _check_records(model):
+    """Validate ``model`` by the loader's checks on its records written in the file's form.
+
+    A beam's ``length`` and ``axes`` are not keys of the file (the loader derives
+    them from the ends and ``y_axis``): they must agree with what it would derive.
+    """
+    file = model.source if isinstance(model.source, str) else f"model {model.name!r}"
+    fields = _validate(_document(model, file), file)
+    tol = _length_tol(fields["points"])
+    for beam, derived in zip(model.beams, fields["beams"]):
+        _check_beam_frame(_Table(file, {}, f"beam {beam.name!r}"), beam, derived, tol)
+
+
+def _document(model, file):
+    """The model as the parsed TOML document that would load to it (plain Python values)."""
+    document = {"name": model.name, "description": model.description, "points": model.points,
+                "boundary": _boundary_table(model.boundary, file)}
+    for attribute, (kind, cls) in _RECORD_KINDS.items():
+        records = getattr(model, attribute)
+        for i, record in enumerate(records):
+            if not isinstance(record, cls):
+                raise ModelError(file, f"{attribute}[{i}] must be a {cls.__name__} record, "
+                                       f"got {type(record).__name__}")
+        document[kind] = [_record_table(record, file) for record in records]
+    if model.damping is not None:
+        if np.shape(model.damping) != (2,):
+            raise ModelError(file, f"must be None or (alpha, beta), got {model.damping!r}",
+                             key="damping")
+        document["damping"] = dict(zip(("alpha", "beta"), model.damping))
+    return _plain(document)
+
+
+def _record_table(record, file):
+    """An element record as its table in the file: a beam's ``axes`` become ``y_axis``;
+    a rigid body's inertia must be the (3, 3) tensor (the file's [Ixx, Iyy, Izz] is not)."""
+    table = {f: getattr(record, f) for f in record.__dataclass_fields__ if f != "kind"}
+    if isinstance(record, Rigid) and np.ndim(record.inertia) != 2:
+        raise ModelError(file, f"must be a (3, 3) tensor, got shape {np.shape(record.inertia)}",
+                         element=f"rigid {record.name!r}", key="inertia")
+    if isinstance(record, Spring) and record.c is None:
+        del table["c"]
+    if isinstance(record, Beam):
+        del table["length"]
+        axes = table.pop("axes")
+        if np.shape(axes) == (3, 3):
+            table["y_axis"] = np.asarray(axes)[1]
+    return table
+
+
+def _boundary_table(boundary, file):
+    """``[boundary]`` as lists of fixed components from (6,) bool masks."""
+    if not isinstance(boundary, dict):
+        return boundary
+    table = {}
+    for point, mask in boundary.items():
+        mask = np.asarray(mask)
+        if mask.shape != (6,) or mask.dtype != bool:
+            raise ModelError(file, f"must be a (6,) bool mask of fixed components "
+                                   f"({', '.join(COMPONENTS)})", element="[boundary]", key=point)
+        table[point] = [c for c, fixed in zip(COMPONENTS, mask) if fixed]
+    return table
+
+
+def _plain(value):
+    """``value`` with arrays, tuples and numpy scalars turned into lists and Python scalars."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        return value.item()
+    return value
+
+
+def _check_beam_frame(t, beam, derived, tol):
+    """A beam record's ``length`` and ``axes`` are those derived from its ends and y axis."""
+    if not _deviation(beam.length, derived["length"]) <= tol:
+        raise t.error("length", f"must be the distance between the ends, "
+                                f"{derived['length']:g} m, got {beam.length!r}")
+    if not _deviation(beam.axes, derived["axes"]) <= _ORTHO_TOL:
+        raise t.error("axes", "rows must be the beam's local x (from ends[0] to ends[1]), "
+                              "y and z unit vectors, a right-handed frame")
+
+
+def _deviation(value, expected):
+    """max |value - expected| (inf if ``value`` is not numbers of the same shape; nan stays nan)."""
+    try:
+        value = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return math.inf
+    return np.abs(value - expected).max() if value.shape == np.shape(expected) else math.inf
 
 
 # --- building ---------------------------------------------------------------

@@ -1,4 +1,4 @@
-"""Mode shapes, augmented eigenvectors and their orthogonality (seed 002 §3.4).
+"""Mode shapes, augmented eigenvectors and their orthogonality (docs/method.md).
 
 At a natural frequency ω the null space of Ū_all(ω) holds the boundary
 unknowns z̄ of the modes (a whole basis for a repeated frequency). The element
@@ -42,6 +42,8 @@ from linmstmm.threads import single_blas_thread
 
 #: Normalisations of the modes: unit modal mass, or unit largest translation.
 NORMALIZATIONS = ("mass", "max")
+#: The one default, of :func:`mode_shapes` and of ``linmstmm modes``: unit modal mass.
+DEFAULT_NORMALIZATION = "mass"
 #: Frequencies closer than this (relative) are one repeated frequency.
 SAME_FREQUENCY = 1e-9
 #: Roots asked for beyond ``count``, so that an eigenspace cut by the count is completed.
@@ -181,7 +183,7 @@ def mac_matrix(a, b) -> np.ndarray:
 
 @single_blas_thread
 def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = None,
-                stations: int = 21, normalization: str = "mass", rigid_body: bool = True,
+                stations: int = 21, normalization: str = DEFAULT_NORMALIZATION, rigid_body: bool = True,
                 root: str | None = None) -> ModalResult:
     """Natural modes of ``model`` by the transfer matrix method.
 
@@ -189,9 +191,10 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         whichever stops first). A repeated frequency always comes with its whole
         eigenspace, so one more mode than ``count`` may come back.
     stations : number of equally spaced stations (ends included) of each beam field.
-    normalization : "mass" (M_k = 1) or "max" (largest translation 1 m; a mode
-        without translation: largest rotation 1 rad). The largest component is
-        made positive either way.
+    normalization : "mass" (the default, also of ``linmstmm modes``: M_k = 1 kg,
+        amplitudes in m/√kg and rad/√kg) or "max" (largest translation 1 m; a
+        mode without translation: largest rotation 1 rad). The largest
+        component is made positive either way.
     rigid_body : include the zero-frequency modes first.
     root : boundary end to use as the root of the transfer tree.
     ``fmax`` alone is checked as :func:`linmstmm.solve.natural_frequencies` checks it.

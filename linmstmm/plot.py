@@ -30,6 +30,7 @@ from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
 from linmstmm.model import COMPONENTS, Model
 from linmstmm.modes import ModalResult
+from linmstmm.response import QUANTITY_UNITS
 
 #: Largest drawn modal translation, as a fraction of the model's size.
 AMPLITUDE = 0.1
@@ -51,8 +52,6 @@ _WIDTHS = {"beam": 3.0, "rigid": 2.5, "spring": 0.8}
 _DPI = 130
 _AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")
 _SIGN_COLORS = {1.0: "tab:red", -1.0: "tab:blue"}
-_QUANTITY_UNITS = {"displacement": ("m", "rad"), "velocity": ("m/s", "rad/s"),
-                   "acceleration": ("m/s²", "rad/s²")}
 
 
 def _canvas(figsize, rows=1, columns=1, **options):
@@ -272,13 +271,13 @@ def plot_response(result, path, quantity: str = "displacement", title: str = "")
     One row per response point: translations x, y, z on the left, rotations
     on the right. quantity : "displacement", "velocity" or "acceleration".
     """
-    if quantity not in _QUANTITY_UNITS:
-        raise ValueError(f"quantity must be one of {tuple(_QUANTITY_UNITS)}, got {quantity!r}")
+    if quantity not in QUANTITY_UNITS:
+        raise ValueError(f"quantity must be one of {tuple(QUANTITY_UNITS)}, got {quantity!r}")
     values = getattr(result, quantity)
     rows = len(result.points)
     figure, axes = _canvas((9.0, 1.2 + 1.9 * rows), rows, 2, sharex=True)
     for row, point in enumerate(result.points):
-        for column, (unit, first) in enumerate(zip(_QUANTITY_UNITS[quantity], (0, 3))):
+        for column, (unit, first) in enumerate(zip(QUANTITY_UNITS[quantity], (0, 3))):
             axis = axes[row, column]
             for c in range(3):
                 axis.plot(result.times, values[:, row, first + c], color=_AXIS_COLORS[c],

@@ -1,4 +1,5 @@
-"""The topology figure of a model, in the convention of ``seeds/001`` §11.2.
+"""The topology figure of a model, in the convention of the topology
+figures of Rui, Wang and Zhang's book (2018), §11.2 (``docs/method.md``).
 
 * a body is a circle with its name: rigid bodies white, beams light blue
   (a beam is a body element here, drawn as a circle too), junctions (the
@@ -15,7 +16,7 @@
 * the inputs of a multi-input body are labelled ``I1``, ``I2``, … next to it.
 
 Layout: layers by depth from the root (root on the right, tips to the left,
-so transfer runs left to right as in the seed's figures); the tips of the
+so transfer runs left to right as in the book's figures); the tips of the
 transfer tree are stacked in depth-first order and every element sits at the
 mean height of its inputs. The figure is drawn with the Agg backend into a
 PNG file; no window is opened.

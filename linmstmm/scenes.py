@@ -1,4 +1,4 @@
-"""Firing scenes of the MLRS-style launcher (seed 003, ``models/mlrs/``).
+"""Firing scenes of the MLRS-style launcher (``models/mlrs/``, ``docs/model-format.md``).
 
 "Model only what a scene requires": in the scene of tube l (l = 1 … 18, its
 slot in the 3 × 6 bundle) only that tube is flexible — two Euler beams on a

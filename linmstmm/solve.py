@@ -55,7 +55,7 @@ class FrequencyResult:
     evaluations: int = 0
 
     def to_dict(self) -> dict:
-        """The ``linmstmm freqs --json`` object (``shared/spec/cli.md``)."""
+        """The ``linmstmm freqs --json`` object (``docs/cli.md``)."""
         return {
             "model": self.model,
             "frequencies_hz": [float(f) for f in self.frequencies_hz],

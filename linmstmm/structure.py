@@ -4,7 +4,8 @@
 :class:`StructureReport`: the root, the tips, the junctions, the multi-input
 bodies with their inputs, the loop cuts, the order of Ū_all, and the block
 layout of U_all as the automatic deduction theorem writes it
-(``seeds/001`` §11.4–11.6, ``seeds/003``), so an engineer can compare the
+(Rui, Wang and Zhang's book, 2018, §11.4–11.6, and the
+multiple launch rocket system study; ``docs/method.md``), so an engineer can compare the
 deduction with a derivation by hand.
 
 Block layout of ``U_all Z_all = 0``:
@@ -399,9 +400,11 @@ def run_check(args) -> int:
     if args.plot is not None:
         _write_figure(topology, model, args.plot)
     if args.json:
-        print(json.dumps({"model": model.name, **report.to_dict()}))
+        print(json.dumps({"model": model.name, "description": model.description, **report.to_dict()}))
     else:
         print(f"{model.name}: deduced transfer structure")
+        if model.description:
+            print(f"  {model.description}")
         print(report.to_text())
     return 0
 

@@ -41,7 +41,7 @@ def main(argv=None) -> None:
     result = respond(model, case)
     seconds = time.perf_counter() - start
     plot_response(result, args.plot, args.quantity, title=f"{model.name}: firing ({Path(args.loads).name})")
-    print(f"{model.name}: {len(case.loads)} loads, {case.modes} elastic modes, "
+    print(f"{model.name}: {len(case.loads)} loads, {result.elastic_modes} elastic modes, "
           f"{result.times.size} time steps to {result.times[-1]:g} s, solved in {seconds:.2f} s")
     print_peaks(result.points, *peak_responses(result, args.quantity), args.quantity)
     print(f"wrote {args.plot}")

@@ -389,7 +389,7 @@ def _toml_value(value) -> str:
 
 
 def to_toml(model: Model) -> str:
-    """The model as a model file (shared/spec/model-format.md)."""
+    """The model as a model file (docs/model-format.md)."""
     lines = [f"name = {_toml_value(model.name)}", "", "[points]"]
     lines += [f"{p} = {_toml_value(x)}" for p, x in model.points.items()]
     for r in model.rigids:

@@ -1,4 +1,4 @@
-"""The ``linmstmm`` command line against its contract (shared/spec/cli.md)."""
+"""The ``linmstmm`` command line against its contract (docs/cli.md)."""
 from __future__ import annotations
 
 import json
@@ -29,7 +29,8 @@ def test_freqs_json_follows_the_contract():
     np.testing.assert_allclose(data["frequencies_hz"], expected, rtol=1e-12)
 
 
-@pytest.mark.parametrize("command, key", [("freqs", "frequencies_hz"), ("modes", "natural_freq_hz")])
+@pytest.mark.parametrize("command, key", [("freqs", "frequencies_hz"), ("modes", "natural_freq_hz"),
+                                          ("fe", "frequencies_hz")])
 def test_fewer_modes_than_asked_for_are_noted(command, key):
     """6 degrees of freedom, 10 asked: the table and the JSON both carry the note."""
     table = run(command, "models/spring_mass_chain.toml", "--count", "10")
@@ -95,3 +96,88 @@ def test_requests_without_end_exit_2_naming_the_option(args, says):
     result = run(command, "models/cantilever_tip_mass.toml", *options)
     assert result.returncode == 2 and result.stdout == ""
     assert result.stderr.count("\n") == 1 and says in result.stderr
+
+
+#: A free 3.5 kg body and a spring whose far end carries no mass: six rigid-body
+#: modes and no elastic one.
+BODY_WITH_A_DANGLING_SPRING = """
+name = "body with a dangling spring"
+[points]
+port = [0.2, 0.1, 0.0]
+loose = [0.2, 0.1, 0.0]
+[[rigid]]
+name = "body"
+ports = ["port"]
+mass = 3.5
+com = [0.0, 0.0, 0.0]
+inertia = [0.1, 0.2, 0.3]
+[[spring]]
+name = "dangling"
+ends = ["port", "loose"]
+k = [1000.0, 2000.0, 3000.0, 10.0, 20.0, 30.0]
+"""
+
+
+def test_fe_finds_no_elastic_mode_where_none_exists(tmp_path):
+    """``fe`` JSON and table agree with ``freqs``: exit 0, six rigid-body modes, no
+    frequency (no mode row in the table), and a note that none exists."""
+    path = tmp_path / "dangling.toml"
+    path.write_text(BODY_WITH_A_DANGLING_SPRING)
+    fe = run("fe", str(path), "--json")
+    mstmm = run("freqs", str(path), "--json")
+    assert fe.returncode == 0 == mstmm.returncode, fe.stderr + mstmm.stderr
+    data, reference = json.loads(fe.stdout), json.loads(mstmm.stdout)
+    assert data["frequencies_hz"] == reference["frequencies_hz"] == [] and data["error_estimate"] == []
+    assert data["rigid_body_modes"] == reference["rigid_body_modes"] == 6
+    assert data["note"].startswith("only 0 elastic natural frequencies exist")
+    table = run("fe", str(path))
+    assert table.returncode == 0, table.stderr
+    lines = table.stdout.splitlines()
+    assert "  rigid-body modes: 6" in lines and table.stdout.count("note: only 0 elastic") == 1
+    header = next(i for i, line in enumerate(lines) if line.split()[:2] == ["mode", "f"])
+    assert lines[header + 1].lstrip().startswith("solve time")
+
+
+def test_version_is_the_package_version():
+    import tomllib
+
+    import linmstmm
+
+    result = run("--version")
+    assert result.returncode == 0, result.stderr
+    declared = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    assert result.stdout.strip() == f"linmstmm {linmstmm.__version__}" == f"linmstmm {declared}"
+
+
+def _commands():
+    """The names of the registered subcommands."""
+    from linmstmm.cli import build_parser
+
+    parser = build_parser()
+    (sub,) = [action for action in parser._actions if action.dest == "command"]
+    return list(sub.choices)
+
+
+@pytest.mark.parametrize("args", [(), ("-h",), ("--help",)])
+def test_bare_and_help_list_every_command_with_an_example(args):
+    from linmstmm.cli import COMMAND_EXAMPLES
+
+    result = run(*args)
+    assert result.returncode == 0, result.stderr
+    assert sorted(COMMAND_EXAMPLES) == sorted(_commands())
+    for name, example in COMMAND_EXAMPLES.items():
+        assert f"  {name} " in result.stdout and example in result.stdout, name
+
+
+def test_help_examples_are_valid_invocations():
+    """Each example parses (its command, options and bundled files exist)."""
+    from linmstmm.cli import COMMAND_EXAMPLES, build_parser
+
+    for name, example in COMMAND_EXAMPLES.items():
+        words = example.split()
+        assert words[:2] == ["linmstmm", name]
+        args = build_parser().parse_args(words[1:])
+        assert args.command == name
+        for value in vars(args).values():
+            if isinstance(value, str) and value.startswith("models/"):
+                assert (ROOT / value).is_file(), value

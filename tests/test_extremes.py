@@ -262,7 +262,7 @@ def test_near_zero_elastic_modes_next_to_rigid_body_modes():
     ω² = k_r (1/J1_i + 1/J2_i). Six rigid-body modes at zero.
     """
     m1, m2, k, kr = 2.0, 3.0, 1e-4, 2e-4
-    J1, J2 = np.array([1.0, 2.0, 3.0]), np.array([1.5, 2.5, 0.5])
+    J1, J2 = np.array([1.0, 2.0, 3.0]), np.array([1.5, 2.5, 3.5])  # real bodies: J3 <= J1 + J2
     points = {"p": np.zeros(3), "q": np.zeros(3)}
     model = Model("soft pair", points,
                   rigids=(make_rigid("one", ["p"], m1, [0, 0, 0], J1),

@@ -1,7 +1,8 @@
 """The MLRS-style launcher (models/mlrs/) and its firing scenes (linmstmm.scenes).
 
-Seed 003: eight boundary ends and one closed loop give Ū_all of order 60, and
-the first six natural frequencies lie in 2-6 Hz. A scene only changes how the
+As in the published MLRS study (docs/method.md): eight boundary ends and one
+closed loop give Ū_all of order 60, and the first six natural frequencies lie
+in 2-6 Hz. A scene only changes how the
 same launcher is modelled (which tube is flexible), so the whole launcher's
 mass, mass centre and inertia must not change from scene to scene.
 """
@@ -43,7 +44,7 @@ def whole(model):
     return sum(parts[1:], parts[0])
 
 
-def test_topology_is_the_seeds(model):
+def test_topology_is_the_studys(model):
     topology = build_topology(model)
     labels = sorted(b.label for b in topology.boundaries)
     assert labels == sorted(["breech free end", "muzzle"] + [f"ground{i}" for i in range(1, 7)])
@@ -113,7 +114,7 @@ def test_fired_rockets_lighten_the_cradle(model, bundle):
         scene_model(model, 0)
 
 
-def test_first_six_in_the_seeds_band(mstmm):
+def test_first_six_in_the_studys_band(mstmm):
     assert mstmm.ubar_order == 60
     assert mstmm.rigid_body_modes == 0
     assert np.all((mstmm.frequencies_hz[:6] > 2.0) & (mstmm.frequencies_hz[:6] < 6.0))

@@ -1,4 +1,4 @@
-"""The model loader (``linmstmm.model.load_model``) against shared/spec/model-format.md.
+"""The model loader (``linmstmm.model.load_model``) against docs/model-format.md.
 
 Error tests start from ``BASE`` (a valid model using every kind of element and
 section), change one thing, and check that the ModelError names the file, the
@@ -7,6 +7,7 @@ element and the key. CLI tests run ``python -m linmstmm freqs`` on the files in
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import subprocess
 import sys
@@ -142,6 +143,13 @@ def test_syntax_error_names_line_and_column(tmp_path):
 def test_duplicate_point_name(tmp_path):
     text = edit(("top = [2.0, 0.0, 1.0]\n", "top = [2.0, 0.0, 1.0]\ntop = [3.0, 0.0, 1.0]\n"))
     model_error(tmp_path, text, None, None, "invalid TOML", "line 9", "duplicate point name")
+
+
+@pytest.mark.parametrize("opening, closing", [("[", "]"), ("{a = ", "}")])
+def test_nesting_too_deep_for_the_reader(tmp_path, opening, closing):
+    depth = 5000
+    text = edit(('name = "base"', f'name = "base"\nx = {opening * depth}1{closing * depth}'))
+    model_error(tmp_path, text, None, None, "invalid TOML", "nested too deeply")
 
 
 def test_not_utf8(tmp_path):
@@ -311,6 +319,42 @@ def test_inertia_not_positive_semidefinite(tmp_path):
 def test_inertia_diagonal_with_negative_entry(tmp_path):
     text = edit(("inertia = [0.1, 0.2, 0.3]", "inertia = [0.1, -0.2, 0.3]"))
     model_error(tmp_path, text, "rigid 'payload'", "inertia", "inertia[1] must be >= 0")
+
+
+@pytest.mark.parametrize("inertia", [
+    "[0.1, 0.2, 0.5]",                                              # Izz > Ixx + Iyy
+    "[0.5, 0.1, 0.2]",                                              # Ixx > Iyy + Izz
+    "[[0.3, 0.2, 0.0], [0.2, 0.3, 0.0], [0.0, 0.0, 0.05]]",         # principal 0.05, 0.1, 0.5
+])
+def test_inertia_breaking_the_triangle_inequality(tmp_path, inertia):
+    text = edit(("inertia = [0.1, 0.2, 0.3]", f"inertia = {inertia}"))
+    model_error(tmp_path, text, "rigid 'payload'", "inertia", "triangle inequality", "no real body")
+
+
+def _rotated_plate(scale):
+    """Inertia tensor, kg m^2 x ``scale``, of a flat plate (Izz = Ixx + Iyy) turned about
+    an oblique axis: the equality holds only to rounding."""
+    angle, axis = 0.7, np.array([1.0, 2.0, 2.0]) / 3.0
+    cross = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    rotation = np.eye(3) + math.sin(angle) * cross + (1 - math.cos(angle)) * cross @ cross
+    return scale * rotation @ np.diag([0.1, 0.25, 0.35]) @ rotation.T
+
+
+@pytest.mark.parametrize("scale", [1.0, 1e-6, 1e6])
+@pytest.mark.parametrize("principal", [[0.0, 0.0, 0.0], [0.0, 0.2, 0.2], [0.2, 0.2, 0.4], None])
+def test_inertia_on_the_triangle_boundary_is_accepted(tmp_path, principal, scale):
+    # point mass, thin rod, flat plates (None: turned): equality, in any units of mass and length.
+    tensor = _rotated_plate(scale) if principal is None else scale * np.diag(principal)
+    text = edit(("inertia = [0.1, 0.2, 0.3]", f"inertia = {tensor.tolist()}"))
+    np.testing.assert_allclose(load_text(tmp_path, text).element("payload").inertia, tensor, rtol=1e-15)
+
+
+@pytest.mark.parametrize("scale", [1e-6, 1.0, 1e6])
+def test_triangle_check_does_not_depend_on_units(tmp_path, scale):
+    # a plate whose Izz exceeds Ixx + Iyy by 1e-6 of the trace is refused at every scale.
+    tensor = _rotated_plate(scale) + scale * 1e-6 * 0.7 * np.diag([0.0, 0.0, 1.0])
+    text = edit(("inertia = [0.1, 0.2, 0.3]", f"inertia = {tensor.tolist()}"))
+    model_error(tmp_path, text, "rigid 'payload'", "inertia", "triangle inequality")
 
 
 def test_negative_mass(tmp_path):
@@ -558,3 +602,154 @@ def test_cli_reports_bad_model_in_one_line(name, words):
     assert "Traceback" not in done.stderr and done.stdout == ""
     for word in [relative, *words]:
         assert word in lines[0]
+
+
+# --- models built in code -----------------------------------------------------
+#
+# Model(...) runs the loader's checks on its records: each case below changes
+# one record of the base model in code and expects the loader's message, with
+# "model 'base'" (the model's name) in place of the file.
+
+@pytest.fixture
+def base(tmp_path):
+    """BASE as a Model built in code (no source file)."""
+    return dataclasses.replace(load_text(tmp_path, BASE), source=None)
+
+
+def changed(model, element, **values):
+    """``model`` rebuilt (so checked) with ``values`` set on the record ``element``."""
+    attribute = {"rigid": "rigids", "beam": "beams", "spring": "springs"}[model.element(element).kind]
+    records = tuple(dataclasses.replace(r, **values) if r.name == element else r
+                    for r in getattr(model, attribute))
+    return dataclasses.replace(model, **{attribute: records})
+
+
+def with_points(model, **points):
+    return dataclasses.replace(model, points=model.points | {p: np.array(v) for p, v in points.items()})
+
+
+def code_error(build, model, element, key, *words):
+    """The ModelError of ``build(model)``, checked as :func:`model_error` checks a file's."""
+    with pytest.raises(ModelError) as info:
+        build(model)
+    error, line = info.value, str(info.value)
+    assert error.file in ("model 'base'", "model ''") and line.startswith(error.file + ": "), line
+    assert (error.element, error.key) == (element, key), line
+    for word in words:
+        assert word in line, line
+    return error
+
+
+PLATE_OFF_AXIS = np.diag([0.1, 0.2, 0.5])
+UNSYMMETRIC = np.array([[0.1, 0.01, 0.0], [0.02, 0.2, 0.0], [0.0, 0.0, 0.3]])
+NOT_PSD = np.array([[0.1, 0.5, 0.0], [0.5, 0.2, 0.0], [0.0, 0.0, 0.3]])
+FLIPPED = np.array([[1.0, 0, 0], [0, 1.0, 0], [0, 0, -1.0]])
+
+
+@pytest.mark.parametrize("build, element, key, words", [
+    (lambda m: dataclasses.replace(m, name=""), None, "name", ["non-empty string"]),
+    (lambda m: dataclasses.replace(m, description=3), None, "description", ["must be a string"]),
+    (lambda m: dataclasses.replace(m, points=[]), None, "points", ["must be a table [points]"]),
+    (lambda m: with_points(m, top=[2.0, np.nan, 1.0]), "[points]", "top", ["top[1] must be finite"]),
+    (lambda m: with_points(m, top=[2.0, 1.0]), "[points]", "top", ["array of 3 numbers"]),
+    (lambda m: with_points(m, spare=[9.0, 9.0, 9.0]), "[points]", "spare", ["not used by any element"]),
+    (lambda m: changed(m, "payload", name=""), "rigid #1", "name", ["non-empty string"]),
+    (lambda m: changed(m, "k1", name="arm"), "spring 'arm'", "name", ["duplicate element name"]),
+    (lambda m: changed(m, "payload", ports=()), "rigid 'payload'", "ports", ["non-empty array"]),
+    (lambda m: changed(m, "payload", ports=("hnige",)), "rigid 'payload'", "ports",
+     ["unknown point 'hnige'", "did you mean 'hinge'?"]),
+    (lambda m: changed(m, "payload", ports=("hinge", "hinge")), "rigid 'payload'", "ports", ["listed twice"]),
+    (lambda m: changed(m, "payload", mass=-5.0), "rigid 'payload'", "mass", ["mass must be >= 0"]),
+    (lambda m: changed(m, "payload", mass=np.inf), "rigid 'payload'", "mass", ["mass must be finite"]),
+    (lambda m: changed(m, "payload", com=np.zeros(2)), "rigid 'payload'", "com", ["array of 3 numbers"]),
+    (lambda m: changed(m, "payload", inertia=np.zeros(3)), "rigid 'payload'", "inertia",
+     ["(3, 3) tensor"]),
+    (lambda m: changed(m, "payload", inertia=np.zeros((3, 2))), "rigid 'payload'", "inertia", ["3x3"]),
+    (lambda m: changed(m, "payload", inertia=UNSYMMETRIC), "rigid 'payload'", "inertia", ["not symmetric"]),
+    (lambda m: changed(m, "payload", inertia=NOT_PSD), "rigid 'payload'", "inertia",
+     ["not positive semidefinite"]),
+    (lambda m: changed(m, "payload", inertia=PLATE_OFF_AXIS), "rigid 'payload'", "inertia",
+     ["triangle inequality"]),
+    (lambda m: changed(m, "arm", ends=("root",)), "beam 'arm'", "ends", ["array of 2 point names"]),
+    (lambda m: changed(m, "arm", ends=("tip", "tip")), "beam 'arm'", "ends", ["zero length"]),
+    (lambda m: changed(m, "arm", ends=("tip", "hinge")), "beam 'arm'", "ends", ["zero length", "coincide"]),
+    (lambda m: changed(m, "arm", ends=("root", "hnige")), "beam 'arm'", "ends", ["unknown point 'hnige'"]),
+    (lambda m: changed(m, "arm", rho=-1.0), "beam 'arm'", "rho", ["rho must be >= 0"]),
+    (lambda m: changed(m, "arm", axial=1), "beam 'arm'", "axial", ["true or false"]),
+    (lambda m: changed(m, "arm", torsion="no"), "beam 'arm'", "torsion", ["true or false"]),
+    (lambda m: changed(m, "arm", length=2.5), "beam 'arm'", "length",
+     ["distance between the ends, 2 m", "got 2.5"]),
+    (lambda m: changed(m, "arm", axes=-np.eye(3)), "beam 'arm'", "axes", ["local x"]),
+    (lambda m: changed(m, "arm", axes=np.diag([1.0, 1.0, -1.0])), "beam 'arm'", "axes", ["right-handed"]),
+    (lambda m: changed(m, "arm", axes=np.eye(2)), "beam 'arm'", "axes", ["local x"]),
+    (lambda m: changed(m, "arm", axes=np.array([[1.0, 0, 0], [1.0, 0, 0], [0, 0, 1.0]])), "beam 'arm'",
+     "y_axis", ["parallel to the beam axis"]),
+    (lambda m: with_points(m, hinge=[2.001, 0.0, 0.0]), "spring 'k1'", "ends", ["do not coincide"]),
+    (lambda m: changed(m, "k1", k=np.array([1e6, 1e6, 0.0, 1e4, 1e4, np.inf])), "spring 'k1'", "k",
+     ["k[2] must be > 0"]),
+    (lambda m: changed(m, "k1", k=np.ones(3)), "spring 'k1'", "k", ["array of 6 numbers"]),
+    (lambda m: changed(m, "k1", axes=FLIPPED), "spring 'k1'", "axes", ["right-handed"]),
+    (lambda m: changed(m, "k1", axes=2 * np.eye(3)), "spring 'k1'", "axes", ["orthonormal"]),
+    (lambda m: changed(m, "k1", c=-np.ones(6)), "spring 'k1'", "c", ["c[0] must be >= 0"]),
+    (lambda m: dataclasses.replace(m, boundary={"hnige": np.ones(6, bool)}), "[boundary]", "hnige",
+     ["unknown point 'hnige'"]),
+    (lambda m: dataclasses.replace(m, boundary={"root": np.ones(3, bool)}), "[boundary]", "root",
+     ["(6,) bool mask"]),
+    (lambda m: dataclasses.replace(m, boundary={"root": np.ones(6)}), "[boundary]", "root", ["(6,) bool mask"]),
+    (lambda m: dataclasses.replace(m, damping=(-0.1, 0.0)), "[damping]", "alpha", ["alpha must be >= 0"]),
+    (lambda m: dataclasses.replace(m, damping=(0.1, np.nan)), "[damping]", "beta", ["beta must be finite"]),
+    (lambda m: dataclasses.replace(m, damping=0.1), None, "damping", ["(alpha, beta)"]),
+    (lambda m: dataclasses.replace(m, rigids=m.beams[:1]), None, None, ["rigids[0] must be a Rigid record"]),
+])
+def test_model_built_in_code_is_checked(base, build, element, key, words):
+    code_error(build, base, element, key, *words)
+
+
+@pytest.mark.parametrize("key", ["E", "G", "A", "Iy", "Iz", "J", "Ip"])
+def test_beam_constants_built_in_code_must_be_positive(base, key):
+    code_error(lambda m: changed(m, "post", **{key: 0.0}), base, "beam 'post'", key, f"{key} must be > 0")
+
+
+def test_model_without_mass_built_in_code(base):
+    code_error(lambda m: changed(changed(changed(m, "payload", mass=0.0), "arm", rho=0.0), "post", rho=0.0),
+               base, None, None, "model has no mass")
+
+
+def test_model_without_elements_built_in_code():
+    for points in ({}, {"a": np.zeros(3)}):
+        with pytest.raises(ModelError, match="^model 'empty': model has no elements"):
+            Model("empty", points)
+
+
+def test_code_and_file_get_the_same_message(tmp_path, base):
+    from_file = model_error(tmp_path, edit(("mass = 5.0", "mass = -5.0")), "rigid 'payload'", "mass")
+    from_code = code_error(lambda m: changed(m, "payload", mass=-5.0), base, "rigid 'payload'", "mass")
+    assert from_code.message == from_file.message
+
+
+def test_model_built_in_code_keeps_its_source_in_messages(base):
+    with pytest.raises(ModelError, match="^somewhere.toml: rigid 'payload': key 'mass'"):
+        changed(dataclasses.replace(base, source="somewhere.toml"), "payload", mass=-1.0)
+
+
+def test_valid_model_built_in_code_is_accepted(base):
+    # lists and numpy scalars stand for numbers, as integers do in a file.
+    rebuilt = changed(base, "payload", mass=np.float32(4.0), com=[2.0, 0.0, 0.4])
+    assert rebuilt.element("payload").mass == np.float32(4.0)
+    assert dataclasses.replace(base, damping=None, boundary={}).boundary == {}
+
+
+@pytest.mark.parametrize("path", sorted(str(p.relative_to(ROOT)) for p in ROOT.glob("models/**/*.toml")
+                                        if p.parent.name != "loads" and p.name != "bundle.toml"))
+def test_bundled_models_load(path):
+    model = load_model(ROOT / path)
+    assert model.elements and model.source == str(ROOT / path)
+
+
+def test_cli_reports_too_deep_nesting_in_one_line(tmp_path):
+    path = write(tmp_path, f"name = {'[' * 5000}{']' * 5000}\n")
+    done = subprocess.run([sys.executable, "-m", "linmstmm", "freqs", str(path)],
+                          cwd=ROOT, capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2 and done.stdout == "", done.stderr
+    assert done.stderr.splitlines() == [f"linmstmm: error: {path}: invalid TOML: arrays or tables "
+                                        f"nested too deeply for the TOML reader"]

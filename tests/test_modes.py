@@ -111,7 +111,7 @@ def tree():
         beams=(make_beam("post", "g", "p1", points, A=2e-3, Iy=8e-7, Iz=6e-7, J=1e-6),
                make_beam("arm", "p2", "tip", points, Iy=1e-7, Iz=2e-7, J=2e-7)),
         springs=(make_spring("mount", "p3", "q3", [2e5, 3e5, 1e5, 4e3, np.inf, 5e3],
-                             axes=np.array([[0.0, 0.6, 0.8], [0.0, 0.8, -0.6], [1.0, 0.0, 0.0]])),),
+                             axes=np.array([[0.0, 0.6, 0.8], [0.0, 0.8, -0.6], [-1.0, 0.0, 0.0]])),),
         boundary={"g": fixed()})
 
 
@@ -249,3 +249,29 @@ def test_shapes_match_the_finite_element_route():
                           for k in range(lam.size)])
     np.testing.assert_allclose(modes.omega, np.sqrt(lam), rtol=1e-6)
     assert np.diag(modes.mac(fe_shapes, points)).min() > 0.9999
+
+
+def test_one_default_normalisation_for_the_function_and_the_command(capsys):
+    """``mode_shapes`` and ``linmstmm modes`` both scale to unit modal mass unless told
+    otherwise; ``--normalization max`` gives the same shapes over √M_k."""
+    from pathlib import Path
+
+    from linmstmm.cli import main
+    from linmstmm.model import load_model
+
+    path = str(Path(__file__).resolve().parents[1] / "models" / "cantilever_tip_mass.toml")
+    runs = {}
+    for option in ([], ["--normalization", "max"]):
+        assert main(["modes", path, "--count", "3", "--json", *option]) == 0
+        data = json.loads(capsys.readouterr().out)
+        runs[data["normalization"]] = data
+    api = mode_shapes(load_model(path), count=3)
+    assert sorted(runs) == ["mass", "max"] and api.normalization == "mass"
+    np.testing.assert_allclose(runs["mass"]["modal_mass"], 1.0, rtol=1e-12)
+    tip = {name: np.array(data["point_displacements"]["tip"]) for name, data in runs.items()}
+    np.testing.assert_allclose(tip["mass"], api.point_displacements["tip"], rtol=1e-9, atol=1e-12)
+    scale = np.sqrt(runs["max"]["modal_mass"])[:, None]
+    np.testing.assert_allclose(tip["max"] / scale, tip["mass"], rtol=1e-6, atol=1e-9 * np.abs(tip["mass"]).max())
+    with pytest.raises(SystemExit):
+        main(["modes", "--help"])
+    assert "(default mass" in " ".join(capsys.readouterr().out.split())

@@ -5,18 +5,27 @@ only, so the FE route has exactly the model's 18 DOFs (no mesh) and the
 modal sum with all 18 modes must reproduce the direct solution. The direct
 solutions are independent of the modes: the state-space matrix exponential
 for the impulse and the step, and a linear solve for the harmonic response.
+
+The static correction is checked on the bundled held models: a damped step
+response with a truncated modal sum must settle on the FE route's static
+solution K⁻¹ f (a sparse direct solve on its default mesh).
 """
 from __future__ import annotations
+
+from pathlib import Path
 
 import numpy as np
 import pytest
 import scipy.linalg
-from builders import fixed, make_rigid, make_spring
+import scipy.sparse.linalg
+from builders import fixed, make_rigid, make_spring, single_beam_model
 
-from linmstmm.fe import assemble
-from linmstmm.model import Model
+from linmstmm.fe import assemble, static_displacements
+from linmstmm.model import Model, load_model
 from linmstmm.modes import mode_shapes
-from linmstmm.response import PointLoad, frf, impulse, modal_response, step
+from linmstmm.response import LoadCase, PointLoad, frf, impulse, modal_response, respond, step
+
+ROOT = Path(__file__).resolve().parents[1]
 
 DAMPING = (0.3, 2e-4)
 TIMES = np.linspace(0.0, 1.5, 301)
@@ -110,3 +119,56 @@ def test_frf_equals_direct_harmonic_solve(setting):
         for i, point in enumerate(["p3", "b2"]):
             want = fe_at(fe, point, q)
             assert np.abs(H[i] - want).max() < 1e-8 * np.abs(want).max()
+
+
+# --- static correction ------------------------------------------------------------
+
+HELD_MODELS = {  # model, loaded point, [force N, moment N m], seconds to settle at ζ = 0.3
+    "cantilever": ("models/cantilever_tip_mass.toml", "tip", [30.0, -40.0, -100.0, 5.0, 8.0, -6.0], 2.0),
+    "launcher": ("models/mlrs/mlrs.toml", "tube_rear", [-3939.231, 500.0, -694.5927, 100.0, -200.0, 50.0],
+                 6.0),
+}
+
+
+def fe_static(model, point, vector):
+    """point -> (6,) K⁻¹ f by a sparse direct solve on the FE route's default mesh."""
+    fe = assemble(model)
+    q = scipy.sparse.linalg.spsolve(fe.K.tocsc(), fe_load(fe, point, vector))
+    return {p: fe_at(fe, p, q) for p in model.points}
+
+
+@pytest.mark.parametrize("name", HELD_MODELS)
+def test_damped_step_settles_on_the_static_solution(name):
+    """Long-time mean of a step response (10 modes, ζ = 0.3) = K⁻¹ f to 1e-6 with the
+    static correction; the truncated modal sum alone is further off than that."""
+    file, point, vector, settle = HELD_MODELS[name]
+    model = load_model(ROOT / file)
+    vector = np.array(vector)
+    case = LoadCase((PointLoad(point, vector[:3], vector[3:], step(0.01)),),
+                    np.linspace(0.0, settle, 2001), tuple(model.points), 10)
+    want = fe_static(model, point, vector)
+    scale = max(np.abs(w).max() for w in want.values())
+    for corrected in (True, False):
+        result = respond(model, case, damping_ratio=0.3, static_correction=corrected)
+        assert result.static_correction is corrected and result.elastic_modes >= 10
+        late = result.displacement[result.times > 0.8 * settle].mean(axis=0)
+        error = max(np.abs(late[i] - want[p]).max() for i, p in enumerate(result.points)) / scale
+        assert bool(error < 1e-6) == corrected, (corrected, error)
+
+
+def test_static_solution_of_the_cantilever_is_the_closed_form():
+    """Tip force F: deflection F L³ / (3 E I) and slope F L² / (2 E I), on one element."""
+    model = load_model(ROOT / HELD_MODELS["cantilever"][0])
+    beam = model.beams[0]
+    got = static_displacements(model, [("tip", [0.0, 0.0, -100.0, 0.0, 0.0, 0.0])], ["tip"])[0, 0]
+    EI = beam.E * beam.Iy
+    np.testing.assert_allclose(got[[2, 4]], [-100.0 * beam.length**3 / (3 * EI), 100.0 * beam.length**2 / (2 * EI)],
+                               rtol=1e-12)
+
+
+def test_free_floating_model_gets_no_static_correction_and_says_so():
+    model = single_beam_model()
+    case = LoadCase((PointLoad("b", np.array([0.0, 0.0, 10.0]), np.zeros(3), step()),),
+                    np.linspace(0.0, 0.1, 11), ("a", "b"), 4)
+    result = respond(model, case)
+    assert not result.static_correction and "6 rigid-body modes" in result.note

@@ -1,7 +1,8 @@
 """The deduced structure (``linmstmm.structure``) and the topology figure.
 
-The block layouts below are written by hand from the theorem
-(``seeds/001`` §11.4–11.6) for each topology and compared entry by entry.
+The block layouts below are written by hand from the theorem (Rui, Wang and
+Zhang's book, 2018, §11.4–11.6; docs/method.md) for each topology and compared
+entry by entry.
 """
 from __future__ import annotations
 
@@ -45,8 +46,8 @@ def spring_body_model(bodies, springs, ground=None):
                  boundary={} if ground is None else {ground: fixed()})
 
 
-def seed_figure_11_1():
-    """The tree of seeds/001 Figure 11.1: elements numbered as in the seed.
+def book_figure_11_1():
+    """The tree of the book's Figure 11.1: elements numbered as in the book.
 
     Tip bodies 1–4 feed bodies 9 (by hinges 5, 6) and 10 (by 7, 8); 9 feeds
     body 13 by hinge 11, 13 feeds body 15 by hinge 14 (its first input P15,14),
@@ -78,7 +79,7 @@ def loop_model():
 
 
 def ring_model():
-    """seeds/001 Figure 11.7: three masses and three springs in a ring, no boundary."""
+    """The book's Figure 11.7: three masses and three springs in a ring, no boundary."""
     bodies = {"m1": ["a1", "b1"], "m2": ["a2", "b2"], "m3": ["a3", "b3"]}
     springs = {"k1": ("b1", "a2", (1, 0)), "k2": ("b2", "a3", (0, 1)),
                "k3": ("b3", "a1", (-1, 0))}
@@ -129,8 +130,8 @@ def test_tree_with_one_multi_input_body_has_its_geometric_row():
     assert report.ubar_order == 12 + 2 * 6 == 6 * (1 + len(report.tips))
 
 
-def test_seed_figure_11_1_geometric_rows_of_bodies_9_10_15():
-    report = describe(build_topology(seed_figure_11_1()))
+def test_book_figure_11_1_geometric_rows_of_bodies_9_10_15():
+    report = describe(build_topology(book_figure_11_1()))
     assert report.root.element == "18" and len(report.tips) == 4 and not report.cuts
     assert report.ubar_order == 30
     inputs = {body.name: [i.point for i in body.inputs] for body in report.multi_input_bodies}
@@ -189,7 +190,7 @@ def test_to_text_and_to_dict_carry_the_layout():
     assert data["cuts"][0]["elements"] == ["s2", "R2"]
 
 
-@pytest.mark.parametrize("make", [chain_model, seed_figure_11_1, loop_model, ring_model,
+@pytest.mark.parametrize("make", [chain_model, book_figure_11_1, loop_model, ring_model,
                                   junction_model])
 def test_o_blocks_are_exactly_the_zero_blocks_of_the_numeric_ubar(make):
     """The symbolic layout against Deduction's own Ū_all at one frequency."""
@@ -206,7 +207,7 @@ def test_o_blocks_are_exactly_the_zero_blocks_of_the_numeric_ubar(make):
             assert zero == (report.blocks[r][c] == "O"), (report.block_rows[r], column)
 
 
-@pytest.mark.parametrize("make", [seed_figure_11_1, loop_model, ring_model, junction_model])
+@pytest.mark.parametrize("make", [book_figure_11_1, loop_model, ring_model, junction_model])
 def test_figure_is_a_png(tmp_path, make):
     path = tmp_path / "topology.png"
     plot_topology(build_topology(make()), path, title=make.__name__)

@@ -1,5 +1,5 @@
 """Rigid body: transfer matrix between two ports, and the pieces of the
-multi-input body (seed 003, eqs 3-4).
+multi-input body (eqs 3-4 of the multiple launch rocket system study, ``docs/method.md``).
 
 Newton-Euler about the mass centre c, harmonic at ω (inertia force
 m ω² u_c, inertia moment ω² J_c θ), with the sign convention of the package

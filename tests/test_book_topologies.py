@@ -1,4 +1,5 @@
-"""The topologies drawn in seed 001 (shared/seeds/001_3f4ab1f6c6aaaf98.txt).
+"""Topologies drawn in chapter 11 of Rui, Wang and Zhang, "Transfer Matrix Method for
+Multibody Systems: Theory and Applications" (Wiley, 2018; docs/method.md).
 
 Figure 11.1: a tree whose bodies 9, 10 and 15 each have two inputs (hinges 5
 and 6, 7 and 8, 14 and 12), tips 1-4, and an output chain 15 → 16 → 17 → 18

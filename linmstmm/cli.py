@@ -97,6 +97,10 @@ def build_parser() -> argparse.ArgumentParser:
     freqs.add_argument("--digits", type=_positive_int, default=None,
                        help="significant digits wanted (above 14 the mpmath path is used)")
     freqs.add_argument("--root", default=None, help="boundary point to use as the root")
+    freqs.add_argument("--engine", choices=("auto", "numpy", "compiled"), default="auto",
+                       help="how det Ū_all is evaluated: the numpy carry, or numba-compiled kernels "
+                            "(about 5x cheaper per evaluation, 0.5-1.5 s to start in a new process); "
+                            "auto: numpy in a new process")
     freqs.set_defaults(run=_run_freqs)
     add_check_command(sub)
     add_fe_command(sub)
@@ -135,7 +139,8 @@ def _run_freqs(args):
 
     model = load_model(args.model)
     count, fmax = _request(args)
-    result = natural_frequencies(model, count=count, fmax=fmax, digits=args.digits, root=args.root)
+    result = natural_frequencies(model, count=count, fmax=fmax, digits=args.digits, root=args.root,
+                                 engine=args.engine)
     data = result.to_dict()
     if args.json:
         print(json.dumps(data))

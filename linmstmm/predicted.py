@@ -13,7 +13,8 @@ roots are predicted first and each evaluation goes where a root is:
    one batch per step); each prediction in a cluster by Newton on the matrix
    pencil (:meth:`RootFinder.polish`), which steps to the nearest root however
    close its neighbours; where two arrive at one root (a multiple root, or two
-   roots too close for float64), the full search takes over;
+   roots too close for float64), the segment search of :class:`RootFinder`
+   takes the interval around them, halfway to the neighbouring predictions;
 3. **certify** — one argument-principle count of det Ū_all with the polished
    roots divided out, from 0 to a gap above the last root wanted, must come to
    zero (:meth:`RootFinder.confirm_no_other_zeros`). A prediction that
@@ -39,6 +40,8 @@ MAX_ELEMENTS = 64
 CLUSTER = 1e-3
 #: Relative size of the secant's first step (its second point).
 FIRST_STEP = 1e-7
+#: Halvings of the range by counts before a stretch that misses a root is searched whole.
+REPAIR_DEPTH = 8
 #: Secant steps before a root that has not settled is handed to the pencil.
 SECANT_STEPS = 12
 
@@ -160,9 +163,15 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
     found, steps = secant_roots(finder.log_det, predictions[single], finder.xtol, finder.UNCERTAIN)
     roots: list[float] = []
     starts = [float(predictions[i]) for g in groups if len(g) > 1 for i in g]
-    for i, root, step in zip(single, found, steps):
-        if np.isnan(root) or abs(root - predictions[i]) > 0.5 * _gap(predictions, i):
-            starts.append(float(predictions[i]))  # did not settle near its start: the pencil decides
+    settled = np.array([not np.isnan(r) and abs(r - predictions[i]) <= 0.5 * _gap(predictions, i)
+                        for i, r in zip(single, found)], dtype=bool)
+    for a in np.flatnonzero(settled):  # two predictions that settled on one root: neither stands
+        twins = settled & (np.abs(found - found[a]) <= finder.SAME_ROOT * found[a])
+        if twins.sum() > 1:
+            settled[twins] = False
+    for i, root, step, ok in zip(single, found, steps, settled):
+        if not ok:
+            starts.append(float(predictions[i]))  # did not settle near its start, alone: the pencil decides
             continue
         finder.last_step[root] = step
         roots.append(root)
@@ -170,17 +179,73 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
     # root whatever its neighbours). Members that arrive at one root would make
     # it multiple, and the closing count cannot tell a double root from two
     # roots closer than its contour sees (random loops 57: 40th and 41st 9.7e-6
-    # apart, certified as one double root): the full search decides those.
-    for root, _ in finder.polish(starts):
+    # apart, certified as one double root): the segment search decides those,
+    # between the settled roots around them.
+    troubled = []
+    for start, (root, _) in zip(starts, finder.polish(starts)):
         if root is None or any(abs(r - root) <= finder.SAME_ROOT * root for r in roots):
+            troubled.append(start)
+        else:
+            roots.append(root)
+    roots = sorted(roots)
+    for lo, hi in _intervals_around(troubled, roots, predictions):
+        try:
+            roots = [r for r in roots if not lo < r <= hi] + finder.segment(lo, hi)
+        except RuntimeError:  # a count that cannot be made there: the full search decides
             return None
-        roots.append(root)
     roots = sorted(roots)
     if len(roots) < count:
         return None
-    if not finder.confirm_no_other_zeros(roots, _gap_above(roots, count, finder.SAME_ROOT)):
-        return None
+    upper = _gap_above(roots, count, finder.SAME_ROOT)
+    if not finder.confirm_no_other_zeros(roots, upper):
+        # A root the coarse model did not predict in range (or one polished twice):
+        # halve by counts to the stretch that holds it and search only there.
+        roots = _repaired(finder, roots, None, upper, REPAIR_DEPTH)
+        if roots is None or len(roots) < count:
+            return None
+        upper = _gap_above(roots, count, finder.SAME_ROOT)
+        if not finder.confirm_no_other_zeros(roots, upper):
+            return None
     return roots[:count]
+
+
+def _repaired(finder, roots: list[float], lo: float, hi: float, depth: int):
+    """``roots`` with those in (lo, hi] made complete (lo None: from the search's
+    floor): a count of det with the known ones divided out; where it is not zero,
+    halved at a known root's gap and counted again, down to ``depth`` halvings or
+    two known roots, where the segment search takes the stretch. None where a
+    count cannot be made."""
+    extra = finder.other_zeros(roots, lo, hi)
+    if extra is None:
+        return None
+    if extra == 0:
+        return roots
+    lo = finder.floor if lo is None else lo
+    inside = [r for r in roots if lo < r <= hi]
+    if depth == 0 or len(inside) <= 2:
+        outside = [r for r in roots if not lo < r <= hi]
+        return sorted(outside + finder.segment(lo, hi))
+    middle = float(np.sqrt(inside[len(inside) // 2 - 1] * inside[len(inside) // 2]))
+    roots = _repaired(finder, roots, lo, middle, depth - 1)
+    return None if roots is None else _repaired(finder, roots, middle, hi, depth - 1)
+
+
+def _intervals_around(troubled: list[float], roots: list[float], predictions: np.ndarray) -> list[tuple]:
+    """Disjoint intervals (lo, hi], rad/s, each holding troubled predictions and
+    reaching halfway (geometrically) to the nearest prediction not among them on
+    either side: the segment search runs there."""
+    intervals: list[list[float]] = []
+    troubled_set = set(troubled)
+    for start in sorted(troubled):
+        below = [p for p in predictions if p < start and p not in troubled_set]
+        above = [p for p in predictions if p > start and p not in troubled_set]
+        lo = np.sqrt(start * below[-1]) if below else start / 2
+        hi = np.sqrt(start * above[0]) if above else start * 1.5
+        if intervals and lo <= intervals[-1][1]:
+            intervals[-1][1] = max(intervals[-1][1], hi)
+        else:
+            intervals.append([lo, hi])
+    return [(float(lo), float(hi)) for lo, hi in intervals]
 
 
 def _gap(predictions: np.ndarray, i: int) -> float:

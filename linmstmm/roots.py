@@ -57,6 +57,9 @@ MAX_XTOL = 1e-6
 SCAN_OCTAVES = 4
 #: Lowest scanned circular frequency, rad/s.
 OMEGA_FLOOR = 1e-3
+#: Predictions asked for beyond the count (plus a tenth of it): a coarse mesh can rank
+#: a true root among the first N one or two places too high (the launcher's 100th).
+PREDICTION_MARGIN = 2
 #: A predicted root below this many OMEGA_FLOOR is refused (an error, not a silently
 #: wrong list): a free strip 9.9 m long with Iz = 1e-12 m⁴ has its first bending mode at
 #: 1.4e-3 rad/s, which the counts from OMEGA_FLOOR took for a double root higher up;
@@ -113,6 +116,8 @@ class RootFinder:
 
     #: Offsets |μ|/ω below this are the same root (multiplicity).
     SAME_ROOT = 1e-9
+    #: rad/s, where every count starts
+    floor = OMEGA_FLOOR
     #: Newton steps |μ|/ω that stop shrinking below this have reached the rounding
     #: floor of Ū_all: the root is accepted, with that step as its uncertainty
     #: (:attr:`last_step`; the caller refines uncertain roots in mpmath).
@@ -784,11 +789,16 @@ class RootFinder:
         rounds fewer). False also where it cannot count: the segment search then
         decides (and says so if it cannot either).
         """
+        return self.other_zeros(known, None, upper) == 0
+
+    def other_zeros(self, known: list[float], lo: float | None, hi: float) -> int | None:
+        """Zeros of det Ū_all in (lo, hi) less those in ``known`` (negative where a known
+        one is not a zero); lo None: OMEGA_FLOOR. None where the count cannot be made."""
         try:
-            return count_zeros(deflated(self.log_det, known), OMEGA_FLOOR, upper,
-                               max_points=DEFLATED_MAX_POINTS, initial_points=DEFLATED_POINTS) == 0
+            return count_zeros(deflated(self.log_det, known), OMEGA_FLOOR if lo is None else lo, hi,
+                               max_points=DEFLATED_MAX_POINTS, initial_points=DEFLATED_POINTS)
         except RuntimeError:
-            return False
+            return None
 
     def _scan_ahead(self, count: int | None, omega_max: float | None):
         """Guess, polish, confirm: the fast path of :meth:`find`, or None.
@@ -1064,7 +1074,7 @@ class RootFinder:
         segment search (:meth:`_search`).
         """
         if count is not None and self.predictor is not None:
-            predictions = self.predictor(count + 1)
+            predictions = self.predictor(count + PREDICTION_MARGIN + count // 10)
             if predictions.size and predictions[0] < FLOOR_MARGIN * OMEGA_FLOOR:
                 raise RuntimeError(
                     f"the lowest elastic natural frequency is near {predictions[0] / (2 * np.pi):.3g} Hz "

@@ -566,7 +566,8 @@ def test_singular_inertia_in_skew_axes_has_a_direction_without_mass():
     """A body whose inertia tensor is singular in axes skew to the model's (a
     direction without mass that no DOF is aligned with) on a spring to ground, a
     spring dangling from it: five elastic modes, as the transfer-matrix route finds."""
-    skew = 0.1 * np.array([[1.0, 1.0, 0.0], [1.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    axis = np.array([1.0, -1.0, 0.0]) / np.sqrt(2.0)  # a thin rod along a skew axis: no inertia about it
+    skew = 0.1 * (np.eye(3) - np.outer(axis, axis))
     points = {"ground": np.zeros(3), "port": np.zeros(3)}
     model = with_dangling_spring(Model(name="skew", points=points,
                                        rigids=(make_body("body", ["port"], [0.1, 0.0, 0.0], 2.0, skew),),

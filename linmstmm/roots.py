@@ -57,6 +57,9 @@ MAX_XTOL = 1e-6
 SCAN_OCTAVES = 4
 #: Lowest scanned circular frequency, rad/s.
 OMEGA_FLOOR = 1e-3
+#: Where the lowest root found is below this many OMEGA_FLOOR, a count in the disc
+#: of radius OMEGA_FLOOR checks that no elastic root hides below it (:meth:`RootFinder._check_floor`).
+FLOOR_CHECK = 1e3
 #: Predictions asked for beyond the count (plus a tenth of it): a coarse mesh can rank
 #: a true root among the first N one or two places too high (the launcher's 100th).
 PREDICTION_MARGIN = 2
@@ -172,6 +175,7 @@ class RootFinder:
         #: why the search ended early, if it did
         self.note = ""
         self._rigid = rigid_body_modes
+        self._divided = False  # the rigid-body zeros divided out of log_det
         #: callable n -> (m,) predicted lowest elastic roots, rad/s, or None
         self.predictor = predictor
         #: the compiled determinant behind ``log_det`` and ``matrix``, where the
@@ -201,6 +205,7 @@ class RootFinder:
         """
         if rigid and count_in_disc(self.log_det, OMEGA_FLOOR) == 2 * rigid:
             self.log_det = deflated(self.log_det, np.zeros(rigid))
+            self._divided = True
 
     def rigid_body_modes(self) -> int:
         """Number of zero-frequency (rigid-body) modes, as given at construction."""
@@ -1082,12 +1087,32 @@ class RootFinder:
                     f"({FLOOR_MARGIN * OMEGA_FLOOR / (2 * np.pi):.3g} Hz): use `linmstmm fe` for this model")
             found = predicted_roots(self, predictions, count)
             if found is not None:  # certified up to above the count-th: complete below omega_max too
+                self._check_floor(found)
                 return [w for w in found if omega_max is None or w <= omega_max]
         found = self._scan_ahead(count, omega_max) if count is not None or omega_max is not None else None
         if found is None:
             found = self._search(count, omega_max, omega_start)
         found = self._separated(found)
+        self._check_floor(found)
         return found[:count] if count is not None else found
+
+    def _check_floor(self, found: list[float]) -> None:
+        """Raise RuntimeError if det has zeros below OMEGA_FLOOR besides the rigid-body
+        modes' (every count starts there, so such roots would be missing from the
+        list without a word: a cantilever with Iy = 1e-20 m⁴ has its first four
+        between 1.5e-6 and 7e-5 Hz). Checked with one count in that disc, only where
+        the lowest root found is within FLOOR_CHECK times the floor."""
+        if not found or found[0] > FLOOR_CHECK * OMEGA_FLOOR:
+            return
+        expected = 0 if self._divided else 2 * self._rigid
+        try:
+            below = count_in_disc(self.log_det, OMEGA_FLOOR)
+        except RuntimeError:
+            below = None
+        if below != expected:
+            raise RuntimeError(f"det Ū_all has zeros below {OMEGA_FLOOR:g} rad/s "
+                               f"({OMEGA_FLOOR / (2 * np.pi):.3g} Hz) besides the rigid-body modes', which "
+                               "the root search cannot certify: use `linmstmm fe` for this model")
 
     def _separated(self, roots: list[float]) -> list[float]:
         """``roots`` with each multiple one that is a cluster of distinct roots split into them.

@@ -272,3 +272,25 @@ def test_near_zero_elastic_modes_next_to_rigid_body_modes():
     want = np.sort(np.r_[[np.sqrt(k * (1 / m1 + 1 / m2))] * 3, np.sqrt(kr * (1 / J1 + 1 / J2))]) / (2 * np.pi)
     assert got.rigid_body_modes == 6
     np.testing.assert_allclose(got.frequencies_hz, want, rtol=1e-9)
+
+
+@pytest.mark.parametrize("Iy", [1e-12, 1e-16, 1e-20, 1e-24])
+def test_thin_strip_cantilever_gives_fe_frequencies_or_an_honest_error(Iy):
+    """The bundled cantilever with Iy from 1e-12 down to 1e-24 m⁴ (Iz stays 2e-7): the
+    FE route's frequencies, or a RuntimeError naming `linmstmm fe` where the lowest
+    lie below the search's floor (Iy = 1e-20 returned four frequencies around 2e-4 Hz
+    for FE's 1.5e-6 … 7e-5 Hz before, without a word)."""
+    import dataclasses
+
+    from linmstmm.fe import fe_frequencies
+    from linmstmm.model import load_model
+
+    bundled = load_model("models/cantilever_tip_mass.toml")
+    model = dataclasses.replace(bundled, beams=(dataclasses.replace(bundled.beams[0], Iy=Iy),))
+    fe = fe_frequencies(model, count=4).frequencies_hz
+    try:
+        found = natural_frequencies(model, count=4).frequencies_hz
+    except RuntimeError as error:
+        assert "linmstmm fe" in str(error) and fe[0] < 1e-2
+    else:
+        np.testing.assert_allclose(found, fe, rtol=1e-8)

@@ -140,12 +140,6 @@ CASES = [
     Case("damping", "beta", "[boundary]", "[damping]\nbeta = 1e-4\n\n[boundary]", "response"),
 ]
 
-#: Spring ``c`` (viscous damping) is loaded but no computation uses it yet; the
-#: response commands are to refuse such a model with a message naming ``c``.
-C_IGNORED = pytest.mark.xfail(reason="spring 'c' is loaded but used by no computation, and the "
-                                     "response path does not refuse it yet", strict=False)
-
-
 def write(tmp_path, text, name="model.toml"):
     path = tmp_path / name
     path.write_text(text)
@@ -196,8 +190,7 @@ def differs(before, after):
     return False
 
 
-@pytest.mark.parametrize("case", [pytest.param(c, marks=C_IGNORED) if c.key == "c" else c
-                                  for c in CASES], ids=str)
+@pytest.mark.parametrize("case", CASES, ids=str)
 def test_key_acts_or_is_refused(tmp_path, capsys, case):
     assert BASE.count(case.old) == 1, case.old
     changed = write(tmp_path, BASE.replace(case.old, case.new))

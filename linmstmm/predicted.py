@@ -145,7 +145,9 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
 
 
 def predicted_roots(finder, predictions: np.ndarray, count: int):
-    """The lowest ``count`` roots (rad/s, repeated per multiplicity) from ``predictions``, certified.
+    """The lowest ``count`` or more roots (rad/s, repeated per multiplicity) from
+    ``predictions``, certified: every root up to the end of the certifying count
+    (a gap above the count-th, so a multiple root there comes whole).
 
     finder : the :class:`~linmstmm.roots.RootFinder` of the model (its
     determinant, pencil and counts). predictions : (m,) rad/s ascending,
@@ -206,7 +208,7 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
         upper = _gap_above(roots, count, finder.SAME_ROOT)
         if not finder.confirm_no_other_zeros(roots, upper):
             return None
-    return roots[:count]
+    return [r for r in roots if r <= upper]
 
 
 def _repaired(finder, roots: list[float], lo: float, hi: float, depth: int):

@@ -1087,8 +1087,9 @@ class RootFinder:
                     f"({FLOOR_MARGIN * OMEGA_FLOOR / (2 * np.pi):.3g} Hz): use `linmstmm fe` for this model")
             found = predicted_roots(self, predictions, count)
             if found is not None:  # certified up to above the count-th: complete below omega_max too
+                found = self._separated(found)
                 self._check_floor(found)
-                return [w for w in found if omega_max is None or w <= omega_max]
+                return [w for w in found[:count] if omega_max is None or w <= omega_max]
         found = self._scan_ahead(count, omega_max) if count is not None or omega_max is not None else None
         if found is None:
             found = self._search(count, omega_max, omega_start)

@@ -25,7 +25,7 @@ def launcher():
 
 def test_launcher_first_20_in_few_evaluations_agree_with_fe(launcher):
     _, finder, _ = frequency_finder(launcher)
-    roots = predicted_roots(finder, predict_frequencies(launcher, 21), 20)
+    roots = predicted_roots(finder, predict_frequencies(launcher, 21), 20)[:20]
     assert roots is not None
     assert finder.determinant.evaluations / 20 <= 10
     fe = fe_frequencies(launcher, 20)
@@ -43,7 +43,7 @@ def test_wrong_predictions_are_caught_by_the_count_and_repaired(launcher, change
         predictions = np.delete(predictions, 4)
     else:
         predictions = np.sort(np.r_[predictions, predictions[4] * (1 + 1e-6)])
-    roots = predicted_roots(finder, predictions, 10)
+    roots = predicted_roots(finder, predictions, 10)[:10]
     fe = fe_frequencies(launcher, 10)
     np.testing.assert_allclose(np.array(roots) / (2 * np.pi), fe.frequencies_hz,
                                rtol=max(1e-9, 3 * np.nanmax(fe.error_estimate)))

@@ -107,6 +107,8 @@ def test_launcher2_has_two_loops_with_beams_and_a_launcher_size_ubar():
 
 
 def test_launcher2_twenty_frequencies_within_fe_estimate():
+    """``freqs --count 20`` against ``fe --count 20``: each relative difference within
+    the FE route's own error estimate for that frequency, plus float64 rounding."""
     if not fe_is_wired():
         pytest.skip("`linmstmm fe` is not on the command line yet")
     freqs = solve("freqs", LAUNCHER2, "--count", "20")

@@ -160,13 +160,22 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
     predictions = predictions[predictions > 0]
     if predictions.size < count:
         return None
-    groups = _clusters(predictions)
-    single = [g[0] for g in groups if len(g) == 1]
-    found, steps = secant_roots(finder.log_det, predictions[single], finder.xtol, finder.UNCERTAIN)
+    # Every prediction by the secant first, a cluster's members too (predictions
+    # that settle on one root are caught below and go to the pencil): the
+    # launcher's pairs 1e-4 apart at 5.7-21 krad/s are predicted to 2e-5, where
+    # the pencil does not converge.
+    single = list(range(predictions.size))
+    found, steps = secant_roots(finder.log_det, predictions, finder.xtol, finder.UNCERTAIN)
     roots: list[float] = []
-    starts = [float(predictions[i]) for g in groups if len(g) > 1 for i in g]
+    starts: list[float] = []
+    # A cluster member stands only where the secant converged (a multiple root's
+    # det keeps its sign: the secant creeps to the rounding floor there instead).
+    in_cluster = np.zeros(predictions.size, dtype=bool)
+    for group in _clusters(predictions):
+        in_cluster[group] = len(group) > 1
     settled = np.array([not np.isnan(r) and abs(r - predictions[i]) <= 0.5 * _gap(predictions, i)
-                        for i, r in zip(single, found)], dtype=bool)
+                        and (not in_cluster[i] or step <= finder.xtol)
+                        for i, r, step in zip(single, found, steps)], dtype=bool)
     for a in np.flatnonzero(settled):  # two predictions that settled on one root: neither stands
         twins = settled & (np.abs(found - found[a]) <= finder.SAME_ROOT * found[a])
         if twins.sum() > 1:
@@ -183,12 +192,21 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
     # roots closer than its contour sees (random loops 57: 40th and 41st 9.7e-6
     # apart, certified as one double root): the segment search decides those,
     # between the settled roots around them.
-    troubled = []
-    for start, (root, _) in zip(starts, finder.polish(starts)):
-        if root is None or any(abs(r - root) <= finder.SAME_ROOT * root for r in roots):
-            troubled.append(start)
-        else:
+    troubled, partners = [], []
+    for start, (root, offsets) in zip(starts, finder.polish(starts)):
+        if root is not None and not _known(root, roots, finder.SAME_ROOT):
             roots.append(root)
+        elif root is None:
+            troubled.append(start)
+        else:  # landed on a root already found: its pencil's next offset points at the partner
+            partner = _partner(root, offsets, finder.SAME_ROOT)
+            (partners if partner is not None else troubled).append((start, partner) if partner else start)
+    if partners:
+        for (start, _), (root, _) in zip(partners, finder.polish([p for _, p in partners])):
+            if root is not None and not _known(root, roots, finder.SAME_ROOT):
+                roots.append(root)
+            else:
+                troubled.append(start)
     roots = sorted(roots)
     for lo, hi in _intervals_around(troubled, roots, predictions):
         try:
@@ -230,6 +248,18 @@ def _repaired(finder, roots: list[float], lo: float, hi: float, depth: int):
     middle = float(np.sqrt(inside[len(inside) // 2 - 1] * inside[len(inside) // 2]))
     roots = _repaired(finder, roots, lo, middle, depth - 1)
     return None if roots is None else _repaired(finder, roots, middle, hi, depth - 1)
+
+
+def _known(root: float, roots: list[float], same: float) -> bool:
+    """True if ``root`` is within ``same`` (relative) of one of ``roots``."""
+    return any(abs(r - root) <= same * root for r in roots)
+
+
+def _partner(root: float, offsets: np.ndarray, same: float) -> float | None:
+    """The nearest other root the pencil at ``root`` sees (its smallest real offset
+    beyond ``same``, relative), or None."""
+    real = offsets[(np.abs(offsets.imag) <= 1e-6 * np.abs(offsets)) & (np.abs(offsets) > same * root)].real
+    return float(root - real[np.argmin(np.abs(real))]) if real.size else None
 
 
 def _intervals_around(troubled: list[float], roots: list[float], predictions: np.ndarray) -> list[tuple]:

@@ -56,7 +56,9 @@ PROBES = (0.07310, 0.19137, 0.53)
 def characteristic_frequency(topology) -> float:
     """A frequency of the model's own scale, rad/s, from its elements alone.
 
-    The lowest of: each beam's bending scale √(E I_min / ρA) / L², and
+    The lowest of: each beam's bending scale √(E I_min / ρA) / S², with S the
+    length of all beams together (a chain of 1000 short beams bends as one long
+    beam; its pieces' own scale put the probes where Ū_all overflows), and
     √(k / m) for each spring's softest finite translation k against the
     model's whole mass m. It moves with the model's units and size, so that
     probes at multiples of it sit at the same place among the model's own
@@ -66,8 +68,9 @@ def characteristic_frequency(topology) -> float:
     """
     records = [element.record for element in topology.elements if element.record is not None]
     mass = sum(record.mass for record in records if record.kind in ("rigid", "beam"))
-    scales = [np.sqrt(record.E * min(record.Iy, record.Iz) / (record.rho * record.A)) / record.length ** 2
-              for record in records if record.kind == "beam" and record.rho > 0]
+    beams = [record for record in records if record.kind == "beam" and record.rho > 0]
+    span = sum(beam.length for beam in beams)  # a chain of short beams bends as one long one
+    scales = [np.sqrt(beam.E * min(beam.Iy, beam.Iz) / (beam.rho * beam.A)) / span ** 2 for beam in beams]
     for record in records:
         if record.kind == "spring" and mass > 0:
             finite = record.k[:3][np.isfinite(record.k[:3])]

@@ -33,6 +33,10 @@ from linmstmm.model import Model
 #: Radians of a bending wave per element of the predicting mesh: its frequencies are
 #: then high by about 1/720 relative, well inside the secant's reach.
 WAVE_PER_ELEMENT = 1.0
+#: Unknowns of the predicting FE model beyond which there is no prediction (and the
+#: scan-based search runs): its dense eigenproblem grows as their cube, and a chain
+#: of 1000 bodies took 3.5 s to predict what the search finds in 0.1 s.
+MAX_UNKNOWNS = 1500
 #: Elements per beam the predicting mesh may take.
 MAX_ELEMENTS = 64
 #: Predictions closer than this (relative) are a cluster, polished together by
@@ -56,10 +60,14 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2) -> 
     The lowest as many as the FE model has rigid-body modes are theirs, and dropped
     (a threshold relative to the largest would drop a soft strip's first bending
     modes with them).
-    Returns (m,) ascending, m <= count (fewer if the model has fewer).
+    Returns (m,) ascending, m <= count (fewer if the model has fewer); none for
+    a model of more than MAX_UNKNOWNS unknowns.
     """
     from linmstmm.fe import assemble
 
+    nodes = len(model.points) + len(model.rigids) + (elements_per_beam - 1) * len(model.beams)
+    if 6 * nodes > MAX_UNKNOWNS:  # a dense solve would cost more than the search it saves
+        return np.zeros(0)
     fe = assemble(model, elements_per_beam)
     K, M = fe.K.toarray(), fe.M.toarray()
     wanted = min(count + fe.rigid_modes.shape[1], K.shape[0]) - 1

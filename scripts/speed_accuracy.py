@@ -208,7 +208,7 @@ def merged_labels(x, y, labels, spans, near: float = 0.04) -> list:
 
 
 def plot_trade(points, title: str, path: Path, time_target: float | None = None) -> None:
-    fig, ax = plt.subplots(figsize=(10, 6.5))
+    fig, ax = plt.subplots(figsize=(12.5, 6.5))
     drawn = [p for p in points if np.isfinite(p["seconds"])]
     y_of = lambda p: max(p["error"], ERROR_FLOOR) if np.isfinite(p["error"]) else 1.0  # noqa: E731
     spans = tuple(np.log10(max(v) / min(v)) or 1.0 for v in ([p["seconds"] for p in drawn], [y_of(p) for p in drawn]))
@@ -220,9 +220,10 @@ def plot_trade(points, title: str, path: Path, time_target: float | None = None)
         y = [y_of(p) for p in chosen]
         ax.plot(x, y, label=family, alpha=0.85, **style)
         if family in LABELLED:
+            below = family == "FE automatic"  # apart from the FE fixed-mesh labels, which sit above
             for xi, yi, text in merged_labels(x, y, [short_label(p) for p in chosen], spans):
-                ax.annotate(text, (xi, yi), textcoords="offset points", xytext=(4, 4), fontsize=7,
-                            color=style["color"])
+                ax.annotate(text, (xi, yi), textcoords="offset points", xytext=(5, -11 if below else 4),
+                            fontsize=7, color=style["color"])
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.axhline(TARGET_ERROR, color="grey", ls=":", lw=1)
@@ -235,13 +236,13 @@ def plot_trade(points, title: str, path: Path, time_target: float | None = None)
     ax.set_ylabel(f"max relative error, first {COUNT} frequencies")
     ax.set_title(title, fontsize=11)
     ax.grid(True, which="major", alpha=0.3)
-    ax.legend(fontsize=8, loc="best")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     failed = [p["setting"] for p in points if not np.isfinite(p["seconds"])]
     fig.text(0.01, 0.01, f"errors ≤ {ERROR_FLOOR:.0e} are drawn on the grey band (the references' resolution); "
-             "an incomplete solve is drawn at 1; hollow markers: the same settings on one BLAS thread; "
-             "MSTMM settings: see the table"
+             "an incomplete solve is drawn at 1;\nhollow markers: the same settings on one BLAS thread; "
+             "the MSTMM settings of each point are in the report's table"
              + (f"; raised an error (not drawn): {', '.join(failed)}" if failed else ""), fontsize=7, color="0.4")
-    fig.tight_layout(rect=(0, 0.02, 1, 1))
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
@@ -299,31 +300,37 @@ def exponent(rows, key, n_min=100) -> float:
     return float(np.polyfit(n, t, 1)[0])
 
 
+def slope(rows, key) -> str:
+    """`` (p=…)``: the fitted exponent of ``key`` for a legend, or nothing when too few sizes have it."""
+    p = exponent(rows, key)
+    return f" (p={p:.2f})" if np.isfinite(p) else ""
+
+
 def plot_scaling(springs, beams, path: Path) -> None:
     fig, (left, right) = plt.subplots(1, 2, figsize=(13, 7.5))
     for rows, name, colour in ((springs, "spring–mass chain", "tab:blue"), (beams, "beam chain", "tab:red")):
         n = [r["n"] for r in rows]
         left.plot(n, [r["det_batch_cpu"] for r in rows], "o-", color=colour,
-                  label=f"{name}: batch of 64, per frequency (p={exponent(rows, 'det_batch_cpu'):.2f})")
+                  label=f"{name}: batch of 64, per frequency{slope(rows, 'det_batch_cpu')}")
         left.plot(n, [r["det_single_cpu"] for r in rows], "s--", color=colour, alpha=0.7,
-                  label=f"{name}: single frequency (p={exponent(rows, 'det_single_cpu'):.2f})")
+                  label=f"{name}: single frequency{slope(rows, 'det_single_cpu')}")
+        failed = [f"{r['n']:,}" for r in rows if "solve_failure" in r]
         right.plot(n, [r["solve"] for r in rows], "o-", color=colour,
-                   label=f"{name}: MSTMM natural_frequencies (p={exponent(rows, 'solve'):.2f})")
+                   label=f"{name}: MSTMM natural_frequencies{slope(rows, 'solve')}"
+                         + (f"; raised an error at N = {', '.join(failed)}" if failed else ""))
         right.plot(n, [r["build"] for r in rows], ":", color=colour, alpha=0.8,
-                   label=f"{name}: of which topology + deduction build (p={exponent(rows, 'build'):.2f})")
+                   label=f"{name}: of which topology + deduction build{slope(rows, 'build')}")
         fe_label = "FE, 1 element per beam (coarse)" if rows is beams else "FE (exact for springs)"
         right.plot(n, [r["fe"] for r in rows], "^--", color=colour, alpha=0.6,
-                   label=f"{name}: {fe_label} (p={exponent(rows, 'fe'):.2f})")
+                   label=f"{name}: {fe_label}{slope(rows, 'fe')}")
         auto = [r for r in rows if "fe_auto" in r]
         if auto:
             right.plot([r["n"] for r in auto], [r["fe_auto"] for r in auto], "v-.", color="tab:orange",
-                       label=f"{name}: FE automatic refinement (p={exponent(auto, 'fe_auto'):.2f})")
+                       label=f"{name}: FE automatic refinement{slope(auto, 'fe_auto')}")
     all_n = np.array(sorted({r["n"] for r in springs + beams}), float)
     anchor = springs[0]["det_batch_cpu"] * all_n / all_n[0]
     left.plot(all_n, anchor, color="0.6", lw=0.8, label="slope 1 (linear)")
-    right.axhline(2.0, color="grey", ls="--", lw=1)
-    right.text(all_n[0], 2.0, " 2 s target (10,000 bodies, 20 frequencies)", va="bottom", ha="left", fontsize=8,
-               color="grey")
+    right.axhline(2.0, color="grey", ls="--", lw=1, label="2 s target (10,000 bodies, 20 frequencies)")
     left.set_title("one stable determinant evaluation, Deduction.log_det (CPU time, best of runs)", fontsize=10)
     left.set_ylabel("CPU seconds per frequency")
     right.set_title(f"full solve, first {springs[0].get('count', 20)} frequencies (wall time)", fontsize=10)

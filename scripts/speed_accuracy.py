@@ -178,7 +178,7 @@ def short_label(point) -> str:
 LABELLED = ("FE fixed mesh", "FE automatic", "MSTMM mpmath")
 
 
-def merged_labels(x, y, labels, spans, near: float = 0.04) -> list:
+def merged_labels(x, y, labels, spans, near: float = 0.02) -> list:
     """One label per run of consecutive points that would print on top of each other.
 
     Parameters

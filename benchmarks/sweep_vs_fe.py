@@ -1,4 +1,4 @@
-"""Random models against the FE route: the sweep behind the closing notes of issue 4.
+"""Random models against the FE route: a sweep over many random models and kinds.
 
     python benchmarks/sweep_vs_fe.py --modes 80 --seeds 0 32 [--kinds ring loops] [--digits 20]
 

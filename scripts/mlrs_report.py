@@ -1,19 +1,21 @@
-"""Regenerate reports/mlrs.md and reports/figures/mlrs_*.png (issue 6, item 3).
+"""Regenerate reports/mlrs.md and reports/figures/mlrs_*.png.
 
     python scripts/mlrs_report.py
 
 (run from anywhere; paths are taken relative to the repository). The report
-on the MLRS-style launcher of models/mlrs/ (seed 003):
+on the MLRS-style launcher of models/mlrs/, whose topology follows the launcher
+paper (Rui et al., "Study on the vibration characteristics of a complex
+multiple launch rocket system", docs/method.md):
 
-1. the model, its topology figure (root = the muzzle, as in the seed) and the
+1. the model, its topology figure (root = the muzzle, as in the paper) and the
    deduced block structure of U_all;
 2. the first ten natural frequencies by the MSTMM and by the FE route, with
-   the seed's Table 1 beside them for orientation;
+   the paper's Table 1 beside them for orientation;
 3. the first six mode shapes, one figure each;
 4. the firing-scene sweep (tube l = 1 … 18, all other tubes loaded, and a
    salvo in slot order), with the time of the sweep with and without warm
    start;
-5. a timing table like the seed's Table 2: MSTMM against the FE route at
+5. a timing table like the paper's Table 2: MSTMM against the FE route at
    equal accuracy (first ten frequencies to 1e-9 relative), measured side by
    side in this run, best of five.
 
@@ -55,11 +57,12 @@ REPORT = REPO / "reports" / "mlrs.md"
 FIGURES = REPO / "reports" / "figures"
 COMMAND = "python scripts/mlrs_report.py"
 
-#: Seed 003, Table 1: modal test and the seed's own MSTMM (mode 5 has no MSTMM value).
-SEED_TEST_HZ = (2.77, 2.99, 3.94, 4.25, 5.01, 5.23)
-SEED_MSTMM_HZ = (2.76, 2.99, 3.96, 4.32, None, 5.33)
-#: Seed 003, Table 2: computational time, s.
-SEED_ANSYS_S, SEED_MSTMM_S = 11.06, 0.17
+#: The launcher paper (Rui et al.), Table 1: its modal test and its own MSTMM, Hz
+#: (mode 5 has no MSTMM value).
+PAPER_TEST_HZ = (2.77, 2.99, 3.94, 4.25, 5.01, 5.23)
+PAPER_MSTMM_HZ = (2.76, 2.99, 3.96, 4.32, None, 5.33)
+#: The launcher paper, Table 2: computational time, s.
+PAPER_ANSYS_S, PAPER_MSTMM_S = 11.06, 0.17
 
 COUNT = 10          # frequencies in the table and the timing
 MODES = 6           # mode shapes drawn, frequencies per scene
@@ -128,7 +131,7 @@ def frequency_rows(model, count: int = COUNT):
 
     Returns (rows, mstmm, fe): rows is a list of dicts with keys mode,
     mstmm, fe, fe_error (the FE route's own error estimate), difference
-    ((MSTMM − FE) / FE), seed_test, seed_mstmm (None beyond the seed's six).
+    ((MSTMM − FE) / FE), paper_test, paper_mstmm (None beyond the paper's six).
     MSTMM: natural_frequencies (float64 defaults); FE: automatic refinement
     to rtol = 1e-9.
     """
@@ -138,24 +141,24 @@ def frequency_rows(model, count: int = COUNT):
     for i, (f, g) in enumerate(zip(mstmm.frequencies_hz, fe.frequencies_hz)):
         rows.append(dict(mode=i + 1, mstmm=float(f), fe=float(g), fe_error=float(fe.error_estimate[i]),
                          difference=float((f - g) / g),
-                         seed_test=SEED_TEST_HZ[i] if i < len(SEED_TEST_HZ) else None,
-                         seed_mstmm=SEED_MSTMM_HZ[i] if i < len(SEED_MSTMM_HZ) else None))
+                         paper_test=PAPER_TEST_HZ[i] if i < len(PAPER_TEST_HZ) else None,
+                         paper_mstmm=PAPER_MSTMM_HZ[i] if i < len(PAPER_MSTMM_HZ) else None))
     return rows, mstmm, fe
 
 
 def frequency_table(rows) -> str:
-    """The frequency table in markdown, in the style of the seed's Table 1."""
-    def seed(value, digits=2):
+    """The frequency table in markdown, in the style of the paper's Table 1."""
+    def paper(value, digits=2):
         return "–" if value is None else f"{value:.{digits}f}"
 
     lines = ["| mode | MSTMM [Hz] | FE route [Hz] | relative difference (MSTMM − FE) / FE | "
-             "seed test [Hz] | seed MSTMM [Hz] | ours vs seed test [%] |",
+             "paper's test [Hz] | paper's MSTMM [Hz] | ours vs paper's test [%] |",
              "|:---:|---:|---:|---:|---:|---:|---:|"]
     for row in rows:
-        versus = ("" if row["seed_test"] is None
-                  else f"{100 * (row['mstmm'] - row['seed_test']) / row['seed_test']:+.1f}")
+        versus = ("" if row["paper_test"] is None
+                  else f"{100 * (row['mstmm'] - row['paper_test']) / row['paper_test']:+.1f}")
         lines.append(f"| {row['mode']} | {row['mstmm']:.6f} | {row['fe']:.6f} | {row['difference']:+.1e} | "
-                     f"{seed(row['seed_test'])} | {seed(row['seed_mstmm'])} | {versus} |")
+                     f"{paper(row['paper_test'])} | {paper(row['paper_mstmm'])} | {versus} |")
     return "\n".join(lines)
 
 
@@ -488,7 +491,9 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
     add("")
     add(f"`models/mlrs/mlrs.toml` models a {mass / 1e3:.1f} t 6×6 multiple launch rocket system in "
         "the firing position (suspension locked, four stabiliser jacks lowered, tubes at 10° "
-        "elevation) with the topology of the seed's Fig. 1: six chains of tyre (elastic hinge), "
+        "elevation) with the topology of Fig. 1 of the launcher paper (Rui et al., *Study on "
+        "the vibration characteristics of a complex multiple launch rocket system*, listed in "
+        "docs/method.md; \"the paper\" below): six chains of tyre (elastic hinge), "
         "axle and wheel (rigid body) and locked suspension (elastic hinge) feed the chassis "
         f"({rigid['chassis'].mass / 1e3:.1f} t, one body with six inputs); the slewing ring is an "
         f"elastic hinge to the turntable ({rigid['turntable'].mass / 1e3:.1f} t); trunnions and "
@@ -503,12 +508,12 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
         f"(its slot in the {bundle.rows} × {bundle.columns} bundle) is flexible, its points move "
         "to that slot, and the other seventeen are rigid masses in the cradle "
         "(`linmstmm.scenes`, with `models/mlrs/bundle.toml`); the model file is scene 1. "
-        "Its parameters are **plausible values for a ~20 t truck launcher, not the seed's data** "
-        "(the seed publishes none): masses, geometry and most stiffnesses are set from the "
+        "Its parameters are **plausible values for a ~20 t truck launcher, not the paper's data** "
+        "(the paper publishes none): masses, geometry and most stiffnesses are set from the "
         "hardware as the file's comments explain, and only the honestly uncertain stiffnesses — "
         "stabiliser jacks on soil, the locked suspension, the slewing ring's tilt and traverse "
         "stiffness and the elevating cylinder — were tuned so the first six frequencies fall in "
-        "the band of the seed's modal test. Nothing here measures the seed's launcher.")
+        "the band of the paper's modal test. Nothing here measures the paper's launcher.")
     add("")
     add(f"![topology of the MLRS-style launcher, root = muzzle]({rel(FIGURES / 'mlrs_topology.png')})")
     add("")
@@ -519,18 +524,18 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
     add("```")
     add("")
     tips = len(report.tips)
-    add(f"Compared with the seed's U_all: the same eight boundary ends (the muzzle as root, "
+    add(f"Compared with the paper's U_all: the same eight boundary ends (the muzzle as root, "
         f"{tips} tips: six ground points and the breech's free end) and one loop, so Ū_all is "
-        f"{report.ubar_order}×{report.ubar_order} = 6 × 8 + 12 as in the seed; the block layout "
-        f"is {len(report.block_rows)} × {len(report.block_columns)} blocks like the seed's 9 × 9, "
+        f"{report.ubar_order}×{report.ubar_order} = 6 × 8 + 12 as in the paper; the block layout "
+        f"is {len(report.block_rows)} × {len(report.block_columns)} blocks like the paper's 9 × 9, "
         "with the same chassis rows (G_{tyre1-chassis} in the first ground column and "
         "G_{tyre k-chassis} on the diagonal). The rest differs where the two deductions make "
         "different choices: our columns put the breech before the ground points; the "
-        "multi-input elements at the two tube supports are massless junctions (the seed makes "
+        "multi-input elements at the two tube supports are massless junctions (the paper makes "
         "the beams 27+5l, 28+5l the multi-input elements, so its last two rows are theirs); and "
         "both cut the loop between the cradle and a tube support (ours at the rear mount, the "
-        "seed's Z_{23,25+5l} at hinge 25+5l), but our supplement equation puts C on the "
-        "support's side where the seed writes it on the cradle's (its main-row entry "
+        "paper's Z_{23,25+5l} at hinge 25+5l), but our supplement equation puts C on the "
+        "support's side where the paper writes it on the cradle's (its main-row entry "
         "T_{23-28+5l} C + T_{25+5l-28+5l}), so the cradle and tube rows carry their loop "
         "entries in different places.")
     add("")
@@ -543,8 +548,8 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
         f"{mstmm.rigid_body_modes} rigid-body modes). FE route: `fe_frequencies(model, count={COUNT})`, "
         f"mesh doubling with Richardson extrapolation to rtol = 1e-9 (finest mesh "
         f"{fe.elements_per_beam} elements per beam, {fe.n_dof} DOFs; largest own error estimate "
-        f"{np.max(fe.error_estimate):.1e}). The seed's Table 1 is beside ours **for orientation "
-        "only: the seed's values belong to a different, real launcher**, and our stiffnesses were "
+        f"{np.max(fe.error_estimate):.1e}). The paper's Table 1 is beside ours **for orientation "
+        "only: the paper's values belong to a different, real launcher**, and our stiffnesses were "
         "tuned only roughly towards its test band, so agreement is not expected to be exact "
         "(mode by mode the shapes need not even correspond).")
     add("")
@@ -554,8 +559,8 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
     add(f"Largest |MSTMM − FE| / FE: {max(abs(r['difference']) for r in rows):.1e}. "
         f"The first six lie between {first_six.min():.2f} and {first_six.max():.2f} Hz "
         f"({'inside' if first_six.min() > 2 and first_six.max() < 6 else 'NOT inside'} the band "
-        "2–6 Hz of issue 6); the seed's test band is 2.77–5.23 Hz. Modes 7–10 have no seed "
-        "counterpart.")
+        "2–6 Hz the model was built for); the paper's test band is 2.77–5.23 Hz. Modes 7–10 "
+        "have no counterpart in the paper.")
     add("")
 
     # ---- modes
@@ -682,8 +687,8 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
          f"meshes 4 … {r['result'].elements_per_beam} per beam, finest {r['result'].n_dof} DOFs", r, r1)
     line(f"FE route, coarsest fixed mesh reaching 1e-9 ({mesh} elements per beam, "
          "`estimate_error=False`)", f"{mesh_dof} DOFs", x, x1)
-    add(f"| *seed, Table 2: ANSYS* | *not stated* | *{SEED_ANSYS_S}* | | | | | *65 : 1* |")
-    add(f"| *seed, Table 2: MSTMM* | *Ū_all 60×60* | *{SEED_MSTMM_S}* | | | | | *1 : 1* |")
+    add(f"| *paper, Table 2: ANSYS* | *not stated* | *{PAPER_ANSYS_S}* | | | | | *65 : 1* |")
+    add(f"| *paper, Table 2: MSTMM* | *Ū_all 60×60* | *{PAPER_MSTMM_S}* | | | | | *1 : 1* |")
     add("")
     near = [f"{n}: {e:.1e}" for n, _, e in tried if n >= max(1, mesh - 4)]
     add(f"The fixed mesh was found by trying 1, 2, … elements per beam against the reference "
@@ -708,7 +713,7 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
         f"{m1['wall'] / x1['wall']:.0f} times faster than the MSTMM (one BLAS thread). The "
         "default-threading FE numbers are the fragile ones: the FE route's sparse and small "
         "dense linear algebra runs on all OpenBLAS threads, which on this 2-core machine, "
-        "shared with other sessions' jobs, largely wait for each other — in this run the FE "
+        "shared with other users' jobs, largely wait for each other — in this run the FE "
         f"refinement took {min(r['walls']):.3f}–{max(r['walls']):.3f} s per round and "
         f"{r['cpu']:.3f} s of CPU with default threading against "
         f"{min(r1['walls']):.3f}–{max(r1['walls']):.3f} s and {r1['cpu']:.3f} s of CPU on one "
@@ -717,16 +722,16 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
         f"{min(m1['walls']):.3f}–{max(m1['walls']):.3f} s on one thread. The one-thread column "
         "is the fair comparison of the two algorithms on this machine.")
     add("")
-    add("So we do **not** reproduce the seed's 65 : 1, and the reason is the size of the FE "
+    add("So we do **not** reproduce the paper's 65 : 1, and the reason is the size of the FE "
         "model: the FE route here discretises exactly the MSTMM's idealisation — "
         f"{len(model.rigids)} rigid bodies as 6-DOF nodes, {len(model.springs)} massless springs "
         f"and only the two tube beams meshed — so {mesh_dof} DOFs already reach 1e-9 and even the "
         f"refinement ends at {r['result'].n_dof}; a sparse eigen-solve of that size takes "
-        "milliseconds. The seed's 11.06 s are those of ANSYS, a general-purpose package; the "
-        "seed says \"the same dynamics model\" but states neither the model's size nor what "
+        "milliseconds. The paper's 11.06 s are those of ANSYS, a general-purpose package; the "
+        "paper says \"the same dynamics model\" but states neither the model's size nor what "
         "the time includes, and a launcher model built in such a package is normally meshed far "
         "finer than two beams, with the package's set-up, assembly and I/O on top — that, not a "
-        f"{r['result'].n_dof}-DOF model, is what its 65 : 1 compares against. (The seed's text "
+        f"{r['result'].n_dof}-DOF model, is what its 65 : 1 compares against. (The paper's text "
         "also claims \"more than 1000 times\"; its Table 2 gives 11.06 / 0.17 = 65.) The "
         "MSTMM's cost, by contrast, does not depend on a mesh: it is the evaluation of the "
         f"{mstmm.ubar_order}×{mstmm.ubar_order} determinant at many trial frequencies (a scan "
@@ -739,7 +744,7 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
         f"OPENBLAS_CORETYPE={os.environ.get('OPENBLAS_CORETYPE', 'unset')}. Code: git {git_state()}. "
         "Load average (1 / 5 / 15 min): "
         + "; ".join(f"{when}: {value}" for when, value in loads.items())
-        + ". The machine is shared with other sessions' work; a load near or above 2 on these "
+        + ". The machine is shared with other users' work; a load near or above 2 on these "
         "2 cores inflates wall times, and best-of-N removes only part of that: timings vary with "
         "load from run to run, so read differences under ~30 % as noise. CPU time below wall "
         "time means the process waited for a core.")

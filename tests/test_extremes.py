@@ -1,4 +1,4 @@
-"""Numerical stability at the extremes (issue 4), each against a closed form.
+"""Numerical stability at the extremes, each against a closed form.
 
 Discrete references are the eigenvalues of the K, M matrices written by hand
 in the test and solved in mpmath at 50 digits (independent of the transfer

@@ -183,7 +183,7 @@ def test_sweep_over_a_salvo(model, mstmm):
 
 @pytest.mark.parametrize("fired", [None, salvo], ids=["all other tubes loaded", "salvo"])
 def test_every_scene_agrees_with_finite_elements(model, fired):
-    """Issue 6: the first ten frequencies of all 18 scenes agree with the FE route to 1e-7."""
+    """The first ten frequencies of all 18 scenes agree with the FE route to 1e-7."""
     from linmstmm.fe import fe_frequencies
 
     sweep = scene_sweep(model, count=10, fired=fired)

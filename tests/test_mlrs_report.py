@@ -29,7 +29,7 @@ def model(report):
     return report.load()
 
 
-def test_structure_text_is_the_seeds_shape(report, model):
+def test_structure_text_is_the_papers_shape(report, model):
     topology, structure = report.structure(model)
     assert structure.root.label == "muzzle"
     assert len(structure.tips) == 7 and len(structure.cuts) == 1
@@ -46,11 +46,11 @@ def test_frequency_table(report, model):
     assert [row["mode"] for row in rows] == [1, 2, 3, 4, 5, 6]
     assert all(abs(row["difference"]) < 1e-7 for row in rows)
     assert all(2.0 < row["mstmm"] < 6.0 for row in rows)
-    assert [row["seed_test"] for row in rows] == list(report.SEED_TEST_HZ)
+    assert [row["paper_test"] for row in rows] == list(report.PAPER_TEST_HZ)
     table = report.frequency_table(rows).splitlines()
     assert len(table) == 2 + 6
     assert all(line.count("|") == table[0].count("|") for line in table)
-    assert "| 5 |" in table[6] and "| 5.01 | – |" in table[6]  # the seed has no MSTMM value for mode 5
+    assert "| 5 |" in table[6] and "| 5.01 | – |" in table[6]  # the paper has no MSTMM value for mode 5
 
 
 def test_mode_descriptions_cover_the_drawn_modes(report):

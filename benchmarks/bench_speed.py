@@ -1,0 +1,218 @@
+"""Speed of the transfer-matrix solve against the FE route on the same files, measured in one run.
+
+    python benchmarks/bench_speed.py [--quick] [--out reports]
+
+Writes ``OUT/speed.md`` and ``OUT/figures/speed_vs_fe.png`` (``--quick``: fewer
+counts and rounds, into a temporary folder unless ``--out`` is given). Every
+figure is a ratio or a time from this one run; nothing is a unit test.
+
+Measured per model (the launcher-size files in models/):
+
+* one evaluation of det Ū_all, warm: the compiled kernels at a single ω and
+  per ω in a batch of 512, and the numpy carry likewise;
+* the first N natural frequencies (N = 10, 20, 60, 100) by
+  ``natural_frequencies(engine="compiled")``, warm: wall time, evaluations of
+  det Ū_all per root, and the largest relative difference from the FE route's
+  automatic refinement at rtol 1e-10 (an independent check);
+* the FE route on the coarsest mesh (elements per beam doubled from 1, at most 128) whose
+  first N frequencies are within 1e-9 of the transfer-matrix ones (1e-6 for
+  N >= 60; where even 128 elements do not reach it, that mesh and its
+  difference are reported): dense LAPACK ``eigh(K, M, subset_by_index=…)`` (up
+  to DENSE_LIMIT unknowns) and sparse shift-invert ``eigsh``, assembly
+  excluded, the faster of the two taken as the FE baseline; and the ``fe``
+  command's own automatic refinement (``fe_frequencies``);
+* the start-up of a new process running the README's main command.
+"""
+from __future__ import annotations
+
+import argparse
+import subprocess
+import sys
+import tempfile
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+import numpy as np
+import scipy.linalg as la
+import scipy.sparse.linalg as sla
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+from linmstmm.deduction import Deduction  # noqa: E402
+from linmstmm.determinant import CompiledDeterminant, NumpyDeterminant, load_kernels  # noqa: E402
+from linmstmm.fe import assemble, fe_frequencies  # noqa: E402
+from linmstmm.model import load_model  # noqa: E402
+from linmstmm.nullspace import release_indeterminate  # noqa: E402
+from linmstmm.solve import natural_frequencies  # noqa: E402
+from linmstmm.threads import one_blas_thread  # noqa: E402
+from linmstmm.topology import build_topology  # noqa: E402
+
+#: Degrees of freedom above which the dense eigensolver is not timed (sparse eigsh wins there).
+DENSE_LIMIT = 2000
+MODELS = {"launcher (models/mlrs/mlrs.toml)": REPO / "models" / "mlrs" / "mlrs.toml",
+          "launcher 2 (models/launcher2/launcher2.toml)": REPO / "models" / "launcher2" / "launcher2.toml"}
+
+
+def best_time(function, rounds: int) -> tuple[float, object]:
+    """(best wall time s, last result) over ``rounds`` calls after one warm-up."""
+    result = function()
+    best = np.inf
+    for _ in range(rounds):
+        start = time.perf_counter()
+        result = function()
+        best = min(best, time.perf_counter() - start)
+    return best, result
+
+
+def evaluation_costs(model, rounds: int) -> dict:
+    """Seconds per evaluation of det Ū_all: compiled and numpy, single ω and batched."""
+    deduction = Deduction(build_topology(model))
+    release_indeterminate(deduction)
+    compiled, reference = CompiledDeterminant(deduction), NumpyDeterminant(deduction)
+    omegas = np.geomspace(1.0, 2e4, 512)
+    singles = omegas[::8]
+    costs = {}
+    for name, engine in (("compiled", compiled), ("numpy", reference)):
+        single = best_time(lambda: [engine.log_det(w) for w in singles], rounds)[0] / singles.size
+        batch = best_time(lambda: engine.log_det(omegas), rounds)[0] / omegas.size
+        costs[name] = (single, batch)
+    return costs
+
+
+def rel_diff(a, b) -> float:
+    n = min(len(a), len(b))
+    return float(np.max(np.abs(np.asarray(a[:n]) / np.asarray(b[:n]) - 1))) if n else np.nan
+
+
+def fe_eigensolves(model, count: int, target: np.ndarray, tolerance: float, rounds: int) -> dict:
+    """The FE route's eigensolvers on the coarsest mesh within ``tolerance`` of ``target`` (Hz)."""
+    for per_beam in (1, 2, 4, 8, 16, 32, 64, 128):
+        fe = assemble(model, per_beam)
+        K, M = fe.K.tocsc(), fe.M.tocsc()
+        rigid = fe.rigid_modes.shape[1]
+        wanted = min(count + rigid, K.shape[0] - 1)
+        dense_K, dense_M = K.toarray(), M.toarray()
+        try:
+            lam = la.eigh(dense_K, dense_M, eigvals_only=True, subset_by_index=[0, wanted - 1])
+        except np.linalg.LinAlgError:
+            return {"note": f"M singular at {per_beam} elements per beam: no dense eigh"}
+        found = np.sqrt(np.abs(lam[rigid:])) / (2 * np.pi)
+        if rel_diff(found, target) <= tolerance or per_beam == 128:
+            break
+    eigh_time = (best_time(lambda: la.eigh(dense_K, dense_M, eigvals_only=True,
+                                           subset_by_index=[0, wanted - 1]), rounds)[0]
+                 if K.shape[0] <= DENSE_LIMIT else np.nan)
+    shift = -0.5 * (2 * np.pi * target[0]) ** 2
+    eigsh_time = best_time(lambda: sla.eigsh(K, k=wanted, M=M, sigma=shift, which="LM",
+                                             return_eigenvectors=False), rounds)[0]
+    return {"per_beam": per_beam, "dof": K.shape[0], "error": rel_diff(found, target),
+            "eigh": eigh_time, "eigsh": eigsh_time}
+
+
+def startup(command: list[str], rounds: int) -> float:
+    """Median wall time of a new process running ``command`` (s)."""
+    times = []
+    for _ in range(rounds + 1):
+        start = time.perf_counter()
+        subprocess.run(command, cwd=REPO, capture_output=True, check=True)
+        times.append(time.perf_counter() - start)
+    return float(np.median(times[1:]))
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="counts 10 and 20 only, fewer rounds")
+    parser.add_argument("--out", type=Path, default=None, help="folder for speed.md and figures/ "
+                        "(default reports/, or a temporary folder with --quick)")
+    args = parser.parse_args()
+    out = args.out or (Path(tempfile.mkdtemp()) if args.quick else REPO / "reports")
+    counts = (10, 20) if args.quick else (10, 20, 60, 100)
+    rounds = 2 if args.quick else 5
+    started = time.perf_counter()
+    load_kernels()
+    lines = [f"# Speed of the transfer-matrix solve against the FE route",
+             "",
+             f"Generated by `python benchmarks/bench_speed.py{' --quick' if args.quick else ''}` "
+             f"on {datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC. Every number below is from that one run "
+             "(best of several warm calls in one process; a second core busy with other work inflates "
+             "times, ratios much less). BLAS at one thread for both routes (`linmstmm.threads`).", ""]
+    curves = {}
+    with one_blas_thread():
+        for label, path in MODELS.items():
+            if not path.exists():
+                continue
+            model = load_model(path)
+            costs = evaluation_costs(model, rounds)
+            lines += [f"## {label}", "",
+                      "| one evaluation of det Ū_all | single ω | per ω in a batch of 512 |", "|---|---:|---:|",
+                      *[f"| {name} | {single * 1e6:.0f} µs | {batch * 1e6:.0f} µs |"
+                        for name, (single, batch) in costs.items()], "",
+                      "| first N | MSTMM (compiled) | evaluations / root | diff. from FE rtol 1e-10 | "
+                      "FE mesh (el./beam, DOF) | its diff. from MSTMM | FE dense eigh | FE eigsh | "
+                      "`fe` command | fastest FE eigensolver / MSTMM | `fe` / MSTMM |",
+                      "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+            for count in counts:
+                repeats = rounds if count <= 20 else 1
+                mstmm_time, result = best_time(lambda: natural_frequencies(model, count, engine="compiled"),
+                                               repeats)
+                fe_time, fe_result = best_time(lambda: fe_frequencies(model, count, rtol=1e-10), 1)
+                tolerance = 1e-9 if count < 60 else 1e-6
+                solves = fe_eigensolves(model, count, result.frequencies_hz, tolerance, repeats)
+                per_root = result.evaluations / max(len(result.frequencies_hz), 1)
+                fastest = np.nanmin([solves.get("eigh", np.nan), solves.get("eigsh", np.nan)])
+                lines.append(
+                    f"| {count} | {mstmm_time * 1e3:.1f} ms | {per_root:.1f} | "
+                    f"{rel_diff(result.frequencies_hz, fe_result.frequencies_hz):.1e} | "
+                    f"{solves.get('per_beam', '-')}, {solves.get('dof', '-')} | {solves.get('error', np.nan):.1e} | "
+                    f"{solves.get('eigh', np.nan) * 1e3:.1f} ms | {solves.get('eigsh', np.nan) * 1e3:.1f} ms | "
+                    f"{fe_time * 1e3:.0f} ms | **{fastest / mstmm_time:.2f}** | {fe_time / mstmm_time:.1f} |")
+                curves.setdefault(label, []).append((count, mstmm_time, solves.get("eigh", np.nan),
+                                                     solves.get("eigsh", np.nan), fe_time))
+            lines.append("")
+    command = [sys.executable, "-m", "linmstmm", "freqs", "models/mlrs/mlrs.toml"]
+    lines += ["## Start-up: a new process", "",
+              "| command | median wall time |", "|---|---:|",
+              f"| `linmstmm freqs models/mlrs/mlrs.toml` (engine auto: numpy in a new process) | "
+              f"{startup(command, rounds):.2f} s |",
+              f"| the same with `--engine compiled` (numba import and cached kernels) | "
+              f"{startup(command + ['--engine', 'compiled'], rounds):.2f} s |", ""]
+    figure = draw(curves, out / "figures" / "speed_vs_fe.png")
+    lines += [f"![time against the number of frequencies]({figure.relative_to(out).as_posix()})", "",
+              f"*Wall time against the number of frequencies asked for, both launcher models; "
+              "FE eigensolvers on the coarsest adequate mesh (assembly excluded).*", "",
+              f"Run time of this script: {time.perf_counter() - started:.0f} s."]
+    (out / "speed.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    print(out / "speed.md")
+
+
+def draw(curves: dict, path: Path) -> Path:
+    """Log-log wall time against the count, one panel per model."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig, axes = plt.subplots(1, max(len(curves), 1), figsize=(6 * max(len(curves), 1), 4.2), squeeze=False)
+    styles = [("MSTMM, compiled", "o-", 1), ("FE dense eigh (assembly excluded)", "s--", 2),
+              ("FE eigsh (assembly excluded)", "^:", 3), ("fe command (refinement)", "d-.", 4)]
+    for ax, (label, rows) in zip(axes[0], curves.items()):
+        rows = np.array(rows, dtype=float)
+        for name, style, column in styles:
+            ax.loglog(rows[:, 0], rows[:, column] * 1e3, style, label=name)
+        ax.set_xticks(rows[:, 0], [f"{int(c)}" for c in rows[:, 0]])
+        ax.minorticks_off()
+        ax.set_xlabel("natural frequencies asked for")
+        ax.set_ylabel("wall time, ms")
+        ax.set_title(label, fontsize=10)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+if __name__ == "__main__":
+    main()

@@ -48,42 +48,48 @@ def nullity(matrix: np.ndarray, tolerance: float = NULL_TOLERANCE, scales=None) 
     return int(np.sum(sigma < tolerance * sigma[0]))
 
 
-#: Generic frequencies (multiples of the model's :func:`characteristic_frequency`)
+#: Generic frequencies (multiples of the model's :func:`characteristic_frequencies`)
 #: at which the constant null space of Ū_all is sought.
 PROBES = (0.07310, 0.19137, 0.53)
 
 
-def characteristic_frequency(topology) -> float:
-    """A frequency of the model's own scale, rad/s, from its elements alone.
+def characteristic_frequencies(topology) -> list[float]:
+    """Frequencies of the model's own scale, rad/s, from its elements alone, to probe at.
 
-    The lowest of: each beam's bending scale √(E I_min / ρA) / S², with S the
-    length of all beams together (a chain of 1000 short beams bends as one long
-    beam; its pieces' own scale put the probes where Ū_all overflows), and
+    First the lowest of each beam's bending scale √(E I_min / ρA) / L² and
     √(k / m) for each spring's softest finite translation k against the
-    model's whole mass m. It moves with the model's units and size, so that
-    probes at multiples of it sit at the same place among the model's own
-    frequencies whatever the units (fixed probes at 0.7–5 rad/s sat 40 times
-    above the first mode of a launcher-size star scaled ×1000, where Ū_all's
-    conditioning hid its null space).
+    model's whole mass m; then the same with the beams' length L taken as all
+    beams together (a chain of 1000 short beams bends as one long one: its
+    pieces' own scale puts the probes where Ū_all overflows). They move with
+    the model's units and size, so probes at multiples of them sit at the same
+    place among the model's own frequencies whatever the units (fixed probes
+    at 0.7–5 rad/s sat 40 times above the first mode of a star scaled ×1000,
+    where Ū_all's conditioning hid its null space).
     """
     records = [element.record for element in topology.elements if element.record is not None]
     mass = sum(record.mass for record in records if record.kind in ("rigid", "beam"))
     beams = [record for record in records if record.kind == "beam" and record.rho > 0]
-    span = sum(beam.length for beam in beams)  # a chain of short beams bends as one long one
-    scales = [np.sqrt(beam.E * min(beam.Iy, beam.Iz) / (beam.rho * beam.A)) / span ** 2 for beam in beams]
+    springs = []
     for record in records:
         if record.kind == "spring" and mass > 0:
             finite = record.k[:3][np.isfinite(record.k[:3])]
             if finite.size:
-                scales.append(np.sqrt(finite.min() / mass))
-    return float(min(scales)) if scales else 1.0
+                springs.append(np.sqrt(finite.min() / mass))
+    span = sum(beam.length for beam in beams)
+    candidates = []
+    for length in ([beam.length for beam in beams], [span] * len(beams)):
+        scales = springs + [np.sqrt(beam.E * min(beam.Iy, beam.Iz) / (beam.rho * beam.A)) / L ** 2
+                            for beam, L in zip(beams, length)]
+        candidates.append(float(min(scales)) if scales else 1.0)
+    return list(dict.fromkeys(candidates))
 
 
 def release_indeterminate(deduction, probe=None) -> int:
     """Find and release statically indeterminate unknowns of ``deduction``.
 
     probe : rad/s, the generic frequencies to look at (default :data:`PROBES`
-    times the model's :func:`characteristic_frequency`).
+    times each of the model's :func:`characteristic_frequencies` in turn, until
+    one can be read: no overflow, no null space that moves).
 
     Redundant rigid constraints (a rigid direction fixed at both ends, ``inf``
     springs closing a loop) make Ū_all singular at every ω, with constant
@@ -93,8 +99,15 @@ def release_indeterminate(deduction, probe=None) -> int:
     Returns the number released. Raises RuntimeError for a null space that
     moves with ω (a mechanism).
     """
-    if probe is None:
-        probe = np.asarray(PROBES) * characteristic_frequency(deduction.topology)
+    if probe is None:  # the first scale whose probes can be read
+        scales = characteristic_frequencies(deduction.topology)
+        for scale in scales[:-1]:
+            try:
+                with np.errstate(over="ignore", invalid="ignore"):  # an overflowing scale is the next one's turn
+                    return release_indeterminate(deduction, np.asarray(PROBES) * scale)
+            except (RuntimeError, np.linalg.LinAlgError):
+                continue
+        probe = np.asarray(PROBES) * scales[-1]
     samples = deduction.matrix(np.asarray(probe, dtype=float))
     rows, cols = equilibration(samples[0])
     samples = rows[:, None] * samples * cols

@@ -6,21 +6,24 @@ roots are predicted first and each evaluation goes where a root is:
 
 1. **predict** — the natural frequencies of a coarse finite-element model of
    the same file (:func:`coarse_predictions`): a dense eigenproblem of a few
-   hundred unknowns, accurate to about 1e-3 and blind only to how close
-   clusters split;
-2. **polish** — each isolated prediction by the secant method on det Ū_all
+   hundred unknowns (none above MAX_UNKNOWNS), accurate to about 1e-3 for
+   the lowest and 1e-2 by the hundredth;
+2. **polish** — every prediction by the secant method on det Ū_all
    (:func:`secant_roots`: one evaluation per step, superlinear, all roots in
-   one batch per step); each prediction in a cluster by Newton on the matrix
-   pencil (:meth:`RootFinder.polish`), which steps to the nearest root however
-   close its neighbours; where two arrive at one root (a multiple root, or two
-   roots too close for float64), the segment search of :class:`RootFinder`
-   takes the interval around them, halfway to the neighbouring predictions;
+   one batch per step); a result that strays, shares its root with another,
+   or (in a cluster) only creeps to the rounding floor goes to Newton on the
+   matrix pencil (:meth:`RootFinder.polish`), and where that too lands on a
+   known root, to the pencil's partner offset and then to the segment search
+   of :class:`RootFinder` between the neighbouring predictions;
 3. **certify** — one argument-principle count of det Ū_all with the polished
-   roots divided out, from 0 to a gap above the last root wanted, must come to
-   zero (:meth:`RootFinder.confirm_no_other_zeros`). A prediction that
-   polished onto a wrong root, a missed root or a wrong multiplicity leaves a
-   non-zero count: then :func:`predicted_roots` returns None and the caller
-   runs the full search. Completeness is never taken from the predictions.
+   roots divided out, from the search's floor to a gap above the last root
+   wanted, must come to zero (:meth:`RootFinder.confirm_no_other_zeros`).
+   Where it does not (a root the coarse model ranked out of range, one found
+   twice), counts halve the range to the stretch that holds the difference and
+   the segment search fills only that (:func:`_repaired`); the count is made
+   again. Where a count cannot be made, :func:`predicted_roots` returns None
+   and the caller runs the full search. Completeness is never taken from the
+   predictions.
 """
 from __future__ import annotations
 
@@ -158,65 +161,19 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
     (a gap above the count-th, so a multiple root there comes whole).
 
     finder : the :class:`~linmstmm.roots.RootFinder` of the model (its
-    determinant, pencil and counts). predictions : (m,) rad/s ascending,
-    ideally count + 1 of them (the one above places the count's upper end in
-    a gap). Returns the roots, or None when the certifying count does not come
-    to zero or a prediction does not polish (the caller then searches).
-    Records each root's last step in ``finder.last_step``.
+    determinant, pencil, counts and segment search). predictions : (m,) rad/s,
+    a few more than ``count`` (those above place the count's upper end in a
+    gap). Returns the roots, or None where a count cannot be made or does not
+    come to zero (the caller then searches). Records each secant root's last
+    step in ``finder.last_step``.
     """
     predictions = np.sort(np.asarray(predictions, dtype=float))
     predictions = predictions[predictions > 0]
     if predictions.size < count:
         return None
-    # Every prediction by the secant first, a cluster's members too (predictions
-    # that settle on one root are caught below and go to the pencil): the
-    # launcher's pairs 1e-4 apart at 5.7-21 krad/s are predicted to 2e-5, where
-    # the pencil does not converge.
-    single = list(range(predictions.size))
-    found, steps = secant_roots(finder.log_det, predictions, finder.xtol, finder.UNCERTAIN)
-    roots: list[float] = []
-    starts: list[float] = []
-    # A cluster member stands only where the secant converged (a multiple root's
-    # det keeps its sign: the secant creeps to the rounding floor there instead).
-    in_cluster = np.zeros(predictions.size, dtype=bool)
-    for group in _clusters(predictions):
-        in_cluster[group] = len(group) > 1
-    settled = np.array([not np.isnan(r) and abs(r - predictions[i]) <= 0.5 * _gap(predictions, i)
-                        and (not in_cluster[i] or step <= finder.xtol)
-                        for i, r, step in zip(single, found, steps)], dtype=bool)
-    for a in np.flatnonzero(settled):  # two predictions that settled on one root: neither stands
-        twins = settled & (np.abs(found - found[a]) <= finder.SAME_ROOT * found[a])
-        if twins.sum() > 1:
-            settled[twins] = False
-    for i, root, step, ok in zip(single, found, steps, settled):
-        if not ok:
-            starts.append(float(predictions[i]))  # did not settle near its start, alone: the pencil decides
-            continue
-        finder.last_step[root] = step
-        roots.append(root)
-    # Each member of a cluster by Newton on the pencil (it steps to the nearest
-    # root whatever its neighbours). Members that arrive at one root would make
-    # it multiple, and the closing count cannot tell a double root from two
-    # roots closer than its contour sees (random loops 57: 40th and 41st 9.7e-6
-    # apart, certified as one double root): the segment search decides those,
-    # between the settled roots around them.
-    troubled, partners = [], []
-    for start, (root, offsets) in zip(starts, finder.polish(starts)):
-        if root is not None and not _known(root, roots, finder.SAME_ROOT):
-            roots.append(root)
-        elif root is None:
-            troubled.append(start)
-        else:  # landed on a root already found: its pencil's next offset points at the partner
-            partner = _partner(root, offsets, finder.SAME_ROOT)
-            (partners if partner is not None else troubled).append((start, partner) if partner else start)
-    if partners:
-        for (start, _), (root, _) in zip(partners, finder.polish([p for _, p in partners])):
-            if root is not None and not _known(root, roots, finder.SAME_ROOT):
-                roots.append(root)
-            else:
-                troubled.append(start)
-    roots = sorted(roots)
-    for lo, hi in _intervals_around(troubled, roots, predictions):
+    roots, unsettled = _secant_polished(finder, predictions)
+    roots, troubled = _pencil_polished(finder, roots, unsettled)
+    for lo, hi in _intervals_around(troubled, predictions):
         try:
             roots = [r for r in roots if not lo < r <= hi] + finder.segment(lo, hi)
         except RuntimeError:  # a count that cannot be made there: the full search decides
@@ -235,6 +192,56 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
         if not finder.confirm_no_other_zeros(roots, upper):
             return None
     return [r for r in roots if r <= upper]
+
+
+def _secant_polished(finder, predictions: np.ndarray) -> tuple[list[float], list[float]]:
+    """(roots, unsettled predictions): every prediction by the secant on det.
+
+    Cluster members too: the launcher's pairs 1e-4 apart at 5.7-21 krad/s are
+    predicted to 2e-5, where Newton on the pencil does not converge. A result
+    stands where it stayed within half the gap to the neighbouring prediction,
+    alone on its root, and, for a cluster member, converged to xtol (a multiple
+    root's det keeps its sign: the secant creeps to the rounding floor there).
+    """
+    found, steps = secant_roots(finder.log_det, predictions, finder.xtol, finder.UNCERTAIN)
+    in_cluster = np.zeros(predictions.size, dtype=bool)
+    for group in _clusters(predictions):
+        in_cluster[group] = len(group) > 1
+    settled = np.array([not np.isnan(root) and abs(root - predictions[i]) <= 0.5 * _gap(predictions, i)
+                        and (not in_cluster[i] or steps[i] <= finder.xtol)
+                        for i, root in enumerate(found)], dtype=bool)
+    for i in np.flatnonzero(settled):  # two that settled on one root: neither stands
+        twins = settled & (np.abs(found - found[i]) <= finder.SAME_ROOT * found[i])
+        if twins.sum() > 1:
+            settled[twins] = False
+    for root, step in zip(found[settled], steps[settled]):
+        finder.last_step[root] = step
+    return list(found[settled]), [float(p) for p in predictions[~settled]]
+
+
+def _pencil_polished(finder, roots: list[float], starts: list[float]) -> tuple[list[float], list[float]]:
+    """(roots, troubled starts): ``starts`` by Newton on the pencil, which steps to the
+    nearest root whatever its neighbours. One that lands on a root already found
+    tries the partner the pencil's next offset there points at; the rest are
+    troubled (a multiple root, or two roots closer than a count's contour sees:
+    random loops 57 had its 40th and 41st 9.7e-6 apart, certified as one double
+    root): the segment search takes the stretch around them."""
+    roots, troubled, partners = list(roots), [], []
+    for start, (root, offsets) in zip(starts, finder.polish(starts)):
+        if root is not None and not _known(root, roots, finder.SAME_ROOT):
+            roots.append(root)
+            continue
+        partner = None if root is None else _partner(root, offsets, finder.SAME_ROOT)
+        if partner is None:
+            troubled.append(start)
+        else:
+            partners.append((start, partner))
+    for (start, _), (root, _) in zip(partners, finder.polish([p for _, p in partners])):
+        if root is not None and not _known(root, roots, finder.SAME_ROOT):
+            roots.append(root)
+        else:
+            troubled.append(start)
+    return roots, troubled
 
 
 def _repaired(finder, roots: list[float], lo: float, hi: float, depth: int):
@@ -270,7 +277,7 @@ def _partner(root: float, offsets: np.ndarray, same: float) -> float | None:
     return float(root - real[np.argmin(np.abs(real))]) if real.size else None
 
 
-def _intervals_around(troubled: list[float], roots: list[float], predictions: np.ndarray) -> list[tuple]:
+def _intervals_around(troubled: list[float], predictions: np.ndarray) -> list[tuple]:
     """Disjoint intervals (lo, hi], rad/s, each holding troubled predictions and
     reaching halfway (geometrically) to the nearest prediction not among them on
     either side: the segment search runs there."""

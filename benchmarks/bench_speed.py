@@ -14,13 +14,13 @@ Measured per model (the launcher-size files in models/):
   ``natural_frequencies(engine="compiled")``, warm: wall time, evaluations of
   det Ū_all per root, and the largest relative difference from the FE route's
   automatic refinement at rtol 1e-10 (an independent check);
-* the FE route on the coarsest mesh (elements per beam doubled from 1, at most 128) whose
-  first N frequencies are within 1e-9 of the transfer-matrix ones (1e-6 for
-  N >= 60; where even 128 elements do not reach it, that mesh and its
-  difference are reported): dense LAPACK ``eigh(K, M, subset_by_index=…)`` (up
-  to DENSE_LIMIT unknowns) and sparse shift-invert ``eigsh``, assembly
-  excluded, the faster of the two taken as the FE baseline; and the ``fe``
-  command's own automatic refinement (``fe_frequencies``);
+* the FE route on the coarsest mesh (elements per beam doubled from 1, at most
+  128) whose first N frequencies are within 1e-9 of the transfer-matrix ones
+  (1e-6 for N >= 60), or the closest where none is: dense LAPACK
+  ``eigh(K, M, subset_by_index=…)`` (up to DENSE_LIMIT unknowns) and sparse
+  shift-invert ``eigsh``, assembly excluded, the faster of the two taken as
+  the FE baseline; and the ``fe`` command's own automatic refinement
+  (``fe_frequencies``);
 * the start-up of a new process running the README's main command.
 """
 from __future__ import annotations
@@ -87,28 +87,33 @@ def rel_diff(a, b) -> float:
 
 
 def fe_eigensolves(model, count: int, target: np.ndarray, tolerance: float, rounds: int) -> dict:
-    """The FE route's eigensolvers on the coarsest mesh within ``tolerance`` of ``target`` (Hz)."""
+    """The FE route's eigensolvers on the coarsest mesh within ``tolerance`` of ``target`` (Hz).
+
+    Meshes of 1, 2, 4, … 128 elements per beam; each judged by shift-invert
+    eigsh (dense eigh loses digits on fine meshes, whose beam-node masses are
+    tiny). Where none is within ``tolerance``, the mesh that came closest.
+    """
+    shift = -0.5 * (2 * np.pi * target[0]) ** 2
+    best = None
     for per_beam in (1, 2, 4, 8, 16, 32, 64, 128):
         fe = assemble(model, per_beam)
         K, M = fe.K.tocsc(), fe.M.tocsc()
-        rigid = fe.rigid_modes.shape[1]
-        wanted = min(count + rigid, K.shape[0] - 1)
-        dense_K, dense_M = K.toarray(), M.toarray()
-        try:
-            lam = la.eigh(dense_K, dense_M, eigvals_only=True, subset_by_index=[0, wanted - 1])
-        except np.linalg.LinAlgError:
-            return {"note": f"M singular at {per_beam} elements per beam: no dense eigh"}
-        found = np.sqrt(np.abs(lam[rigid:])) / (2 * np.pi)
-        if rel_diff(found, target) <= tolerance or per_beam == 128:
+        wanted = min(count + fe.rigid_modes.shape[1], K.shape[0] - 2)
+        lam = np.sort(sla.eigsh(K, k=wanted, M=M, sigma=shift, which="LM", return_eigenvectors=False))
+        error = rel_diff(np.sqrt(np.abs(lam[fe.rigid_modes.shape[1]:])) / (2 * np.pi), target)
+        if best is None or error < best[0]:
+            best = (error, per_beam, K, M, wanted)
+        if error <= tolerance:
             break
-    eigh_time = (best_time(lambda: la.eigh(dense_K, dense_M, eigvals_only=True,
-                                           subset_by_index=[0, wanted - 1]), rounds)[0]
-                 if K.shape[0] <= DENSE_LIMIT else np.nan)
-    shift = -0.5 * (2 * np.pi * target[0]) ** 2
+    error, per_beam, K, M, wanted = best
     eigsh_time = best_time(lambda: sla.eigsh(K, k=wanted, M=M, sigma=shift, which="LM",
                                              return_eigenvectors=False), rounds)[0]
-    return {"per_beam": per_beam, "dof": K.shape[0], "error": rel_diff(found, target),
-            "eigh": eigh_time, "eigsh": eigsh_time}
+    eigh_time = np.nan
+    if K.shape[0] <= DENSE_LIMIT:
+        dense_K, dense_M = K.toarray(), M.toarray()
+        eigh_time = best_time(lambda: la.eigh(dense_K, dense_M, eigvals_only=True,
+                                              subset_by_index=[0, wanted - 1]), rounds)[0]
+    return {"per_beam": per_beam, "dof": K.shape[0], "error": error, "eigh": eigh_time, "eigsh": eigsh_time}
 
 
 def startup(command: list[str], rounds: int) -> float:
@@ -171,14 +176,12 @@ def main() -> None:
                 curves.setdefault(label, []).append((count, mstmm_time, solves.get("eigh", np.nan),
                                                      solves.get("eigsh", np.nan), fe_time))
             lines.append("")
-    lines += ["**Reading the FE columns.** The fixed-mesh FE eigenproblem alone does not reach the "
-              "transfer-matrix frequencies even at 128 elements per beam (column *its diff. from MSTMM*): "
-              "its axial and torsion elements are linear and converge as h². On the launcher that "
-              "difference is 2e-3; on launcher 2 it is 0.2, which convergence alone does not explain (a "
-              "mode the raw fixed-mesh solve ranks differently; not investigated yet). The eigensolver "
-              "times are therefore a lower bound on what the FE route needs for the same accuracy. The "
-              "`fe` command reaches it (its column *diff. from FE rtol 1e-10*) by refinement and "
-              "Richardson extrapolation, and is the like-for-like comparison.", ""]
+    lines += ["**Reading the FE columns.** The FE mesh is the coarsest of 1, 2, 4, … 128 elements per "
+              "beam whose first N frequencies by eigsh are within 1e-9 of the transfer-matrix ones (1e-6 "
+              "from N = 60), or, where none is, the mesh that came closest (column *its diff. from "
+              "MSTMM*): refining further makes the fixed-mesh eigenproblem worse, not better, as its "
+              "beam-node masses shrink. The eigensolver times exclude assembly, which the `fe` command's "
+              "refinement with Richardson extrapolation includes.", ""]
     command = [sys.executable, "-m", "linmstmm", "freqs", "models/mlrs/mlrs.toml"]
     lines += ["## Start-up: a new process", "",
               "| command | median wall time |", "|---|---:|",
@@ -189,7 +192,7 @@ def main() -> None:
     figure = draw(curves, out / "figures" / "speed_vs_fe.png")
     lines += [f"![time against the number of frequencies]({figure.relative_to(out).as_posix()})", "",
               "*Wall time against the number of frequencies asked for, both launcher models; "
-              "FE eigensolvers on the coarsest adequate mesh (assembly excluded).*", "",
+              "FE eigensolvers on the mesh of the tables (assembly excluded).*", "",
               f"Run time of this script: {time.perf_counter() - started:.0f} s."]
     (out / "speed.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
     print(out / "speed.md")

@@ -42,8 +42,8 @@ WAVE_PER_ELEMENT = 1.0
 MAX_UNKNOWNS = 1500
 #: Elements per beam the predicting mesh may take.
 MAX_ELEMENTS = 64
-#: Predictions closer than this (relative) are a cluster, polished together by
-#: the pencil (the secant would take both to the same root).
+#: Predictions closer than this (relative) are a cluster: a member's secant result
+#: stands only where it converged to xtol (see :func:`_secant_polished`).
 CLUSTER = 1e-3
 #: Relative size of the secant's first step (its second point).
 FIRST_STEP = 1e-7

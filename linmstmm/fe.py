@@ -405,6 +405,8 @@ def _negligible_mass_removed(model: Model) -> Model:
     inertia = total * extent ** 2 + sum(np.trace(body.inertia) for body in model.rigids)
     rigids = tuple(_body_mass_kept(body, MASSLESS * total, MASSLESS * inertia) for body in model.rigids)
     beams = tuple(beam if beam.mass > MASSLESS * total else replace(beam, rho=0.0) for beam in model.beams)
+    if all(a is b for a, b in zip(rigids + beams, model.rigids + model.beams)):
+        return model  # nothing negligible: no copy (a copy validates the whole model again)
     return replace(model, rigids=rigids, beams=beams)
 
 

@@ -34,10 +34,9 @@ import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import beam_transfer
-from linmstmm.mode_bound import check_range_request
-from linmstmm.model import Model
+from linmstmm.model import Model, ModelError
 from linmstmm.nullspace import NULL_TOLERANCE, equilibration
-from linmstmm.solve import frequency_finder, search_note
+from linmstmm.solve import search_note, solve_roots
 from linmstmm.threads import single_blas_thread
 
 #: Normalisations of the modes: unit modal mass, or unit largest translation.
@@ -77,7 +76,7 @@ class BeamField:
 class ModalResult:
     """Modes of a model, ascending in frequency (rigid-body modes first).
 
-    omega : (n,) rad/s; ``natural_freq`` (n,) Hz.
+    omega : (n,) rad/s; ``frequencies_hz`` (n,) Hz.
     rigid_body_modes : number of zero-frequency modes at the start.
     modal_mass : (n,) M_k = ⟨M V^k, V^k⟩ (1 for mass normalisation).
     modal_stiffness : (n,) K_k = ω_k² M_k.
@@ -110,7 +109,7 @@ class ModalResult:
     note: str = ""
 
     @property
-    def natural_freq(self) -> np.ndarray:
+    def frequencies_hz(self) -> np.ndarray:
         """(n,) natural frequencies, Hz."""
         return self.omega / (2 * np.pi)
 
@@ -151,7 +150,7 @@ class ModalResult:
         """Plain JSON-ready dictionary (lists of floats)."""
         return {
             "model": self.model,
-            "natural_freq_hz": self.natural_freq.tolist(),
+            "frequencies_hz": self.frequencies_hz.tolist(),
             "omega": self.omega.tolist(),
             "rigid_body_modes": self.rigid_body_modes,
             "normalization": self.normalization,
@@ -203,18 +202,21 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         raise ValueError(f"normalization must be one of {NORMALIZATIONS}, got {normalization!r}")
     if stations < 2:
         raise ValueError(f"stations must be >= 2, got {stations}")
-    if fmax is not None and count is None:
-        check_range_request(model, fmax)
-    deduction, finder, _ = frequency_finder(model, root)
-    omega_max = None if fmax is None else 2 * np.pi * fmax
-    eigenspaces = _group(finder.find(None if count is None else count + EIGENSPACE_MARGIN, omega_max))
+    solution = solve_roots(model, count, fmax, root=root, margin=EIGENSPACE_MARGIN)
+    deduction, finder = solution.deduction, solution.finder
+    eigenspaces = _group(solution.omegas)
     if count is not None:  # whole eigenspaces that start within the first ``count`` modes
         starts = np.cumsum([0] + [m for _, m in eigenspaces])
         eigenspaces = eigenspaces[:int(np.searchsorted(starts, count))]
     elastic = sum(m for _, m in eigenspaces)
-    note = search_note(finder, elastic, finder.unseparated_among([w for w, _ in eigenspaces]), count, fmax)
+    kept = {w for w, _ in eigenspaces}
+    note = search_note(finder, elastic, {w: v for w, v in solution.unseparated.items() if w in kept}, count, fmax)
     if rigid_body and (rigid := finder.rigid_body_modes()):
         eigenspaces.insert(0, (0.0, rigid))
+    if not eigenspaces:
+        raise ModelError(model.source or model.name, "no mode to compute: " + (
+            f"no natural frequency up to {fmax:g} Hz" if count is None else "the model has no mode"),
+            key="fmax" if count is None else None)
     omega = np.repeat([w for w, _ in eigenspaces], [m for _, m in eigenspaces])
     zbar = np.concatenate([_null_basis(deduction, w, m) for w, m in eigenspaces])
     raw = _Fields.of(model, deduction, omega, zbar, stations)

@@ -138,16 +138,48 @@ class ModalResult:
         return float(np.max(np.abs(diagonal / self.omega[elastic] ** 2 - 1), initial=0.0))
 
     def shape_matrix(self, points=None) -> np.ndarray:
-        """(n, 6 p) point displacements of every mode, points in ``points`` order (default: all)."""
+        """The point displacements of every mode as one matrix.
+
+        Parameters
+        ----------
+        points : sequence of str, optional
+            The p points, in the order wanted (default: every point).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, 6 p)
+            x, y, z, rx, ry, rz of each point in turn, per mode.
+        """
         names = list(self.point_displacements) if points is None else list(points)
         return np.concatenate([self.point_displacements[p] for p in names], axis=1)
 
     def mac(self, other_shapes, points=None) -> np.ndarray:
-        """MAC matrix (n, n_other) between these modes and ``other_shapes`` (n_other, 6 p)."""
+        """MAC matrix between these modes and other shapes at the same points.
+
+        Parameters
+        ----------
+        other_shapes : array_like, shape (n_other, 6 p)
+            Shapes laid out as :meth:`shape_matrix` lays them out.
+        points : sequence of str, optional
+            The p points (default: every point).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, n_other)
+            In [0, 1] (:func:`mac_matrix`).
+        """
         return mac_matrix(self.shape_matrix(points), other_shapes)
 
     def to_dict(self) -> dict:
-        """Plain JSON-ready dictionary (lists of floats)."""
+        """Plain JSON-ready dictionary (lists of floats).
+
+        Returns
+        -------
+        dict
+            ``model``, ``frequencies_hz``, ``omega``, ``rigid_body_modes``, ``normalization``,
+            the modal masses and stiffnesses, orthogonality errors and matrices, and the
+            displacements by point, mass centre and beam field.
+        """
         return {
             "model": self.model,
             "frequencies_hz": self.frequencies_hz.tolist(),
@@ -172,8 +204,17 @@ class ModalResult:
 def mac_matrix(a, b) -> np.ndarray:
     """Modal assurance criterion between two sets of shape vectors.
 
-    a : (n_a, d), b : (n_b, d), real or complex. Returns (n_a, n_b) in [0, 1]:
-    |a_i · conj(b_j)|² / ((a_i · conj(a_i)) (b_j · conj(b_j))).
+    Parameters
+    ----------
+    a : array_like, shape (n_a, d)
+        Shapes, real or complex.
+    b : array_like, shape (n_b, d)
+        Shapes, real or complex.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_a, n_b)
+        |a_i · conj(b_j)|² / ((a_i · conj(a_i)) (b_j · conj(b_j))), in [0, 1].
     """
     a, b = np.atleast_2d(a), np.atleast_2d(b)
     cross = np.abs(a @ b.conj().T) ** 2
@@ -186,17 +227,41 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
                 root: str | None = None) -> ModalResult:
     """Natural modes of ``model`` by the transfer matrix method.
 
-    count : the lowest ``count`` elastic modes; fmax : Hz, all up to fmax (both:
-        whichever stops first). A repeated frequency always comes with its whole
-        eigenspace, so one more mode than ``count`` may come back.
-    stations : number of equally spaced stations (ends included) of each beam field.
-    normalization : "mass" (the default, also of ``linmstmm modes``: M_k = 1 kg,
+    The frequencies come from the pipeline of
+    :func:`linmstmm.solve.natural_frequencies` (:func:`linmstmm.solve.solve_roots`:
+    the same deduction, root finder and mpmath refinement), so they agree
+    with it to the last digit.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    count : int or None
+        The lowest ``count`` elastic modes. A repeated frequency always comes
+        with its whole eigenspace, so one more mode than ``count`` may come back.
+    fmax : float or None
+        Hz: all modes up to fmax (with ``count``: whichever stops first);
+        ``fmax`` alone is checked as :func:`linmstmm.solve.natural_frequencies` checks it.
+    stations : int
+        Number of equally spaced stations (ends included) of each beam field.
+    normalization : str
+        "mass" (the default, also of ``linmstmm modes``: M_k = 1 kg,
         amplitudes in m/√kg and rad/√kg) or "max" (largest translation 1 m; a
         mode without translation: largest rotation 1 rad). The largest
         component is made positive either way.
-    rigid_body : include the zero-frequency modes first.
-    root : boundary end to use as the root of the transfer tree.
-    ``fmax`` alone is checked as :func:`linmstmm.solve.natural_frequencies` checks it.
+    rigid_body : bool
+        Include the zero-frequency modes first.
+    root : str or None
+        Boundary end to use as the root of the transfer tree.
+
+    Returns
+    -------
+    ModalResult
+
+    Raises
+    ------
+    ModelError
+        For a range holding too many modes, or no mode at all (key ``fmax``).
     """
     if normalization not in NORMALIZATIONS:
         raise ValueError(f"normalization must be one of {NORMALIZATIONS}, got {normalization!r}")

@@ -239,7 +239,15 @@ class ResponseResult:
     rigid_body_modes: int = 0
 
     def to_dict(self) -> dict:
-        """Plain JSON-ready dictionary: point -> lists (n_t, 6); ``units`` per quantity and component."""
+        """Plain JSON-ready dictionary: point -> lists (n_t, 6); ``units`` per quantity and component.
+
+        Returns
+        -------
+        dict
+            ``times``, ``points``, ``elastic_modes``, ``rigid_body_modes``, ``frequencies_hz``,
+            ``static_correction``, ``note`` when set, ``units``, ``displacement``,
+            ``velocity``, ``acceleration``.
+        """
         return {"times": self.times.tolist(), "points": list(self.points),
                 "elastic_modes": self.elastic_modes, "rigid_body_modes": self.rigid_body_modes,
                 "frequencies_hz": self.frequencies_hz.tolist(), "static_correction": self.static_correction,
@@ -285,7 +293,13 @@ class FRFResult:
         return -(2 * np.pi * self.excitation_hz[:, None, None]) ** 2 * self.receptance
 
     def to_dict(self) -> dict:
-        """Plain JSON-ready dictionary: point -> real and imaginary parts (n_f, 6)."""
+        """Plain JSON-ready dictionary: point -> real and imaginary parts (n_f, 6).
+
+        Returns
+        -------
+        dict
+            ``excitation_hz``, ``points`` and ``receptance`` (point -> ``{real, imag}``).
+        """
         return {"excitation_hz": self.excitation_hz.tolist(), "points": list(self.points),
                 "receptance": {p: {"real": self.receptance[:, i].real.tolist(),
                                    "imag": self.receptance[:, i].imag.tolist()}
@@ -499,11 +513,29 @@ def _static_correction(modes: ModalResult, loads, times, shapes, static) -> np.n
 
 def frf(modes: ModalResult, point: str, vector, excitation_hz, points=None,
         damping=None, *, damping_ratio=None) -> FRFResult:
-    """Receptance between the (6,) load ``vector`` [force, moment] at ``point`` and ``points``.
+    """Receptance between a load ``vector`` at ``point`` and the response ``points``.
 
-    excitation_hz : (n_f,) excitation frequencies, Hz. damping, damping_ratio : Rayleigh (α, β) or
-    modal ratios ζ, see :func:`modal_damping` (neither: undamped, infinite at
-    the natural frequencies).
+    Parameters
+    ----------
+    modes : ModalResult
+        The modes in the sum (rigid-body modes included).
+    point : str
+        The load point.
+    vector : array_like, shape (6,)
+        The load [force (N), moment (N m)], inertial axes.
+    excitation_hz : array_like, shape (n_f,)
+        Excitation frequencies, Hz.
+    points : sequence of str, optional
+        Response points (default: every point of the modes).
+    damping : tuple of float, optional
+        Rayleigh (α 1/s, β s), see :func:`modal_damping`.
+    damping_ratio : float or sequence of float, optional
+        Modal damping ratios ζ instead (neither: undamped, infinite at the
+        natural frequencies).
+
+    Returns
+    -------
+    FRFResult
     """
     excitation_hz = np.asarray(excitation_hz, dtype=float)
     points = tuple(modes.point_displacements) if points is None else tuple(points)
@@ -530,8 +562,16 @@ def respond(model: Model, case: LoadCase, damping_ratio=None,
         mesh (its rigid-body motion is removed with the mesh's mass), so
         it would not be exact.
 
-    Raises :class:`linmstmm.model.ModelError` for a spring with a dashpot
-    (:func:`refuse_dashpots`).
+    Returns
+    -------
+    ResponseResult
+
+    Raises
+    ------
+    ModelError
+        For a spring with a dashpot (:func:`refuse_dashpots`).
+    DampingRatioError
+        For damping ratios that do not fit the modes.
     """
     from linmstmm.fe import static_displacements
 
@@ -579,7 +619,21 @@ _TIME_KEYS = {
 def load_loads(path, model: Model) -> LoadCase:
     """Read and validate the load file ``path`` (format: module docstring) for ``model``.
 
-    Raises :class:`linmstmm.model.ModelError`.
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The load file (format: ``docs/cli.md``, load files).
+    model : Model
+        The model whose points the loads name.
+
+    Returns
+    -------
+    LoadCase
+
+    Raises
+    ------
+    ModelError
+        One line naming the file, the load and the key at fault.
     """
     file = str(path)
     top = _Table(file, _read_toml(path, file))

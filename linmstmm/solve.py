@@ -55,7 +55,15 @@ class FrequencyResult:
     evaluations: int = 0
 
     def to_dict(self) -> dict:
-        """The ``linmstmm freqs --json`` object (``docs/cli.md``)."""
+        """The ``linmstmm freqs --json`` object (``docs/cli.md``).
+
+        Returns
+        -------
+        dict
+            JSON-ready: ``model``, ``frequencies_hz``, ``rigid_body_modes``, ``ubar_order``,
+            ``seconds``, ``precision``, ``method``, ``indeterminate_released``, ``evaluations``
+            and, when set, ``note``, ``frequencies_hz_text``, ``omega_rad_s_text``.
+        """
         return {
             "model": self.model,
             "frequencies_hz": [float(f) for f in self.frequencies_hz],

@@ -45,8 +45,6 @@ NORMALIZATIONS = ("mass", "max")
 DEFAULT_NORMALIZATION = "mass"
 #: Frequencies closer than this (relative) are one repeated frequency.
 SAME_FREQUENCY = 1e-9
-#: Roots asked for beyond ``count``, so that an eigenspace cut by the count is completed.
-EIGENSPACE_MARGIN = 2
 #: Relative frequency offset of the matrices that scale Ū_all for its null space.
 SCALE_PROBE = 1e-3
 #: Gauss–Legendre points along a beam beyond its largest wavenumber × length.
@@ -267,12 +265,12 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         raise ValueError(f"normalization must be one of {NORMALIZATIONS}, got {normalization!r}")
     if stations < 2:
         raise ValueError(f"stations must be >= 2, got {stations}")
-    solution = solve_roots(model, count, fmax, root=root, margin=EIGENSPACE_MARGIN)
+    solution = solve_roots(model, count, fmax, root=root)
     deduction, finder = solution.deduction, solution.finder
-    eigenspaces = _group(solution.omegas)
-    if count is not None:  # whole eigenspaces that start within the first ``count`` modes
-        starts = np.cumsum([0] + [m for _, m in eigenspaces])
-        eigenspaces = eigenspaces[:int(np.searchsorted(starts, count))]
+    omegas = solution.omegas
+    if count and omegas.size == count:  # the count may cut the last eigenspace
+        omegas = _whole_last_eigenspace(finder, omegas)
+    eigenspaces = _group(omegas)
     elastic = sum(m for _, m in eigenspaces)
     kept = {w for w, _ in eigenspaces}
     note = search_note(finder, elastic, {w: v for w, v in solution.unseparated.items() if w in kept}, count, fmax)
@@ -314,6 +312,20 @@ def _group(omegas) -> list[tuple[float, int]]:
         else:
             groups.append((float(omega), 1))
     return groups
+
+
+def _whole_last_eigenspace(finder, omegas: np.ndarray) -> np.ndarray:
+    """``omegas`` (rad/s, ascending) with the last root repeated up to its multiplicity.
+
+    The multiplicity is the finder's count of roots around it
+    (:meth:`~linmstmm.roots.RootFinder.multiplicity`), as the mpmath
+    refinement of a root cut by the count takes it; the roots before it are
+    left exactly as found.
+    """
+    last = omegas[-1]
+    present = int(np.count_nonzero(np.abs(omegas - last) <= SAME_FREQUENCY * last))
+    wanted = finder.multiplicity(last, sorted(set(omegas))) or present
+    return np.r_[omegas, np.full(max(wanted - present, 0), last)]
 
 
 def _null_basis(deduction: Deduction, omega: float, dimension: int) -> np.ndarray:

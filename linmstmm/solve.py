@@ -140,7 +140,7 @@ class RootSolution:
 
 
 def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None, *, digits: int | None = None,
-                root: str | None = None, guess_hz=None, engine: str = "auto", margin: int = 0) -> RootSolution:
+                root: str | None = None, guess_hz=None, engine: str = "auto") -> RootSolution:
     """The elastic roots of det Ū_all of ``model``: the one pipeline of frequencies and modes.
 
     Builds the deduction and its root finder (:func:`frequency_finder`), finds
@@ -151,7 +151,7 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
     model : Model
         The model.
     count : int or None
-        The lowest ``count`` roots (plus ``margin``); None: every root up to ``fmax``.
+        The lowest ``count`` roots; None: every root up to ``fmax``.
     fmax : float or None
         Hz: every root up to fmax; with ``count``, whichever stops first.
     digits : int or None
@@ -165,8 +165,6 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
         Frequencies of a similar model to start from (with ``count`` only).
     engine : str
         How det Ū_all is evaluated: "numpy", "compiled" or "auto".
-    margin : int
-        Roots asked for beyond ``count`` (an eigenspace cut by the count is then completed).
 
     Returns
     -------
@@ -181,12 +179,11 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
     if fmax is not None and count is None:
         check_range_request(model, fmax)
     deduction, finder, released = frequency_finder(model, root, engine=engine)
-    asked = None if count is None else count + margin
     omega_max = None if fmax is None else 2 * np.pi * fmax
     if guess_hz is not None and count is not None and fmax is None:
-        omegas = np.array(finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), asked))
+        omegas = np.array(finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count))
     else:
-        omegas = np.array(finder.find(asked, omega_max))
+        omegas = np.array(finder.find(count, omega_max))
     unseparated = finder.unseparated_among(omegas)
     uncertain = sorted({w for w in omegas if finder.last_step.get(w, 0.0) > CERTIFIED_STEP} - set(unseparated))
     every = bool(digits and digits > FLOAT64_DIGITS)

@@ -3,8 +3,7 @@
 Every ``*.toml`` under models/ that loads as a model is a case; other TOML
 files there (the MLRS tube bundle, load files) are data, not models, and are
 left out. The first ten frequencies (all, if there are fewer) must agree to 1e-7 relative and the
-rigid-body mode counts must be equal. Until ``fe`` is wired into the command
-line the FE half is skipped (the ``freqs`` half still runs).
+rigid-body mode counts must be equal.
 
 The second launcher (models/launcher2/launcher2.toml, two closed loops) is also
 checked deeper: its deduced structure is the one its comments describe, and its

@@ -37,6 +37,7 @@ from linmstmm.elements.beam import beam_transfer
 from linmstmm.model import Model, ModelError
 from linmstmm.nullspace import NULL_TOLERANCE, equilibration
 from linmstmm.solve import search_note, solve_roots
+from linmstmm.stages import report
 from linmstmm.threads import single_blas_thread
 
 #: Normalisations of the modes: unit modal mass, or unit largest translation.
@@ -281,6 +282,7 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
             f"no natural frequency up to {fmax:g} Hz" if count is None else "the model has no mode"),
             key="fmax" if count is None else None)
     omega = np.repeat([w for w, _ in eigenspaces], [m for _, m in eigenspaces])
+    report("mode shapes")
     zbar = np.concatenate([_null_basis(deduction, w, m) for w, m in eigenspaces])
     raw = _Fields.of(model, deduction, omega, zbar, stations)
     gram = raw.mass_gram()

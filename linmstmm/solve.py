@@ -15,6 +15,7 @@ from linmstmm.precision import refine_roots, separated_cluster
 from linmstmm.predicted import predict_frequencies
 from linmstmm.determinant import determinant
 from linmstmm.rigid_motion import rigid_body_mode_count
+from linmstmm.stages import report
 from linmstmm.roots import CERTIFIED_STEP, OMEGA_CEILING, RootFinder
 from linmstmm.threads import single_blas_thread
 from linmstmm.topology import build_topology
@@ -178,7 +179,9 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
     """
     if fmax is not None and count is None:
         check_range_request(model, fmax)
+    report("deducing Ubar_all")
     deduction, finder, released = frequency_finder(model, root, engine=engine)
+    report("finding roots")
     omega_max = None if fmax is None else 2 * np.pi * fmax
     if guess_hz is not None and count is not None and fmax is None:
         omegas = np.array(finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count))
@@ -190,6 +193,7 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
     wanted = digits if every else (ESCALATION_DIGITS if uncertain or unseparated else None)
     if not wanted:
         return RootSolution(deduction, finder, released, omegas, unseparated=unseparated)
+    report(f"refining in mpmath to {wanted} digits")
     omegas, precision, text, omega_text = _refined_in_mpmath(
         deduction, model, finder, omegas, [w for w in omegas if w not in unseparated and (every or w in uncertain)],
         unseparated, wanted, cut_by_count=count is not None)

@@ -29,6 +29,7 @@ from linmstmm.response import (
     quantity_units,
     refuse_dashpots,
 )
+from linmstmm.stages import report
 
 #: Frequencies in a scan and in a receptance sweep, by default.
 DEFAULT_SCAN_POINTS = 2000
@@ -100,6 +101,7 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
     shapes = mode_shapes(model, modes, fmax=reach)
     sweep = fmax * np.arange(1, frequencies + 1) / frequencies
     damping = damping_in_use(model, damping_ratio)
+    report("receptance")
     result = frf(shapes, point, np.eye(6)[COMPONENTS.index(direction)], sweep, targets,
                  damping["damping"], damping_ratio=damping_ratio)
     load_unit = "N m" if direction.startswith("r") else "N"
@@ -345,10 +347,13 @@ def determinant_scan(model: Model, fmax: float, points: int = DEFAULT_SCAN_POINT
     from linmstmm.solve import frequency_finder, search_note
 
     check_range_request(model, fmax)
+    report("deducing Ubar_all")
     deduction, finder, _ = frequency_finder(model)
     omega_max = 2 * np.pi * fmax
     grid = omega_max * np.arange(1, points + 1) / points
+    report("scanning det Ubar_all")
     parts = [deduction.log_det(grid[start:start + SCAN_CHUNK]) for start in range(0, grid.size, SCAN_CHUNK)]
+    report("finding roots")
     roots = np.array(finder.find(None, omega_max))
     note = search_note(finder, roots.size, finder.unseparated_among(roots), None, fmax)
     return ScanResult(model.name, grid, np.concatenate([p[0] for p in parts]),

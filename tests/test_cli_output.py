@@ -20,8 +20,9 @@ import numpy as np
 import pytest
 
 import linmstmm.solve
-from linmstmm import cli
+from linmstmm import cli, mode_shapes, natural_frequencies
 from linmstmm.model import ModelError, load_model
+from linmstmm.stages import listening
 
 ROOT = Path(__file__).resolve().parents[1]
 CANTILEVER = ROOT / "models" / "cantilever_tip_mass.toml"
@@ -188,6 +189,29 @@ def test_progress_goes_to_a_terminal_only_and_never_to_stdout(tmp_path, monkeypa
     data = json.loads(capsys.readouterr().out)  # stdout is the JSON alone
     assert len(data["files"]) == 2
     assert ("mode figures" in terminal.getvalue()) is not quiet
+
+
+@pytest.mark.parametrize("quiet", [False, True])
+def test_a_long_solve_shows_its_stages_on_a_terminal(monkeypatch, capsys, quiet):
+    terminal = Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    argv = ["freqs", str(CANTILEVER), "--count", "2", "--digits", "20", "--json"]
+    assert cli.main(argv + (["--quiet"] if quiet else [])) == 0
+    assert json.loads(capsys.readouterr().out)["precision"] == "mpmath:20"
+    shown = terminal.getvalue()
+    for stage in ("deducing Ubar_all", "finding roots", "refining in mpmath to 20 digits"):
+        assert (stage in shown) is not quiet, stage
+
+
+def test_the_solvers_report_their_stages_in_order():
+    model = load_model(CANTILEVER)
+    heard = []
+    with listening(heard.append):
+        natural_frequencies(model, count=2)
+        mode_shapes(model, 2)
+    assert heard == ["deducing Ubar_all", "finding roots"] * 2 + ["mode shapes"]
+    natural_frequencies(model, count=1)  # nobody listening: nothing heard
+    assert len(heard) == 5
 
 
 def test_no_progress_off_a_terminal(run, tmp_path):

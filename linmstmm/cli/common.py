@@ -16,6 +16,7 @@ from contextlib import contextmanager
 
 from linmstmm import ModelError
 from linmstmm.response import DampingRatioError
+from linmstmm.stages import listening
 
 
 class UsageError(Exception):
@@ -166,3 +167,20 @@ def progress(args, iterable, total: int, what: str):
 
     return tqdm(iterable, total=total, desc=what, unit="", file=sys.stderr, leave=False,
                 disable=True if getattr(args, "quiet", False) else None)
+
+
+@contextmanager
+def stages(args, what: str):
+    """Show on stderr, while the block runs, each stage the solvers report
+    (:mod:`linmstmm.stages`): on a terminal only, and not with ``--quiet``."""
+    from tqdm import tqdm
+
+    bar = tqdm(desc=what, unit=" stages", file=sys.stderr, leave=False,
+               disable=True if getattr(args, "quiet", False) else None)
+
+    def show(stage):
+        bar.set_postfix_str(stage)
+        bar.update()
+
+    with bar, listening(show):
+        yield

@@ -10,6 +10,7 @@ from linmstmm.cli.common import (
     emit,
     positive_int,
     request,
+    stages,
 )
 
 
@@ -32,8 +33,9 @@ def run_freqs(args) -> int:
     """Run ``linmstmm freqs``; returns the exit status 0."""
     model = load_model(args.model)
     count, fmax = request(args)
-    result = natural_frequencies(model, count=count, fmax=fmax, digits=args.digits, root=args.root,
-                                 engine=args.engine)
+    with stages(args, "freqs"):
+        result = natural_frequencies(model, count=count, fmax=fmax, digits=args.digits, root=args.root,
+                                     engine=args.engine)
     data = result.to_dict()
     emit(args, model, data, lambda d: print_frequency_table(f"{model.name}: natural frequencies (MSTMM)", d),
          lambda: frequency_csv(data))

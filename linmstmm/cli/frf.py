@@ -16,6 +16,7 @@ from linmstmm.cli.common import (
     emit,
     positive_float,
     positive_int,
+    stages,
     writing,
 )
 from linmstmm.model import COMPONENTS
@@ -50,7 +51,7 @@ def add_frf_command(subparsers) -> None:
 def run_frf(args) -> int:
     """Run ``linmstmm frf``; returns the exit status 0."""
     model = load_model(args.model)
-    with as_options(model, "point", "response_points", "direction", "fmax"):
+    with as_options(model, "point", "response_points", "direction", "fmax"), stages(args, "frf"):
         result, summary = frf_study(model, args.point, args.direction, args.fmax, frequencies=args.frequencies,
                                     response_points=args.response_points, modes=args.modes,
                                     damping_ratio=args.zeta)

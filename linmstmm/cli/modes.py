@@ -21,6 +21,7 @@ from linmstmm.cli.common import (
     progress,
     request,
     source,
+    stages,
     writing,
 )
 from linmstmm.compare import fe_mac
@@ -54,7 +55,7 @@ def run_modes(args) -> int:
     if args.animate and args.plot is None:
         raise ModelError(source(model), "--animate needs --plot DIR", key="--animate")
     count, fmax = request(args)
-    with as_options(model, "fmax"):
+    with as_options(model, "fmax"), stages(args, "modes"):
         result = mode_shapes(model, count, fmax=fmax, normalization=args.normalization)
     files = _mode_figures(args, result, model) if args.plot else []
     if args.uff:

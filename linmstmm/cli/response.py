@@ -18,6 +18,7 @@ from linmstmm.cli.common import (
     add_zeta_option,
     as_options,
     emit,
+    stages,
     writing,
 )
 from linmstmm.model import COMPONENTS
@@ -42,7 +43,7 @@ def run_response(args) -> int:
     """Run ``linmstmm response``; returns the exit status 0."""
     model = load_model(args.model)
     case = load_loads(args.loads, model)
-    with as_options(model):
+    with as_options(model), stages(args, "response"):
         result = respond(model, case, damping_ratio=args.zeta)
     damping = damping_in_use(model, args.zeta)
     peaks, times = peak_responses(result, args.quantity)

@@ -8,6 +8,7 @@ from linmstmm.cli.common import (
     emit,
     positive_float,
     positive_int,
+    stages,
     writing,
 )
 from linmstmm.studies import DEFAULT_SCAN_POINTS, determinant_scan
@@ -30,7 +31,8 @@ def run_scan(args) -> int:
     from linmstmm.plot import plot_scan
 
     model = load_model(args.model)
-    scan = determinant_scan(model, args.fmax, args.points)
+    with stages(args, "scan"):
+        scan = determinant_scan(model, args.fmax, args.points)
     with writing(model, "--plot", args.plot):
         plot_scan(scan.omega, scan.sign, scan.log_abs, scan.roots, scan.count(), args.plot,
                   title=f"{model.name}: det Ū_all, {scan.roots.size} natural frequencies up to {args.fmax:g} Hz")

@@ -2,7 +2,13 @@
 from __future__ import annotations
 
 from linmstmm import load_model
-from linmstmm.cli.common import add_model_argument, add_output_options, emit, writing
+from linmstmm.cli.common import (
+    add_model_argument,
+    add_output_options,
+    as_options,
+    emit,
+    writing,
+)
 from linmstmm.structure import describe
 from linmstmm.topology import build_topology
 
@@ -26,7 +32,8 @@ def run_check(args) -> int:
     that cannot be written. Returns the exit status 0.
     """
     model = load_model(args.model)
-    topology = build_topology(model, root=args.root)
+    with as_options(model, "root"):
+        topology = build_topology(model, root=args.root)
     report = describe(topology)
     if args.plot is not None:
         from linmstmm.plot_topology import (

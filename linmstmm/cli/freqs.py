@@ -7,6 +7,7 @@ from linmstmm import load_model, natural_frequencies
 from linmstmm.cli.common import (
     add_output_options,
     add_request_options,
+    as_options,
     emit,
     positive_int,
     request,
@@ -33,7 +34,7 @@ def run_freqs(args) -> int:
     """Run ``linmstmm freqs``; returns the exit status 0."""
     model = load_model(args.model)
     count, fmax = request(args)
-    with stages(args, "freqs"):
+    with as_options(model, "root"), stages(args, "freqs"):
         result = natural_frequencies(model, count=count, fmax=fmax, digits=args.digits, root=args.root,
                                      engine=args.engine)
     data = result.to_dict()

@@ -284,7 +284,8 @@ def _refined_in_mpmath(deduction, model, finder, omegas, chosen, unseparated, di
     top = [omegas[-1]] if cut_by_count and len(chosen) and max(chosen) == omegas[-1] else []
     cut = {w: finder.multiplicity(w, sorted(set(omegas))) for w in top}
     refined = dict(zip(chosen, refine_roots(deduction, model, list(chosen), digits,
-                                            {w: m for w, m in cut.items() if m})))
+                                            {w: m for w, m in cut.items() if m},
+                                            log_det=finder.determinant.log_det)))
     values = [refined.get(w) for w in omegas]
     distinct_refined = len(set(chosen))
     for w, (m, radius) in list(unseparated.items()):

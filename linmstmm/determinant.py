@@ -18,7 +18,8 @@ cost figure the benchmarks report per root.
 
 :func:`determinant` chooses: ``engine="auto"`` takes the compiled kernels
 where they are already loaded in this process (a long session, a parameter
-study: :func:`load_kernels`), the numpy carry otherwise.
+study: :func:`load_kernels`), the numpy carry otherwise and for a model with
+released joints.
 """
 from __future__ import annotations
 
@@ -44,10 +45,15 @@ def load_kernels() -> None:
 
 
 def determinant(deduction: Deduction, engine: str = "auto"):
-    """The determinant of ``deduction`` by ``engine`` ("auto", "numpy" or "compiled")."""
+    """The determinant of ``deduction`` by ``engine`` ("auto", "numpy" or "compiled").
+
+    "auto" takes the numpy carry for a model with released joints, which the
+    compiled program does not carry (:func:`~linmstmm.program.compile_program`
+    refuses them).
+    """
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
-    if engine == "compiled" or (engine == "auto" and kernels_loaded()):
+    if engine == "compiled" or (engine == "auto" and kernels_loaded() and not deduction.jump_columns):
         return CompiledDeterminant(deduction)
     return NumpyDeterminant(deduction)
 

@@ -57,7 +57,7 @@ def characteristic_frequencies(topology) -> list[float]:
     """Frequencies of the model's own scale, rad/s, from its elements alone, to probe at.
 
     First the lowest of each beam's bending scale √(E I_min / ρA) / L² and
-    √(k / m) for each spring's softest finite translation k against the
+    √(k / m) for each spring's softest finite, unreleased translation k against the
     model's whole mass m; then the same with the beams' length L taken as all
     beams together (a chain of 1000 short beams bends as one long one: its
     pieces' own scale puts the probes where Ū_all overflows). They move with
@@ -72,7 +72,7 @@ def characteristic_frequencies(topology) -> list[float]:
     springs = []
     for record in records:
         if record.kind == "spring" and mass > 0:
-            finite = record.k[:3][np.isfinite(record.k[:3])]
+            finite = record.k[:3][np.isfinite(record.k[:3]) & (record.k[:3] > 0)]  # not released
             if finite.size:
                 springs.append(np.sqrt(finite.min() / mass))
     span = sum(beam.length for beam in beams)

@@ -168,7 +168,15 @@ class _Planner:
 
 
 def compile_program(deduction: Deduction) -> Program:
-    """The straight-line program of ``deduction`` (after any release of unknowns)."""
+    """The straight-line program of ``deduction`` (after any release of unknowns).
+
+    Raises ValueError for a deduction with released joint directions: their
+    jumps and force rows are carried by the numpy deduction only.
+    """
+    if deduction.jump_columns:
+        names = ", ".join(repr(deduction.topology.elements[e].name) for e in deduction.jump_columns)
+        raise ValueError(f"the compiled engine does not carry released joints (spring {names}); "
+                         f"use the numpy engine")
     plan = _Planner(deduction)
     topology = deduction.topology
     elements = topology.elements

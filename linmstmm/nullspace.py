@@ -60,7 +60,8 @@ def characteristic_frequencies(topology) -> list[float]:
     √(k / m) for each spring's softest finite, unreleased translation k against the
     model's whole mass m; then the same with the beams' length L taken as all
     beams together (a chain of 1000 short beams bends as one long one: its
-    pieces' own scale puts the probes where Ū_all overflows). They move with
+    pieces' own scale puts the probes where Ū_all overflows); where there are
+    neither, the springs' rotations (:func:`_torsion_scales`). They move with
     the model's units and size, so probes at multiples of them sit at the same
     place among the model's own frequencies whatever the units (fixed probes
     at 0.7–5 rad/s sat 40 times above the first mode of a star scaled ×1000,
@@ -80,8 +81,24 @@ def characteristic_frequencies(topology) -> list[float]:
     for length in ([beam.length for beam in beams], [span] * len(beams)):
         scales = springs + [np.sqrt(beam.E * min(beam.Iy, beam.Iz) / (beam.rho * beam.A)) / L ** 2
                             for beam, L in zip(beams, length)]
-        candidates.append(float(min(scales)) if scales else 1.0)
+        candidates.append(float(min(scales or _torsion_scales(topology, records, mass) or [1.0])))
     return list(dict.fromkeys(candidates))
+
+
+def _torsion_scales(topology, records, mass) -> list[float]:
+    """√(k / (m d²)) for each spring's softest finite, unreleased rotation k against the
+    model's whole mass m at its extent d (the largest distance between ports), rad/s:
+    the scale of a model whose only compliance is rotational (rods on pins with
+    torsion springs); empty where there is none."""
+    positions = np.array([port.position for element in topology.elements for port in element.ports], float)
+    extent = np.linalg.norm(positions.max(axis=0) - positions.min(axis=0)) if positions.size else 0.0
+    scales = []
+    for record in records:
+        if record.kind == "spring" and mass > 0 and extent > 0:
+            finite = record.k[3:][np.isfinite(record.k[3:]) & (record.k[3:] > 0)]
+            if finite.size:
+                scales.append(np.sqrt(finite.min() / (mass * extent ** 2)))
+    return scales
 
 
 def release_indeterminate(deduction, probe=None) -> int:

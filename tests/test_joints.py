@@ -20,6 +20,8 @@ from linmstmm.modes import mode_shapes
 from linmstmm.response import frf
 from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.solve import natural_frequencies
+from linmstmm.structure import describe
+from linmstmm.topology import build_topology
 from test_rigid_body_modes import in_other_units
 
 INF = np.inf
@@ -284,3 +286,15 @@ def test_a_released_model_built_in_code_is_checked_like_a_file():
         Model("bad", {"g": np.zeros(3), "a": np.zeros(3)},
               rigids=(make_rigid("m", ["a"], 1.0, [0, 0, 0], [1, 1, 1]),),
               springs=(make_spring("pin1", "g", "a", [INF] * 5 + [7.0], release=["rz"]),), boundary={"g": fixed()})
+
+
+def test_check_report_shows_the_jumps_and_the_zero_force_rows():
+    """The ball joint adds three unknowns (its jumps) and three rows (no moment), so
+    Ū_all is of order 12 + 3 with the two boundary ends' 6 + 6 unknowns."""
+    report = describe(build_topology(beam_on_joint(["rx", "ry", "rz"])))
+    assert report.ubar_order == 15
+    assert [(joint.name, joint.released) for joint in report.joints] == [("joint", ("rx", "ry", "rz"))]
+    assert report.block_rows == ("main", "joint free") and "Δ[joint]" in report.block_columns
+    text = report.to_text()
+    assert "(12 main rows + 6 x 0 geometric rows + 3 joint rows)" in text
+    assert "Δ[joint]: Δrx Δry Δrz" in text

@@ -611,6 +611,13 @@ def _rigid_field(positions, frames, segments) -> tuple[np.ndarray, float]:
     return placed.reshape(6 * len(positions), -1), float(size)
 
 
+def _across_segments(spring, layout, segments) -> bool:
+    """Whether ``spring`` joins two segments (joined within one, its ends move alike
+    under every rigid motion of it, to the tolerance within which they coincide)."""
+    a, b = (layout.index.points[end] for end in spring.ends)
+    return segments[a] != segments[b]
+
+
 def _rigid_motions(model, layout) -> np.ndarray:
     """(n_full, r) zero-energy motions of each connected part: every segment
     (:func:`_components` without joints) moves rigidly, as far as the boundaries and
@@ -626,7 +633,7 @@ def _rigid_motions(model, layout) -> np.ndarray:
             for point, components in model.boundary.items()
             for dof in layout.index.point(point)[np.asarray(components, bool)]]
     held += [sp.csr_matrix((values, (np.zeros(6, int), cols)), shape=(1, 6 * layout.n_nodes))
-             for spring in model.springs if spring.released.size
+             for spring in model.springs if spring.released.size and _across_segments(spring, layout, segments)
              for _, cols, values in _spring_directions(spring, layout, kept_only=True)]
     held = sp.vstack(held).tocsc() if held else sp.csc_matrix((0, 6 * layout.n_nodes))
     motions = []
@@ -774,7 +781,9 @@ def _rigid_basis(motions, M):
         return np.zeros((n, 0)), np.zeros(0, dtype=int)
     basis = la.orth(motions)
     kinetic, directions = la.eigh(basis.T @ (M @ basis))
-    massive = kinetic > MASSLESS * np.abs(kinetic).max()
+    # against the model's own mass scale too: a joint can leave a motion of massless
+    # points alone, whose kinetic energy is the rounding of the others' DOFs
+    massive = kinetic > MASSLESS * max(np.abs(kinetic).max(), M.diagonal().max())
     modes = basis @ (directions[:, massive] / np.sqrt(kinetic[massive]))
     pivots = la.qr(basis.T, pivoting=True, mode="r")[1]
     return modes, np.sort(pivots[:basis.shape[1]])

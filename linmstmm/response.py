@@ -540,8 +540,8 @@ def respond(model: Model, case: LoadCase, damping_ratio=None,
                             damping_ratio=damping_ratio, static=static)
     if static_correction and not held:
         return replace(result, note=f"no static correction: the model has {modes.rigid_body_modes} "
-                                    f"zero-frequency modes (free-floating, or a mechanism); the modal "
-                                    f"sum alone")
+                                    f"rigid-body modes (free-floating, or a joint's mechanism); the "
+                                    f"modal sum alone")
     return result
 
 

@@ -139,7 +139,7 @@ def rigid_body_motions(model: Model) -> dict[str, np.ndarray]:
         field = _segment_field(unit_motions(positions, centre, size), [segments.index(segment_of[p]) for p in part],
                                len(segments))
         index = {p: i for i, p in enumerate(part)}
-        held = _held_motions(model, part, index, field, size)
+        held = _held_motions(model, part, index, field, size, segment_of)
         allowed = la.null_space(held, rcond=GEOMETRIC_RANK) if held.size else np.eye(field.shape[2])
         if not allowed.shape[1]:
             continue
@@ -166,16 +166,20 @@ def _segment_field(field: np.ndarray, segment: list, count: int) -> np.ndarray:
     return placed
 
 
-def _held_motions(model: Model, part: list, index: dict, field: np.ndarray, size: float) -> np.ndarray:
+def _held_motions(model: Model, part: list, index: dict, field: np.ndarray, size: float,
+                  segment_of: dict) -> np.ndarray:
     """(h, 6 segments) rows that vanish under an allowed motion of the part: its fixed
     boundary components, and the relative motion across each of its joints in the
     directions the joint keeps (in the joint's axes). Rotation rows are scaled by
-    ``size`` so that every row is of order one."""
+    ``size`` so that every row is of order one. A joint whose ends are in one segment
+    (``segment_of``: point -> segment) holds nothing: its ends move alike (to the
+    tolerance within which they coincide, which is no row of the matrix)."""
     weight = np.r_[np.ones(3), np.full(3, size)]
     rows = [(weight[:, None] * field[index[p]])[model.fixed_mask(p)] for p in part]
     for spring in model.springs:
-        if spring.released.size and spring.ends[0] in index:
-            relative = weight[:, None] * (field[index[spring.ends[1]]] - field[index[spring.ends[0]]])
+        a, b = spring.ends
+        if spring.released.size and a in index and segment_of[a] != segment_of[b]:
+            relative = weight[:, None] * (field[index[b]] - field[index[a]])
             local = np.kron(np.eye(2), np.asarray(spring.axes, float)) @ relative
             rows.append(np.delete(local, spring.released, axis=0))
     return np.concatenate(rows) if rows else np.zeros((0, field.shape[2]))

@@ -17,6 +17,7 @@ from linmstmm.cli import main
 from linmstmm.fe import fe_frequencies
 from linmstmm.model import Model, ModelError, load_model
 from linmstmm.modes import mode_shapes
+from linmstmm.predicted import coarse_predictions
 from linmstmm.response import frf
 from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.solve import natural_frequencies
@@ -298,3 +299,35 @@ def test_check_report_shows_the_jumps_and_the_zero_force_rows():
     text = report.to_text()
     assert "(12 main rows + 6 x 0 geometric rows + 3 joint rows)" in text
     assert "Δ[joint]: Δrx Δry Δrz" in text
+
+
+def test_a_joint_within_one_rigid_assembly_holds_nothing():
+    """Two free bodies welded at s, a joint between their ports p and q (which
+    coincide to 1e-11 m, within the loader's tolerance): the joint's ends move alike
+    in every rigid motion of the assembly, so it holds none of its six rigid-body
+    modes, in the kinematics as in the FE route (its rows are rounding, not rank)."""
+    pts = points(p=[0, 0, 0], s=[1.0, 0, 0], q=[0, 1e-11, 0])
+    model = Model("welded", pts, rigids=(make_rigid("one", ["p", "s"], 2.0, [0.5, 0.1, 0], [0.1, 0.2, 0.3]),
+                                         make_rigid("two", ["s", "q"], 3.0, [0.5, -0.1, 0], [0.2, 0.2, 0.3])),
+                  springs=(make_spring("joint", "p", "q", [1e4, 1e4, 1e4, 0.0, 0.0, 1e3], release=["rx", "ry"]),))
+    assert rigid_body_mode_count(model) == 6 == fe_frequencies(model, count=1).rigid_body_modes
+
+
+def test_a_massless_point_free_to_turn_between_two_joints():
+    """The beam on a ball joint again, with a massless point between the ball and the
+    beam and a pin (rz released, elastic in rx and ry) between that point and the
+    beam: the point turns about z freely and carries no mass, a motion with neither
+    stiffness nor mass that is no mode (and that the coarse prediction must remove
+    before its eigenproblem). The frequencies stay the pinned-free beam's."""
+    length = 2.0
+    pts = points(g=[0, 0, 0], m=[0, 0, 0], a=[0, 0, 0], b=[length, 0, 0])
+    model = Model("beam behind a ball and a pin", pts, beams=(make_beam("beam", "a", "b", pts),),
+                  springs=(make_spring("ball", "g", "m", [INF] * 3 + [0.0] * 3, release=["rx", "ry", "rz"]),
+                           make_spring("pin", "m", "a", [INF] * 3 + [3e4, 3e4, 0.0], release=["rz"])),
+                  boundary={"g": fixed()})
+    result = natural_frequencies(model, count=2)
+    assert result.rigid_body_modes == 3 == fe_frequencies(model, count=1).rigid_body_modes
+    exact = 3.926602312 ** 2 * np.sqrt(E * I / (RHO * AREA * length ** 4)) / (2 * np.pi)
+    np.testing.assert_allclose(result.frequencies_hz, [exact, exact], rtol=1e-9)
+    coarse = coarse_predictions(model, 2) / (2 * np.pi)  # two Hermite elements: within 1 %
+    np.testing.assert_allclose(coarse, [exact, exact], rtol=1e-2)

@@ -34,12 +34,23 @@ import numpy as np
 
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.elements.frames import FORCE_INDEX
-from linmstmm.elements.rigid import force_extraction, position_incidence, rigid_transfer_parts
+from linmstmm.elements.rigid import (
+    force_extraction,
+    position_incidence,
+    rigid_transfer_parts,
+)
 from linmstmm.elements.spring import joint_force, joint_jump, spring_transfer
-from linmstmm.numeric import (constant_times, frequencies, is_mp, numbers, power_of_two_scale, size_estimate,
-                              zeros_like_stack)
-from linmstmm.periodic import carry_run, find_runs
 from linmstmm.model import COMPONENTS
+from linmstmm.numeric import (
+    constant_times,
+    frequencies,
+    is_mp,
+    numbers,
+    power_of_two_scale,
+    size_estimate,
+    zeros_like_stack,
+)
+from linmstmm.periodic import carry_run, find_runs
 from linmstmm.topology import Topology
 
 #: Largest βL of one beam piece in the stable evaluation: the piece's own
@@ -211,9 +222,9 @@ class Deduction:
         """The jumps across the released directions of joint ``e`` as a state:
         ``E Δ`` on their columns (less released ones)."""
         if ("jump", e) not in self._tips:
-            columns = self.jump_columns[e]
+            columns, record = self.jump_columns[e], self.topology.elements[e].record
             kept = ~np.isin(columns, self.released_columns)
-            jump = joint_jump(self.topology.elements[e].record.axes, self.topology.elements[e].record.released)
+            jump = joint_jump(record.axes, record.released)
             self._tips["jump", e] = (columns[kept], jump[:, kept])
         columns, jump = self._tips["jump", e]
         return PortState(columns, np.broadcast_to(jump, (n,) + jump.shape), np.ones(n))

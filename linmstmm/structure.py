@@ -243,7 +243,6 @@ def _blocks(topology, rows, columns):
     the row of each joint passed.
     """
     elements = topology.elements
-    root = elements[topology.order[-1]].name
     terms = {(r, c): [] for r in range(len(rows)) for c in range(len(columns))}
     terms[0, 0].append("-I")
     paths = []

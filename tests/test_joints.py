@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from builders import fixed, make_beam, make_rigid, make_spring
+from test_rigid_body_modes import in_other_units
+
 from linmstmm.cli import main
 from linmstmm.fe import fe_frequencies
 from linmstmm.model import Model, ModelError, load_model
@@ -23,7 +24,6 @@ from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.solve import natural_frequencies
 from linmstmm.structure import describe
 from linmstmm.topology import build_topology
-from test_rigid_body_modes import in_other_units
 
 INF = np.inf
 #: A pin about the spring's local z: rigid in the other five directions.

@@ -350,3 +350,26 @@ def test_a_stiff_loop_beside_a_joint_is_no_indeterminate_unknown():
     result, check = natural_frequencies(model, count=6), fe_frequencies(model, count=6)
     assert result.indeterminate_released == 0
     np.testing.assert_allclose(result.frequencies_hz, check.frequencies_hz, rtol=1e-9)
+
+
+def with_random_joints(model: Model, rng: np.random.Generator) -> Model:
+    """``model`` with one to three random directions released in seven springs of ten."""
+    springs = []
+    for spring in model.springs:
+        mask = np.zeros(6, bool)
+        if rng.random() < 0.7:
+            mask[rng.choice(6, rng.integers(1, 4), replace=False)] = True
+        springs.append(dataclasses.replace(spring, k=np.where(mask, 0.0, spring.k), release=mask)
+                       if mask.any() else spring)
+    return dataclasses.replace(model, springs=tuple(springs))
+
+
+@pytest.mark.parametrize("kind", ["tree", "floating_tree", "loops", "floating_loops", "ring"])
+@pytest.mark.parametrize("number", [0, 1, 2])
+def test_random_models_with_joints_agree_with_the_fe_route(kind, number):
+    """Random models (rigid bodies, springs, beams, junctions, loops) with random
+    joints: the same zero-frequency count and the same lowest six frequencies."""
+    model = with_random_joints(random_model(kind, number), np.random.default_rng(1000 + number))
+    result, check = natural_frequencies(model, count=6), fe_frequencies(model, count=6)
+    assert result.rigid_body_modes == check.rigid_body_modes == rigid_body_mode_count(model)
+    np.testing.assert_allclose(result.frequencies_hz, check.frequencies_hz, rtol=1e-9)

@@ -34,11 +34,7 @@ import numpy as np
 
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.elements.frames import FORCE_INDEX
-from linmstmm.elements.rigid import (
-    force_extraction,
-    position_incidence,
-    rigid_transfer_parts,
-)
+from linmstmm.elements.rigid import force_extraction, position_incidence, rigid_transfer_parts
 from linmstmm.elements.spring import joint_force, joint_jump, spring_transfer
 from linmstmm.model import COMPONENTS
 from linmstmm.numeric import (

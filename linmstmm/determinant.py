@@ -18,8 +18,7 @@ cost figure the benchmarks report per root.
 
 :func:`determinant` chooses: ``engine="auto"`` takes the compiled kernels
 where they are already loaded in this process (a long session, a parameter
-study: :func:`load_kernels`), the numpy carry otherwise and for a model with
-released joints.
+study: :func:`load_kernels`), the numpy carry otherwise.
 """
 from __future__ import annotations
 
@@ -45,15 +44,10 @@ def load_kernels() -> None:
 
 
 def determinant(deduction: Deduction, engine: str = "auto"):
-    """The determinant of ``deduction`` by ``engine`` ("auto", "numpy" or "compiled").
-
-    "auto" takes the numpy carry for a model with released joints, which the
-    compiled program does not carry (:func:`~linmstmm.program.compile_program`
-    refuses them).
-    """
+    """The determinant of ``deduction`` by ``engine`` ("auto", "numpy" or "compiled")."""
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
-    if engine == "compiled" or (engine == "auto" and kernels_loaded() and not deduction.jump_columns):
+    if engine == "compiled" or (engine == "auto" and kernels_loaded()):
         return CompiledDeterminant(deduction)
     return NumpyDeterminant(deduction)
 
@@ -95,7 +89,7 @@ class CompiledDeterminant:
                             p.places_start, p.matrices, p.orthos, p.ortho_blocks, p.beams, p.beam_rotation)
         self._layout = (p.slot_offset, p.slot_width, p.slot_columns, p.slot_columns_start, p.workspace,
                         p.slot_rows.size, p.root, p.root_row, p.geometric_rows, p.order, p.kept_rows,
-                        p.kept_columns)
+                        p.kept_columns, p.slot_rows)
         #: evaluations of det Ū_all so far (one per frequency)
         self.evaluations = 0
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.mode_bound import check_range_request
-from linmstmm.model import Model, ModelError
+from linmstmm.model import Model
 from linmstmm.nullspace import release_indeterminate
 from linmstmm.precision import refine_roots, separated_cluster
 from linmstmm.predicted import predict_frequencies
@@ -87,8 +87,6 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     so every caller's counts see the elastic roots only.
     Returns (deduction, finder, number of indeterminate unknowns released).
     """
-    if engine == "compiled":
-        _refuse_joints_compiled(model)
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
     released = release_indeterminate(deduction)
     evaluator = determinant(deduction, engine)
@@ -98,16 +96,6 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     finder.determinant = evaluator
     finder.divide_out_rigid_body_zeros(finder.rigid_body_modes())
     return deduction, finder, released
-
-
-def _refuse_joints_compiled(model: Model) -> None:
-    """Raise ModelError naming the first spring with a released direction: the
-    compiled engine does not carry joints (``engine="auto"`` takes numpy for them)."""
-    for spring in model.springs:
-        if spring.released.size:
-            raise ModelError(model.source or f"model {model.name!r}",
-                             "the compiled engine does not carry released joints; use engine "
-                             "numpy or auto", element=f"spring {spring.name!r}", key="release")
 
 
 @single_blas_thread

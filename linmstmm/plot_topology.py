@@ -29,6 +29,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from linmstmm.label_layout import line_samples, place_label
 from linmstmm.topology import Topology
 
 _BODY_STYLE = {
@@ -223,42 +224,19 @@ def _draw_connection(axes, topology, child, node, position, patches):
                                           shrinkA=0, shrinkB=0, mutation_scale=12))
 
 
-#: Places tried in turn for a spring's name, around its place: (offset in points, ha, va).
-_NAME_PLACES = (((0, 5), "center", "bottom"), ((-4, 4), "right", "bottom"), ((4, 4), "left", "bottom"),
-                ((4, -4), "left", "top"), ((-4, -4), "right", "top"), ((0, -5), "center", "top"))
-
-
 def _name_springs(figure, axes, springs, lines) -> None:
-    """Write each spring's name at the first place of _NAME_PLACES that is clear.
+    """Write each spring's name at the first place around it that is clear.
 
     Clear: the name's box meets no text or node outline drawn so far and no
-    connection or cut arc (``lines``: (k, 2) polylines, data coordinates).
-    Where no place is clear, the first is used.
+    connection or cut arc (``lines``: (k, 2) polylines, data coordinates);
+    see :func:`linmstmm.label_layout.place_label`.
     """
-    renderer = figure.canvas.get_renderer()
     figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
     taken = [(text.get_bbox_patch() or text).get_window_extent(renderer) for text in axes.texts]
-    samples = np.vstack([axes.transData.transform(_densify(line)) for line in lines])
+    samples = line_samples(axes, lines)
     for name, xy in springs:
-        for offset, ha, va in _NAME_PLACES:
-            label = axes.annotate(name, xy, xytext=offset, textcoords="offset points", ha=ha, va=va,
-                                  fontsize=8)
-            box = label.get_window_extent(renderer).padded(1.0)
-            if not box.count_contains(samples) and not box.count_overlaps(taken):
-                break
-            label.remove()
-        else:
-            offset, ha, va = _NAME_PLACES[0]
-            label = axes.annotate(name, xy, xytext=offset, textcoords="offset points", ha=ha, va=va,
-                                  fontsize=8)
-        taken.append(label.get_window_extent(renderer))
-
-
-def _densify(line, step=0.05) -> np.ndarray:
-    """(m, 2) points along the polyline ``line`` (k, 2), at most ``step`` apart (data units)."""
-    pieces = [np.linspace(a, b, max(2, int(np.ceil(np.linalg.norm(b - a) / step)) + 1))
-              for a, b in zip(line[:-1], line[1:])]
-    return np.vstack(pieces)
+        place_label(axes, name, xy, samples, taken, fontsize=8)
 
 
 def _label_input(axes, body_xy, input_xy, k):

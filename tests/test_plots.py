@@ -17,9 +17,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 from builders import fixed, single_beam_model
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 from PIL import Image
 
 from linmstmm import cli
+from linmstmm.label_layout import AROUND, line_samples, place_label
 from linmstmm.mode_commands import add_mode_commands, align_eigenspaces
 from linmstmm.mode_figure import _GIF_COLORS, _mode_canvas, _scene, convex_hull
 from linmstmm.model import load_model
@@ -358,3 +361,21 @@ def test_script_writes_its_figure(tmp_path, script, words):
     assert result.returncode == 0, result.stderr
     assert all(word in result.stdout for word in words)
     assert is_png(figure)
+
+
+def test_a_label_takes_the_first_clear_place():
+    """A line across the place above the anchor sends the label to the next place; a box taken, further."""
+    figure = Figure(figsize=(4, 3))
+    FigureCanvasAgg(figure)
+    axes = figure.add_subplot(xlim=(0, 10), ylim=(0, 10))
+    line = [[0, 5.3], [10, 5.3]]  # a few points above the anchor (5, 5)
+    samples = line_samples(axes, [line])
+    assert np.diff(np.sort(samples[:, 0])).max() <= 2.0 + 1e-9  # at most 2 px apart
+    taken = []
+    first = place_label(axes, "name", (5, 5), samples, taken)
+    assert first.get_anncoords() == "offset points" and first.xyann[1] < 0  # below the line
+    assert not taken[0].count_contains(samples)
+    second = place_label(axes, "name", (5, 5), samples, taken)
+    assert not second.get_window_extent().overlaps(taken[0])
+    everywhere = place_label(axes, "name", (5, 5), samples, taken, places=AROUND[:1])
+    assert everywhere.xyann == AROUND[0][0]  # nothing clear: the first place

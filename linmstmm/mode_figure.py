@@ -336,11 +336,16 @@ class _DeformedView:
 
     def _frame(self) -> None:
         """Limits, equal scales, labels; the isometric view gets an axis triad instead of axes."""
-        axes, view = self.axes, self.view
-        corners = np.array(np.meshgrid(*self.scene.limits, indexing="ij")).reshape(3, -1).T
-        screen = view.project(corners)
-        axes.set_xlim(screen[:, 0].min(), screen[:, 0].max())
-        axes.set_ylim(screen[:, 1].min(), screen[:, 1].max())
+        axes, view, scene = self.axes, self.view, self.scene
+        if view.labels is None:  # the structure's own extent, with room for the motion
+            places = np.concatenate([scene.segments.reshape(-1, 3), *scene.bodies, scene.markers])
+            screen = view.project(places)
+            reach = AMPLITUDE * scene.size
+            low, high = screen.min(axis=0) - reach, screen.max(axis=0) + reach
+        else:
+            low, high = view.project(scene.limits.T)
+        axes.set_xlim(low[0], high[0])
+        axes.set_ylim(low[1], high[1])
         axes.set_aspect("equal", adjustable="box")
         axes.set_title(view.title, fontsize=9)
         if view.labels is None:

@@ -16,6 +16,7 @@ from linmstmm.model import ModelError, load_model
 from linmstmm.fe_command import add_fe_command
 from linmstmm.mode_commands import add_mode_commands
 from linmstmm.structure import add_check_command
+from linmstmm.sweep_command import add_sweep_command
 
 
 class UsageError(Exception):
@@ -105,6 +106,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_check_command(sub)
     add_fe_command(sub)
     add_mode_commands(sub)
+    add_sweep_command(sub)
     return parser
 
 

@@ -88,8 +88,10 @@ def parse_key(model: Model, text: str) -> Key:
 
 
 def unknown_key(model: Model, text: str) -> ModelError:
-    """The ModelError for a key that names no number of ``model`` (with a did-you-mean)."""
-    close = difflib.get_close_matches(text, parameter_keys(model), n=1, cutoff=0.5)
+    """The ModelError for a key that names no number of ``model``, with the closest key
+    (one that differs in case only, else the nearest spelling)."""
+    keys = parameter_keys(model)
+    close = [k for k in keys if k.lower() == text.lower()] or difflib.get_close_matches(text, keys, n=1, cutoff=0.5)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     return ModelError(_file(model), f"names no number of the model{hint}; keys look like "
                                     "rigid.NAME.mass, spring.NAME.k[2], beam.NAME.E, points.NAME[0]",

@@ -24,6 +24,7 @@ cluster (``dask``); the results are the same.
 from __future__ import annotations
 
 import itertools
+import logging
 import math
 import sys
 import time
@@ -35,6 +36,9 @@ from scipy.optimize import linear_sum_assignment
 
 from linmstmm.model import Model, ModelError
 from linmstmm.parameters import get_value, parse_key, with_values
+
+#: Seconds to wait for a dask scheduler given by address before giving up.
+SCHEDULER_TIMEOUT = 10
 
 
 @dataclass(frozen=True)
@@ -307,10 +311,10 @@ def _on_dask(models, count, keys, dask, workers, bar):
     if isinstance(dask, Client):
         return _dask_map(dask, models, count, keys, bar), f"dask {dask.scheduler.address}"
     if dask == "local":
-        with LocalCluster(n_workers=max(workers, 2), threads_per_worker=1,
-                          dashboard_address=None) as cluster, Client(cluster) as client:
+        with LocalCluster(n_workers=max(workers, 2), threads_per_worker=1, dashboard_address=None,
+                          silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
             return _dask_map(client, models, count, keys, bar), f"dask LocalCluster ({max(workers, 2)} workers)"
-    with Client(dask) as client:
+    with Client(dask, timeout=SCHEDULER_TIMEOUT) as client:
         return _dask_map(client, models, count, keys, bar), f"dask {dask}"
 
 

@@ -229,12 +229,11 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
     """
     start = time.perf_counter()
     steps = list(steps)
-    keys = [parse_key(model, text) for text in steps[0]] if steps else []
+    shape = tuple(shape) if shape is not None else (len(steps),)
+    _check_steps(steps, shape)
+    keys = [parse_key(model, text) for text in steps[0]]
     models = [_edited(model, keys, step) for step in steps]
     names = tuple(key.text for key in keys)
-    shape = tuple(shape) if shape is not None else (len(steps),)
-    if math.prod(shape) != len(steps):
-        raise ValueError(f"shape {shape} does not hold {len(steps)} steps")
     solutions, label = _run(models, count, names if sensitivity else (), workers, dask, progress)
     order, mac = track([s.shapes for s in solutions], neighbours(shape), count, _length_scale(model))
     return SweepResult(
@@ -273,6 +272,16 @@ def track(shapes, previous, count: int, length: float) -> tuple[np.ndarray, np.n
         free = np.flatnonzero(order[step] < 0)[:unclaimed.size]
         order[step, free] = unclaimed[:free.size]
     return order, mac
+
+
+def _check_steps(steps: list, shape: tuple) -> None:
+    """ValueError unless there are steps, all setting the same keys, as many as ``shape`` holds."""
+    if not steps or not steps[0]:
+        raise ValueError("a sweep needs at least one step setting at least one key")
+    if any(set(step) != set(steps[0]) for step in steps):
+        raise ValueError(f"every step must set the same keys: {', '.join(steps[0])}")
+    if math.prod(shape) != len(steps):
+        raise ValueError(f"shape {shape} does not hold {len(steps)} steps")
 
 
 def _edited(model: Model, keys, step: dict) -> Model:

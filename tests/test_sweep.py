@@ -138,6 +138,15 @@ def test_a_step_that_breaks_the_model_names_file_element_key_and_step():
                                 "(in the step rigid.m2.mass = -1)")
 
 
+def test_steps_must_set_the_same_keys_and_fill_the_shape():
+    model = load_model(CHAIN)
+    for steps, shape, message in (([], None, "at least one step"),
+                                  ([{"rigid.m2.mass": 1.0}, {"rigid.m1.mass": 1.0}], None, "same keys"),
+                                  ([{"rigid.m2.mass": 1.0}], (2,), "does not hold")):
+        with pytest.raises(ValueError, match=message):
+            sweep(model, steps, shape=shape)
+
+
 # --- ranges ---------------------------------------------------------------------------
 
 def test_ranges_grid_and_zip():

@@ -42,8 +42,8 @@ def frequency_sensitivities(model: Model, modes: ModalResult, keys) -> dict[str,
         (their rows are 0).
     keys : key strings (:mod:`linmstmm.parameters`).
     Returns key -> (n,) Hz per SI unit of the key, in the order of ``modes``.
-    Raises ModelError for a key without a closed-form derivative (points, spring axes)
-    or modes that are not mass-normalised.
+    Raises ModelError for a key without a closed-form derivative (points, spring axes),
+    ValueError for modes that are not mass-normalised.
     """
     if modes.normalization != "mass":
         raise ValueError("sensitivities need mass-normalised modes (normalization='mass')")
@@ -171,6 +171,5 @@ def _start_state(beam, modes: ModalResult) -> np.ndarray:
     transfer = beam_transfer(beam, modes.omega)
     flip = np.concatenate([np.ones(6), -np.ones(6)])
     candidates = [(first, second), (first * flip, second * flip)]
-    misfit = [np.linalg.norm(np.einsum("nij,nj->ni", transfer, a) - b) / max(np.linalg.norm(b), np.finfo(float).tiny)
-              for a, b in candidates]
+    misfit = [np.linalg.norm(np.einsum("nij,nj->ni", transfer, a) - b) for a, b in candidates]
     return candidates[int(np.argmin(misfit))][0]

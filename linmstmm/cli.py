@@ -72,6 +72,7 @@ COMMAND_EXAMPLES = {
     "scan": "linmstmm scan models/cantilever_tip_mass.toml --fmax 200 --plot scan.png",
     "response": "linmstmm response models/cantilever_tip_mass.toml models/loads/cantilever_step.toml",
     "frf": "linmstmm frf models/cantilever_tip_mass.toml --point tip --direction z --fmax 100",
+    "sweep": "linmstmm sweep models/spring_mass_chain.toml --vary spring.k2.k[0]=500:2000:4:log --count 3",
 }
 
 

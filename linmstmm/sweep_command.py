@@ -33,9 +33,9 @@ def add_sweep_command(subparsers):
     sweep.add_argument("model", help="model file (TOML, see model-format.md)")
     sweep.add_argument("--vary", type=_vary, action="append", required=True, metavar="KEY=START:STOP:N[:log]",
                        help="a value of the model (e.g. spring.k1.k[2], beam.arm.E, rigid.m2.mass, "
-                            "points.tip[0]) from START to STOP in N steps; several form a grid")
+                            "points.tip[0]) from START to STOP in N steps (:log geometric); several form a grid")
     sweep.add_argument("--zip", action="store_true", help="pair the --vary ranges (same N) instead of a grid")
-    sweep.add_argument("--count", type=_positive_int, default=DEFAULT_COUNT,
+    sweep.add_argument("--count", type=_positive_int, default=DEFAULT_COUNT, metavar="K",
                        help=f"elastic frequencies per step (default {DEFAULT_COUNT})")
     sweep.add_argument("--json", action="store_true", help="one JSON object on stdout")
     sweep.add_argument("--csv", metavar="FILE", help="one row per step: values, tracked frequencies")

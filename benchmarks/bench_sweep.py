@@ -87,6 +87,11 @@ def write_report(path, command, result, runs, identical, varies) -> None:
     serial = next(iter(runs.values()))[1]
     lines += [f"| {label} | {seconds:.1f} s | {steps / seconds:.1f} | {serial / seconds:.2f} |"
               for label, (_, seconds) in runs.items()]
+    if os.getloadavg()[0] >= facts["cores"]:
+        lines += ["", ("Other work held the cores during this run (1-min load average at or above the "
+                       "number of cores, and these runs are niced), so the extra processes found no idle "
+                       "core: the speed-ups measure that contention, not what the parallel runs give on an "
+                       "idle machine.")]
     lines += [
         "",
         (f"Frequencies and tracking identical in the three runs: **{'yes' if identical else 'NO'}** "
@@ -151,7 +156,7 @@ def plot(result, varies, path) -> None:
     lines.set_xlabel(varies[1].key + " [N m/rad]", fontsize=8)
     lines.set_ylabel("natural frequency [Hz]")
     lines.set_title(f"a tracking path: {varies[0].key} = {x[middle]:.3g}", fontsize=9)
-    lines.legend(fontsize=7)
+    lines.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.0, 0.5))
     for panel in axes[count + 1:]:
         panel.set_visible(False)
     figure.suptitle("MLRS-style launcher: lowest elastic frequencies, columns following mode shapes (MAC)")

@@ -184,7 +184,7 @@ def mac_matrix(a, b) -> np.ndarray:
 @single_blas_thread
 def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = None,
                 stations: int = 21, normalization: str = DEFAULT_NORMALIZATION, rigid_body: bool = True,
-                root: str | None = None) -> ModalResult:
+                root: str | None = None, engine: str = "auto") -> ModalResult:
     """Natural modes of ``model`` by the transfer matrix method.
 
     count : the lowest ``count`` elastic modes; fmax : Hz, all up to fmax (both:
@@ -197,6 +197,8 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         component is made positive either way.
     rigid_body : include the zero-frequency modes first.
     root : boundary end to use as the root of the transfer tree.
+    engine : how the root search evaluates det Ū_all, as for
+        :func:`linmstmm.solve.natural_frequencies` (the frequencies agree to rounding).
     ``fmax`` alone is checked as :func:`linmstmm.solve.natural_frequencies` checks it.
     """
     if normalization not in NORMALIZATIONS:
@@ -205,7 +207,7 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         raise ValueError(f"stations must be >= 2, got {stations}")
     if fmax is not None and count is None:
         check_range_request(model, fmax)
-    deduction, finder, _ = frequency_finder(model, root)
+    deduction, finder, _ = frequency_finder(model, root, engine=engine)
     omega_max = None if fmax is None else 2 * np.pi * fmax
     eigenspaces = _group(finder.find(None if count is None else count + EIGENSPACE_MARGIN, omega_max))
     if count is not None:  # whole eigenspaces that start within the first ``count`` modes

@@ -4,8 +4,9 @@ A sweep is a list of steps, each a dict key -> value (keys:
 :mod:`linmstmm.parameters`). :func:`grid` builds it from :class:`Vary`
 ranges, as their outer product or (``zipped``) side by side. Each step is an
 edited copy of the model, solved afresh by
-:func:`~linmstmm.solve.natural_frequencies` (so every row is exactly what
-``linmstmm freqs`` gives on the edited model, whatever runs the steps) and
+:func:`~linmstmm.solve.natural_frequencies` with the numpy engine (:data:`ENGINE`;
+so every row is exactly what ``linmstmm freqs`` gives on the edited model,
+whatever runs the steps and whatever this process has loaded) and
 :func:`~linmstmm.modes.mode_shapes` (for tracking; and for the sensitivities
 of :mod:`linmstmm.sensitivity`).
 
@@ -37,6 +38,10 @@ from scipy.optimize import linear_sum_assignment
 from linmstmm.model import Model, ModelError
 from linmstmm.parameters import get_value, parse_key, with_values
 
+#: How every step evaluates det Ū_all: the engine ``linmstmm freqs`` uses in a new process.
+#: Fixed, not "auto" (which follows what this process has loaded), so that a step gives
+#: the same bits in this process, in a fresh worker process and on a cluster.
+ENGINE = "numpy"
 #: Seconds to wait for a dask scheduler given by address before giving up.
 SCHEDULER_TIMEOUT = 10
 
@@ -141,14 +146,14 @@ class StepSolution:
     note: str = ""
 
 
-def solve_step(model: Model, count: int, sensitivity_keys=()) -> StepSolution:
-    """Frequencies (as :func:`~linmstmm.solve.natural_frequencies`), mode shapes and,
-    for each key in ``sensitivity_keys`` (key strings), ∂f/∂value of one step."""
+def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGINE) -> StepSolution:
+    """Frequencies (as :func:`~linmstmm.solve.natural_frequencies` with ``engine``), mode
+    shapes and, for each key in ``sensitivity_keys`` (key strings), ∂f/∂value of one step."""
     from linmstmm.modes import mode_shapes
     from linmstmm.solve import natural_frequencies
 
-    result = natural_frequencies(model, count=count)
-    modes = mode_shapes(model, count=count, rigid_body=False)
+    result = natural_frequencies(model, count=count, engine=engine)
+    modes = mode_shapes(model, count=count, rigid_body=False, engine=engine)
     found = min(result.frequencies_hz.size, modes.omega.size)
     shapes = np.stack([modes.point_displacements[p][:found] for p in model.points], axis=1)
     sensitivities = {}

@@ -21,7 +21,7 @@ from linmstmm.modes import mode_shapes
 from linmstmm.parameters import get_value, parse_key, with_values
 from linmstmm.sensitivity import frequency_sensitivities
 from linmstmm.solve import natural_frequencies
-from linmstmm.sweep import sweep
+from linmstmm.sweep import ENGINE, sweep
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
 STEP = 1e-4
@@ -107,8 +107,8 @@ def test_a_key_that_moves_the_geometry_is_refused():
 def test_sweep_reports_them_in_tracked_order():
     model = load_model(MODELS / "mlrs" / "mlrs.toml")
     result = sweep(model, [{"spring.elevation.k[4]": v} for v in (2e7, 3e7)], count=4, sensitivity=True)
-    by_rank = frequency_sensitivities(edited(model, {"spring.elevation.k[4]": 3e7}),
-                                      mode_shapes(edited(model, {"spring.elevation.k[4]": 3e7}), count=4,
-                                                  rigid_body=False), ["spring.elevation.k[4]"])
+    step = edited(model, {"spring.elevation.k[4]": 3e7})
+    modes = mode_shapes(step, count=4, rigid_body=False, engine=ENGINE)  # the sweep's engine
+    by_rank = frequency_sensitivities(step, modes, ["spring.elevation.k[4]"])
     tracked = result.sensitivities["spring.elevation.k[4]"][1]
     np.testing.assert_array_equal(tracked, by_rank["spring.elevation.k[4]"][:4][result.order[1]])

@@ -56,7 +56,15 @@ class Key:
 def parameter_keys(model: Model) -> list[str]:
     """Every key of ``model``, in model order (see the module docstring).
 
-    Returns a list of strings; ``inertia`` lists each symmetric pair once (i <= j).
+    Parameters
+    ----------
+    model : Model
+        The model.
+
+    Returns
+    -------
+    list of str
+        The keys; ``inertia`` lists each symmetric pair once (i <= j).
     """
     keys = [f"points.{name}[{i}]" for name in model.points for i in range(3)]
     for section, attribute in SECTIONS.items():
@@ -75,11 +83,54 @@ def parameter_keys(model: Model) -> list[str]:
     return keys
 
 
+def unit(key: Key) -> str:
+    """The SI unit of ``key``'s value, as the column headers of ``linmstmm sweep --csv`` write it.
+
+    Parameters
+    ----------
+    key : Key
+        A parsed key (:func:`parse_key`).
+
+    Returns
+    -------
+    str
+        "kg", "m", "kg m^2", "N/m", "N m/rad", "N s/m", "N m s/rad", "Pa",
+        "kg/m^3", "m^2", "m^4", "1/s", "s", or "1" for a spring's axis entry.
+    """
+    if key.section == "points":
+        return "m"
+    if key.section == "damping":
+        return "1/s" if key.field == "alpha" else "s"
+    if key.section == "spring":
+        rotation = bool(key.index) and key.index[0] >= 3
+        return {"k": "N m/rad" if rotation else "N/m", "c": "N m s/rad" if rotation else "N s/m"}.get(key.field, "1")
+    return _UNITS[key.field]
+
+
+#: SI unit of each rigid-body and beam field.
+_UNITS = {"mass": "kg", "com": "m", "inertia": "kg m^2", "E": "Pa", "G": "Pa", "rho": "kg/m^3", "A": "m^2",
+          "Iy": "m^4", "Iz": "m^4", "J": "m^4", "Ip": "m^4"}
+
+
 def parse_key(model: Model, text: str) -> Key:
     """The :class:`Key` that ``text`` names in ``model``.
 
-    Raises ModelError naming the model's file and the key, with the closest
-    existing key, if ``text`` names no number of ``model``.
+    Parameters
+    ----------
+    model : Model
+        The model.
+    text : str
+        The key, e.g. ``spring.k1.k[2]``.
+
+    Returns
+    -------
+    Key
+
+    Raises
+    ------
+    ModelError
+        Naming the model's file and the key, with the closest existing key,
+        if ``text`` names no number of ``model``.
     """
     key = _split(text)
     if key is None or not _exists(model, key):
@@ -89,7 +140,20 @@ def parse_key(model: Model, text: str) -> Key:
 
 def unknown_key(model: Model, text: str) -> ModelError:
     """The ModelError for a key that names no number of ``model``, with the closest key
-    (one that differs in case only, else the nearest spelling)."""
+    (one that differs in case only, else the nearest spelling).
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    text : str
+        The key that was asked for.
+
+    Returns
+    -------
+    ModelError
+        The error (not raised), its key ``text``.
+    """
     keys = parameter_keys(model)
     close = [k for k in keys if k.lower() == text.lower()] or difflib.get_close_matches(text, keys, n=1, cutoff=0.5)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
@@ -99,7 +163,20 @@ def unknown_key(model: Model, text: str) -> ModelError:
 
 
 def get_value(model: Model, key: Key) -> float:
-    """The current value of ``key`` in ``model`` (float, in the key's SI unit)."""
+    """The current value of ``key`` in ``model``.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    key : Key
+        A key of ``model`` (:func:`parse_key`).
+
+    Returns
+    -------
+    float
+        The value, in the key's SI unit (:func:`unit`).
+    """
     if key.section == "points":
         return float(model.points[key.name][key.index])
     if key.section == "damping":
@@ -109,10 +186,24 @@ def get_value(model: Model, key: Key) -> float:
 
 
 def with_values(model: Model, edits: dict[Key, float]) -> Model:
-    """A validated copy of ``model`` with each key of ``edits`` set to its value (SI).
+    """A validated copy of ``model`` with each key of ``edits`` set to its value.
 
-    Raises ModelError (file, element, key) if the edited model breaks the
-    model contract, as :func:`linmstmm.model.load_model` would for that file.
+    Parameters
+    ----------
+    model : Model
+        The model.
+    edits : dict of Key to float
+        The new values, SI.
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    ModelError
+        (file, element, key) if the edited model breaks the model contract,
+        as :func:`linmstmm.model.load_model` would for that file.
     """
     points = dict(model.points)
     records = {record.name: record for record in model.elements}

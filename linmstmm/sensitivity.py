@@ -37,13 +37,28 @@ from linmstmm.parameters import Key, parse_key
 def frequency_sensitivities(model: Model, modes: ModalResult, keys) -> dict[str, np.ndarray]:
     """∂f/∂value of each elastic mode of ``modes`` for every key in ``keys``.
 
-    modes : mass-normalised modes of ``model`` (:func:`linmstmm.modes.mode_shapes`
+    Parameters
+    ----------
+    model : Model
+        The model.
+    modes : ModalResult
+        Mass-normalised modes of ``model`` (:func:`linmstmm.modes.mode_shapes`
         with the default normalisation), rigid-body modes left out or included
         (their rows are 0).
-    keys : key strings (:mod:`linmstmm.parameters`).
-    Returns key -> (n,) Hz per SI unit of the key, in the order of ``modes``.
-    Raises ModelError for a key without a closed-form derivative (points, spring axes),
-    ValueError for modes that are not mass-normalised.
+    keys : iterable of str
+        Key strings (:mod:`linmstmm.parameters`).
+
+    Returns
+    -------
+    dict of str to ndarray
+        key -> (n,) Hz per SI unit of the key, in the order of ``modes``.
+
+    Raises
+    ------
+    ModelError
+        For a key without a closed-form derivative (points, spring axes).
+    ValueError
+        For modes that are not mass-normalised.
     """
     if modes.normalization != "mass":
         raise ValueError("sensitivities need mass-normalised modes (normalization='mass')")
@@ -113,6 +128,8 @@ def _rigid_mass_form(rigid, modes: ModalResult, key: Key) -> np.ndarray:
 
 def _spring_form(spring, modes: ModalResult, component: int) -> np.ndarray:
     """(n, n) Φᵀ ∂K/∂k_i Φ: products of the ends' relative displacement along local ``component``."""
+    if spring.release is not None and spring.release[component]:  # a joint: k there does not act
+        return np.zeros((modes.omega.size,) * 2)
     a, b = (modes.point_displacements[p] for p in spring.ends)
     delta = b - a
     axes = np.asarray(spring.axes, float)

@@ -89,11 +89,26 @@ class Vary:
 
 
 def grid(varies, zipped: bool = False) -> tuple[list[dict], tuple[int, ...]]:
-    """The steps of ``varies`` (a list of :class:`Vary`) and the grid's shape.
+    """The steps of ``varies`` and the grid's shape.
 
-    zipped : pair the ranges (all must have the same N; shape (N,)) instead of
-    their outer product (shape (n1, n2, ...), last range fastest).
-    Returns (steps: list of {key: value}, shape).
+    Parameters
+    ----------
+    varies : iterable of Vary
+        The ranges, each with its own key.
+    zipped : bool
+        Pair the ranges (all must have the same N; shape (N,)) instead of
+        their outer product (shape (n1, n2, ...), last range fastest).
+
+    Returns
+    -------
+    steps : list of dict
+        Each step's {key: value}.
+    shape : tuple of int
+
+    Raises
+    ------
+    ValueError
+        For no range, a key varied twice, or zipped ranges of different N.
     """
     varies = list(varies)
     if not varies:
@@ -114,8 +129,19 @@ def grid(varies, zipped: bool = False) -> tuple[list[dict], tuple[int, ...]]:
 
 
 def neighbours(shape: tuple[int, ...]) -> list[int | None]:
-    """For each step of a grid of ``shape`` (last index fastest), the step it is tracked
-    from: one back along the last index that is not 0 (None for the first step)."""
+    """For each step of a grid, the step it is tracked from.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        The grid's shape (last index fastest).
+
+    Returns
+    -------
+    list of int or None
+        Per step, the step one back along the last index that is not 0
+        (None for the first step).
+    """
     out = []
     for index in np.ndindex(*shape):
         moving = [axis for axis, i in enumerate(index) if i > 0]
@@ -147,8 +173,26 @@ class StepSolution:
 
 
 def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGINE) -> StepSolution:
-    """Frequencies (as :func:`~linmstmm.solve.natural_frequencies` with ``engine``), mode
-    shapes and, for each key in ``sensitivity_keys`` (key strings), ∂f/∂value of one step."""
+    """Frequencies, mode shapes and sensitivities of one step.
+
+    Parameters
+    ----------
+    model : Model
+        The step's (edited) model.
+    count : int
+        Elastic frequencies wanted.
+    sensitivity_keys : sequence of str
+        Keys whose ∂f/∂value is wanted (none: no mode-shape derivatives).
+    engine : str
+        How det Ū_all is evaluated, as for :func:`~linmstmm.solve.natural_frequencies`.
+
+    Returns
+    -------
+    StepSolution
+        The frequencies as :func:`~linmstmm.solve.natural_frequencies` with
+        ``engine`` gives them, the mass-normalised shapes at the points and
+        the sensitivities.
+    """
     from linmstmm.modes import mode_shapes
     from linmstmm.solve import natural_frequencies
 
@@ -220,17 +264,37 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
           workers: int = 1, dask=None, progress: bool = False) -> SweepResult:
     """Natural frequencies of ``model`` at every step, modes tracked by MAC.
 
-    steps : list of {key: value} (every step sets the same keys), e.g. from :func:`grid`.
-    count : elastic frequencies per step. shape : the grid's shape (tracking
-    follows its neighbours, :func:`neighbours`); default a line of the steps.
-    sensitivity : also ∂f/∂value of every varied key at every step
-    (:func:`linmstmm.sensitivity.frequency_sensitivities`).
-    workers : local processes running the steps (1: in this process).
-    dask : run the steps on a dask.distributed cluster instead: a scheduler
-    address, "local" (a LocalCluster of ``max(workers, 2)`` single-threaded
-    worker processes, closed at the end) or a ``distributed.Client``.
-    progress : a tqdm bar on stderr.
-    Raises ModelError for an unknown key or a step that breaks the model contract.
+    Parameters
+    ----------
+    model : Model
+        The model the steps edit.
+    steps : list of dict
+        Each step's {key: value} (every step sets the same keys), e.g. from :func:`grid`.
+    count : int
+        Elastic frequencies per step.
+    shape : tuple of int or None
+        The grid's shape (tracking follows its neighbours, :func:`neighbours`);
+        default a line of the steps.
+    sensitivity : bool
+        Also ∂f/∂value of every varied key at every step
+        (:func:`linmstmm.sensitivity.frequency_sensitivities`).
+    workers : int
+        Local processes running the steps (1: in this process).
+    dask : str, distributed.Client or None
+        Run the steps on a dask.distributed cluster instead: a scheduler
+        address, "local" (a LocalCluster of ``max(workers, 2)`` single-threaded
+        worker processes, closed at the end) or a ``distributed.Client``.
+    progress : bool
+        A tqdm bar on stderr (only when stderr is a terminal).
+
+    Returns
+    -------
+    SweepResult
+
+    Raises
+    ------
+    ModelError
+        For an unknown key or a step that breaks the model contract.
     """
     start = time.perf_counter()
     steps = list(steps)
@@ -253,11 +317,23 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
 def track(shapes, previous, count: int, length: float) -> tuple[np.ndarray, np.ndarray]:
     """Columns that follow mode shapes from step to step.
 
-    shapes : per step (m, p, 6) shapes at the points (m <= count).
-    previous : per step the index of the step it is tracked from (None: ranks as they are).
-    length : m, the model's size; rotations are weighted by it in the MAC.
-    Returns (order (steps, count) int: rank of each column's mode, -1 where none;
-    mac (steps, count): MAC of each column against the same column at the previous step).
+    Parameters
+    ----------
+    shapes : list of ndarray
+        Per step (m, p, 6) shapes at the points (m <= count).
+    previous : list of int or None
+        Per step the index of the step it is tracked from (None: ranks as they are).
+    count : int
+        Columns.
+    length : float
+        m, the model's size; rotations are weighted by it in the MAC.
+
+    Returns
+    -------
+    order : ndarray
+        (steps, count) int: rank of each column's mode, -1 where none.
+    mac : ndarray
+        (steps, count): MAC of each column against the same column at the previous step.
     """
     steps = len(shapes)
     order = np.full((steps, count), -1, dtype=int)

@@ -57,10 +57,10 @@ def central_difference(model, text, count, step=STEP):
 
 def check(model, keys, count):
     modes = mode_shapes(model, count=count, rigid_body=False)
-    assert np.ptp(modes.natural_freq) > 0 and np.all(np.diff(modes.natural_freq) > 1e-6 * modes.natural_freq[1:])
+    assert np.ptp(modes.frequencies_hz) > 0 and np.all(np.diff(modes.frequencies_hz) > 1e-6 * modes.frequencies_hz[1:])
     derivatives = frequency_sensitivities(model, modes, keys)
     for text in keys:
-        scale = abs(get_value(model, parse_key(model, text))) / modes.natural_freq[:count]
+        scale = abs(get_value(model, parse_key(model, text))) / modes.frequencies_hz[:count]
         expected = central_difference(model, text, count) * scale
         np.testing.assert_allclose(derivatives[text][:count] * scale, expected, rtol=0, atol=AGREEMENT, err_msg=text)
         assert np.abs(expected).max() > 100 * AGREEMENT, f"{text} does not move these modes: no test"
@@ -112,3 +112,32 @@ def test_sweep_reports_them_in_tracked_order():
     by_rank = frequency_sensitivities(step, modes, ["spring.elevation.k[4]"])
     tracked = result.sensitivities["spring.elevation.k[4]"][1]
     np.testing.assert_array_equal(tracked, by_rank["spring.elevation.k[4]"][:4][result.order[1]])
+
+
+def hinged_chain(mass=3.0, length=0.8, kt=500.0):
+    """Two rods in a row along x, pinned to the ground and to each other (rz released),
+    a torsion spring kt (every direction but rz released) beside each pin."""
+    from builders import fixed, make_rigid, make_spring
+
+    from linmstmm.model import Model
+
+    L, inf = length, np.inf
+    points = {name: np.asarray(x, float) for name, x in
+              dict(g=[0, 0, 0], a1=[0, 0, 0], b1=[L, 0, 0], a2=[L, 0, 0], b2=[2 * L, 0, 0]).items()}
+    springs = []
+    for i, (a, b) in enumerate((("g", "a1"), ("b1", "a2")), 1):
+        springs.append(make_spring(f"pin{i}", a, b, [inf] * 5 + [0.0], release=["rz"]))
+        springs.append(make_spring(f"torsion{i}", a, b, [0.0] * 5 + [kt], release=["x", "y", "z", "rx", "ry"]))
+    rods = tuple(make_rigid(f"link{i}", [f"a{i}", f"b{i}"], mass, [(i - 0.5) * L, 0, 0],
+                            [0.0, mass * L ** 2 / 12, mass * L ** 2 / 12]) for i in (1, 2))
+    return Model("hinged chain", points, rigids=rods, springs=tuple(springs), boundary={"g": fixed()})
+
+
+def test_a_joints_released_direction_has_no_sensitivity():
+    """The stiffness of a released direction does not act (it is 0 by the contract);
+    the torsion spring beside the pin does, and matches the central difference."""
+    model = hinged_chain()
+    modes = mode_shapes(model, count=2, rigid_body=False)
+    derivatives = frequency_sensitivities(model, modes, ["spring.pin1.k[5]", "spring.torsion1.k[0]"])
+    assert not derivatives["spring.pin1.k[5]"].any() and not derivatives["spring.torsion1.k[0]"].any()
+    check(model, ["spring.torsion1.k[5]", "rigid.link2.mass"], count=2)

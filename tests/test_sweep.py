@@ -261,8 +261,22 @@ def test_cli_csv_plot_and_table(tmp_path):
     assert status == 0, err
     assert err == "" and "mode 1 [Hz]" in out
     header, *rows = csv_file.read_text().splitlines()
-    assert header.split(",")[:2] == ["spring.k2.k[0]", "mode_1_hz"] and len(rows) == 3
+    assert header.split(",")[:2] == ["spring.k2.k[0] [N/m]", "mode 1 [Hz]"] and len(rows) == 3
+    assert header.split(",")[-1] == "mode 3 rank" and "wrote" in out
     assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_cli_output_writes_the_json_it_prints(tmp_path):
+    argv = ["sweep", CHAIN, "--vary", "rigid.m2.mass=1:3:2", "--count", 2, "--sensitivity"]
+    status, out, err = run_cli(*argv, "--output", tmp_path / "s.json", "--csv", tmp_path / "s.csv")
+    assert status == 0 and "wrote" in out, err
+    saved = json.loads((tmp_path / "s.json").read_text())
+    status, out, _ = run_cli(*argv, "--json")
+    printed = json.loads(out)
+    assert {k: v for k, v in saved.items() if k not in ("seconds",)} == \
+        {k: v for k, v in printed.items() if k not in ("seconds",)}
+    header = (tmp_path / "s.csv").read_text().splitlines()[0].split(",")
+    assert header[0] == "rigid.m2.mass [kg]" and header[-1] == "dmode 2/drigid.m2.mass [Hz/kg]"
 
 
 @pytest.mark.parametrize("argv, message", [

@@ -19,7 +19,10 @@ Public names (each documented where it is defined):
 * modes: :func:`mode_shapes` -> :class:`ModalResult`, :func:`mac_matrix`;
 * response: :func:`load_loads` -> :class:`LoadCase`, :func:`respond` and
   :func:`modal_response` -> :class:`ResponseResult` (time histories),
-  :func:`frf` -> :class:`FRFResult` (receptance), :class:`PointLoad`.
+  :func:`frf` -> :class:`FRFResult` (receptance), :class:`PointLoad`;
+* parameter studies: the modules :mod:`linmstmm.parameters` (keys naming
+  model values), :mod:`linmstmm.sweep` (sweeps with modes tracked by MAC)
+  and :mod:`linmstmm.sensitivity` (∂f/∂p from the mode shapes).
 
 The names are imported on first use, so ``import linmstmm`` stays light
 (in particular, matplotlib is only imported by the plotting functions).
@@ -53,7 +56,13 @@ _SOURCES = {
     "ResponseResult": "linmstmm.response",
     "FRFResult": "linmstmm.response",
     "builders": "linmstmm.builders",
+    "parameters": "linmstmm.parameters",
+    "sweep": "linmstmm.sweep",
+    "sensitivity": "linmstmm.sensitivity",
 }
+
+#: Public names that are modules (the rest are defined in their module).
+_MODULES = {"builders", "parameters", "sweep", "sensitivity"}
 
 __all__ = list(_SOURCES)
 
@@ -63,7 +72,7 @@ def __getattr__(name: str):
     if name not in _SOURCES:
         raise AttributeError(f"module 'linmstmm' has no attribute {name!r}")
     module = importlib.import_module(_SOURCES[name])
-    value = module if name == "builders" else getattr(module, name)
+    value = module if name in _MODULES else getattr(module, name)
     globals()[name] = value
     return value
 

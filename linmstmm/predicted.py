@@ -279,13 +279,16 @@ def _partner(root: float, offsets: np.ndarray, same: float) -> float | None:
 
 def _intervals_around(troubled: list[float], predictions: np.ndarray) -> list[tuple]:
     """Disjoint intervals (lo, hi], rad/s, each holding troubled predictions and
-    reaching halfway (geometrically) to the nearest prediction not among them on
-    either side: the segment search runs there."""
+    reaching halfway (geometrically) to the nearest prediction on either side that
+    is neither among them nor within CLUSTER of one (the other prediction of a
+    double root is inside: an edge between the two lay on the root, and rounding
+    alone, the model's units, decided which side its one counted copy fell)."""
     intervals: list[list[float]] = []
     troubled_set = set(troubled)
     for start in sorted(troubled):
-        below = [p for p in predictions if p < start and p not in troubled_set]
-        above = [p for p in predictions if p > start and p not in troubled_set]
+        outside = [p for p in predictions if p not in troubled_set and abs(p - start) > CLUSTER * start]
+        below = [p for p in outside if p < start]
+        above = [p for p in outside if p > start]
         lo = np.sqrt(start * below[-1]) if below else start / 2
         hi = np.sqrt(start * above[0]) if above else start * 1.5
         if intervals and lo <= intervals[-1][1]:

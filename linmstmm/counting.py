@@ -67,10 +67,13 @@ def deflated(log_det, roots):
 
 def divided_out(omega, sign, log_abs, roots):
     """(phase, log|·|) of det / ∏_r (ω² − r²), given det's (``sign``, ``log_abs``) at
-    ``omega`` (n,): values already computed need no new evaluation of det."""
+    ``omega`` (n,): values already computed need no new evaluation of det. At a
+    known root itself the value is not finite (the callers test for that), without
+    a warning (they reached the command line's error output)."""
     factors = np.asarray(omega)[:, None] ** 2 - np.asarray(roots, dtype=float)[None, :] ** 2
-    return (sign * np.exp(-1j * np.angle(factors).sum(axis=1)),
-            log_abs - np.log(np.abs(factors)).sum(axis=1))
+    with np.errstate(divide="ignore"):
+        return (sign * np.exp(-1j * np.angle(factors).sum(axis=1)),
+                log_abs - np.log(np.abs(factors)).sum(axis=1))
 
 
 def count_zeros(log_det, a: float, b: float, max_points: int = MAX_POINTS, initial_points: int = INITIAL_POINTS) -> int:
@@ -148,8 +151,10 @@ def _half_windings(log_det, paths, wheres, max_points: int, initial_points: int 
         sign, log_abs = (np.concatenate(parts) for parts in zip(*[
             log_det(points[start:start + EVALUATION_CHUNK]) for start in range(0, points.size, EVALUATION_CHUNK)]))
         here, there = np.split(log_abs + 1j * np.angle(sign), 2)
-        change = (there.real - here.real) + 1j * np.angle(np.exp(1j * (there.imag - here.imag)))
-        return (np.split(here, edges), np.split(change / steps, edges),
+        with np.errstate(invalid="ignore"):  # a point on a known root: not finite, flagged below
+            change = (there.real - here.real) + 1j * np.angle(np.exp(1j * (there.imag - here.imag)))
+            slope = change / steps
+        return (np.split(here, edges), np.split(slope, edges),
                 [bool(ok.all()) for ok in np.split(np.isfinite(log_abs).reshape(2, -1).all(axis=0), edges)])
 
     thetas = [np.linspace(0.0, np.pi, initial_points) for _ in paths]

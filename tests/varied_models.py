@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from builders import STEEL, fixed, make_beam, make_rigid, make_spring
+from builders import fixed, make_beam, make_rigid, make_spring
 from linmstmm.model import Model
 from random_models import KINDS, random_direction, random_rotation, random_model
 

@@ -52,8 +52,8 @@ EIGENSPACE_MARGIN = 2
 #: Relative frequency offset of the matrices that scale Ū_all for its null space.
 SCALE_PROBE = 1e-3
 #: Mode shapes whose mass orthogonality or Rayleigh quotient is off by more than this
-#: (relative) are not returned: :func:`mode_shapes` raises instead (a free beam's
-#: 30th mode, βL = 36, was off by 1e-2 and its 60th by 100 %, silently).
+#: (relative) are named in the result's note (a free beam's 30th mode, βL = 36, was
+#: off by 1e-2 and its 60th by 100 %, without a word).
 SHAPE_ACCURACY = 1e-4
 #: Gauss–Legendre points along a beam beyond its largest wavenumber × length.
 EXTRA_QUADRATURE_POINTS = 20
@@ -95,7 +95,8 @@ class ModalResult:
     com_displacements : rigid body -> (n, 6) at its mass centre.
     beam_fields : beam -> :class:`BeamField`.
     normalization : "mass" or "max" (largest translation of each mode = 1 m).
-    note : what the search must say ("" if nothing; see :func:`linmstmm.solve.search_note`).
+    note : what the search must say ("" if nothing; see :func:`linmstmm.solve.search_note`), and
+        which shapes float64 did not form to SHAPE_ACCURACY.
     """
 
     model: str
@@ -231,7 +232,7 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
     stiffness = transform.T @ raw.stiffness_gram() @ transform
     modal_mass = np.diag(mass).copy()
     norm = np.sqrt(np.outer(modal_mass, modal_mass))
-    _check_accuracy(omega, mass / norm, stiffness / norm)
+    note = "; ".join(part for part in (note, _accuracy_note(omega, mass / norm, stiffness / norm)) if part)
     return ModalResult(
         model.name, omega, int(np.sum(omega == 0)), modal_mass, omega**2 * modal_mass,
         mass / norm, stiffness / norm, fields.zbar, tuple(deduction.columns), fields.port_states,
@@ -242,27 +243,25 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         normalization, note)
 
 
-def _check_accuracy(omega: np.ndarray, mass: np.ndarray, stiffness: np.ndarray) -> None:
-    """Raise RuntimeError naming the lowest mode whose shape is off by more than SHAPE_ACCURACY.
+def _accuracy_note(omega: np.ndarray, mass: np.ndarray, stiffness: np.ndarray) -> str:
+    """What the result must say about shapes off by more than SHAPE_ACCURACY ("" if none).
 
-    omega : (n,) rad/s; mass, stiffness : (n, n) normalised orthogonality matrices
-    (unit diagonal of ``mass``), modes ascending. A mode is off where its column of
-    ``mass`` above the diagonal has an entry, or its Rayleigh quotient K_kk / (ω_k² M_kk) differs from
-    1, by more than SHAPE_ACCURACY. Far above a beam's first modes its field along
-    the beam is a difference of terms cosh βx apart, which float64 cannot form.
+    omega : (n,) rad/s, ascending; mass, stiffness : (n, n) normalised orthogonality
+    matrices (unit diagonal of ``mass``). A mode is off where its column of ``mass``
+    above the diagonal has an entry (a pair blames its higher mode), or its Rayleigh
+    quotient K_kk / (ω_k² M_kk) differs from 1, by more than SHAPE_ACCURACY.
     """
-    # A pair that is not orthogonal blames its higher mode (the lower ones are accurate).
     off = np.triu(np.abs(mass - np.eye(omega.size)), 1).max(axis=0, initial=0.0)
     elastic = omega > 0
     rayleigh = np.zeros(omega.size)
     rayleigh[elastic] = np.abs(np.diag(stiffness)[elastic] / omega[elastic] ** 2 - 1)
     bad = np.flatnonzero(np.maximum(off, rayleigh) > SHAPE_ACCURACY)
-    if bad.size:
-        k = bad[0]
-        raise RuntimeError(f"mode shapes from {omega[k] / (2 * np.pi):.6g} Hz up cannot be formed in float64 "
-                           f"(mode {k + 1}: mass orthogonality off by {off[k]:.1e}, Rayleigh quotient by "
-                           f"{rayleigh[k]:.1e}; a beam's field there spans more than float64 holds): "
-                           f"ask for the modes below it")
+    if not bad.size:
+        return ""
+    k = bad[0]
+    return (f"the mode shapes from {omega[k] / (2 * np.pi):.6g} Hz up are not accurate in float64 (mode {k + 1}: "
+            f"mass orthogonality off by {off[k]:.1e}, Rayleigh quotient by {rayleigh[k]:.1e}; "
+            f"worst {np.max(np.maximum(off, rayleigh)):.1e})")
 
 
 # --- eigenspaces ------------------------------------------------------------
@@ -303,16 +302,25 @@ def _null_basis(deduction: Deduction, omega: float, dimension: int) -> np.ndarra
         raise RuntimeError(f"ω = {omega:.12g} rad/s is not a natural frequency with a null space "
                            f"of dimension {dimension}: relative singular value {worst:.3g}")
     n = sigma.size
-    near = max(int(np.sum(sigma < NULL_TOLERANCE * sigma[0])), dimension)
-    bordered = np.block([[scaled, u[:, n - near:]], [vh[n - near:], np.zeros((near, near))]])
-    basis = np.linalg.solve(bordered, np.eye(n + near, near, -n))[:n]
-    if near > dimension:
-        basis = _closest_null_vectors(basis, u[:, n - near:], scaled, rows[:, None] * (above - below) * cols,
-                                      dimension)
+    try:
+        basis = _bordered_null_vectors(scaled, u, vh, dimension)
+    except np.linalg.LinAlgError:  # other near-null directions than the root's: all of them, then the root's
+        near = int(np.sum(sigma < NULL_TOLERANCE * sigma[0]))
+        basis = _closest_null_vectors(_bordered_null_vectors(scaled, u, vh, near), u[:, n - near:], scaled,
+                                      rows[:, None] * (above - below) * cols, dimension)
     full = np.zeros((dimension, deduction.full_order))
     full[:, np.delete(np.arange(n + len(deduction.released_columns)), deduction.released_columns)] = (
         np.linalg.qr(basis)[0].T * cols)
     return full
+
+
+def _bordered_null_vectors(scaled: np.ndarray, u: np.ndarray, vh: np.ndarray, k: int) -> np.ndarray:
+    """(N, k) null vectors of ``scaled`` (N, N) from the bordered system [[S, u], [vᵀ, 0]]
+    on its last ``k`` left and right singular vectors (``u``, ``vh`` of its SVD).
+    Raises LinAlgError where that system is singular."""
+    n = scaled.shape[0]
+    bordered = np.block([[scaled, u[:, n - k:]], [vh[n - k:], np.zeros((k, k))]])
+    return np.linalg.solve(bordered, np.eye(n + k, k, -n))[:n]
 
 
 def _closest_null_vectors(candidates: np.ndarray, left: np.ndarray, scaled: np.ndarray,

@@ -280,11 +280,12 @@ def test_one_default_normalisation_for_the_function_and_the_command(capsys):
 def test_free_beam_modes_far_above_its_first_agree_with_fe_or_say_they_are_not_accurate(tmp_path, capsys):
     """A free beam's 60 modes raised LinAlgError: at its torsion and axial roots far above the
     first bending modes, the bending blocks of Ū_all are singular to 1/cosh βL < 1e-8, so
-    the bordered system on the SVD's smallest directions was singular. It now takes every
-    near-null direction and Newton's offsets pick the root's own. The first 15 modes agree
-    with FE's (MAC); the 20th (βL ≈ 30) is already 1.5e-5 to 1.1e-4 off. Above βL ≈ 30 the field along the beam is a difference of terms
-    cosh βx apart that float64 cannot form (the 60th mode was 100 % off, without a
-    word): the function's and the command's note names the first mode not accurate."""
+    the bordered system on the SVD's smallest directions was singular. Where it is, every
+    near-null direction is taken and Newton's offsets pick the root's own. The first 15
+    modes agree with FE's (MAC); the 20th (βL ≈ 30) is already 1.5e-5 to 1.1e-4 off.
+    Above that the field along the beam is a difference of terms cosh βx apart that
+    float64 cannot form (the 60th mode was 100 % off, without a word): the function's
+    and the command's note names the first mode that is not accurate."""
     from random_models import to_toml
 
     from linmstmm.cli import main

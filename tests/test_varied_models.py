@@ -48,8 +48,10 @@ CASES = [pytest.param(lambda seed=seed: varied_model(seed)[0], id=f"seed {seed}"
 
 @pytest.mark.parametrize("make", CASES)
 def test_agrees_with_fe(make):
+    """By the numpy engine (``auto`` picks the compiled one once numba is loaded, which
+    depends on the tests run before; see the test below)."""
     model = make()
-    ours, theirs = natural_frequencies(model, COUNT), fe_frequencies(model, count=COUNT)
+    ours, theirs = natural_frequencies(model, COUNT, engine="numpy"), fe_frequencies(model, count=COUNT)
     assert ours.rigid_body_modes == theirs.rigid_body_modes
     assert len(ours.frequencies_hz) == len(theirs.frequencies_hz)
     tolerance = np.maximum(TOLERANCE_FACTOR * theirs.error_estimate, FLOOR)
@@ -57,10 +59,22 @@ def test_agrees_with_fe(make):
         np.c_[ours.frequencies_hz, theirs.frequencies_hz, theirs.error_estimate]
 
 
+@pytest.mark.xfail(strict=True, raises=(ZeroDivisionError, np.linalg.LinAlgError),
+                   reason="the compiled kernels divide by a zero state size where numpy gives inf")
+def test_the_compiled_engine_agrees_on_a_ring_with_planes_1e12_apart_and_dangling_points():
+    """Seed 4 (a ring, Iy/Iz 8.6e11, two massless dangling points): the numpy engine agrees
+    with FE; the compiled kernels raise ZeroDivisionError (numba's division), and with
+    numpy's error model LinAlgError on a matrix of NaN. Not fixed here."""
+    model = varied_model(4)[0]
+    ours, theirs = natural_frequencies(model, COUNT, engine="compiled"), fe_frequencies(model, count=COUNT)
+    np.testing.assert_allclose(ours.frequencies_hz, theirs.frequencies_hz,
+                               rtol=max(FLOOR, TOLERANCE_FACTOR * float(theirs.error_estimate.max())))
+
+
 def test_only_massless_dangling_points_give_no_elastic_frequency():
     model = varied_model(3, family="dangling only")[0]
     assert model.springs and all(s.ends[1] not in {p for r in model.rigids for p in r.ports} for s in model.springs)
-    ours, theirs = natural_frequencies(model, COUNT), fe_frequencies(model, count=COUNT)
+    ours, theirs = natural_frequencies(model, COUNT, engine="numpy"), fe_frequencies(model, count=COUNT)
     assert ours.frequencies_hz.size == theirs.frequencies_hz.size == 0
 
 

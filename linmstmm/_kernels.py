@@ -189,7 +189,7 @@ def _unit_scale(stacked, kinds, scale):
         largest = max(largest, kind_size[k])
     for i in range(rows):
         size = kind_size[kinds[i]] if kind_size[kinds[i]] > 0 else largest
-        scale[i] = 1.0 / (size * peak)
+        scale[i] = 1.0 / (size * peak) if size > 0 else 1.0  # all rows zero: any scale
 
 
 @njit(cache=True, fastmath={"reassoc", "contract"})

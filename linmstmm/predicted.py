@@ -88,6 +88,13 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2) -> 
         return np.zeros(0)
     fe = assemble(model, elements_per_beam)
     K, M = fe.K.toarray(), fe.M.toarray()
+    # Each unknown scaled to unit mass (or stiffness, where it has none): the same
+    # eigenvalues, and a pencil that no longer depends on the units (in km the
+    # translations' and rotations' entries lie 1e6 further apart, and the
+    # predictions were 1e-4 to 3e-2 off where in m they were 1e-7 to 1e-4).
+    size = np.where(np.diag(M) > 0, np.diag(M), np.abs(np.diag(K)))
+    scale = 1 / np.sqrt(np.where(size > 0, size, 1.0))
+    K, M = K * np.outer(scale, scale), M * np.outer(scale, scale)
     wanted = min(count + fe.rigid_modes.shape[1], K.shape[0]) - 1
     try:  # Cholesky of M: every unknown carries mass
         lam = scipy.linalg.eigh(K, M, eigvals_only=True, subset_by_index=[0, wanted])
@@ -370,16 +377,20 @@ def _partner(root: float, offsets: np.ndarray, same: float) -> float | None:
 
 def _intervals_around(troubled: list[float], predictions: np.ndarray, roots: list[float]) -> list[tuple]:
     """Disjoint intervals (lo, hi], rad/s, each holding troubled predictions and
-    reaching halfway (geometrically) to the nearest prediction not among them on
-    either side, and below down to the nearest known root (``roots``, rad/s) under
-    the prediction: the segment search runs there. (The coarse model's predictions
-    lie above the roots they predict: the second of a close pair can lie below the
-    halfway point between their predictions.)"""
+    reaching halfway (geometrically) to the nearest prediction on either side that
+    is neither among them nor within CLUSTER of one (the other prediction of a
+    double root is inside: an edge between the two lay on the root, and rounding
+    alone, the model's units, decided which side its one counted copy fell), and
+    below down to the nearest known root (``roots``, rad/s) under the prediction:
+    the segment search runs there. (The coarse model's predictions lie above the
+    roots they predict: the second of a close pair can lie below the halfway point
+    between their predictions.)"""
     intervals: list[list[float]] = []
     troubled_set = set(troubled)
     for start in sorted(troubled):
-        below = [p for p in predictions if p < start and p not in troubled_set]
-        above = [p for p in predictions if p > start and p not in troubled_set]
+        outside = [p for p in predictions if p not in troubled_set and abs(p - start) > CLUSTER * start]
+        below = [p for p in outside if p < start]
+        above = [p for p in outside if p > start]
         lo = np.sqrt(start * below[-1]) if below else start / 2
         under = [r for r in roots if r < start]
         if under:

@@ -5,7 +5,7 @@ the argument principle (:mod:`linmstmm.counting`).
 
 The fast path (:meth:`RootFinder._scan_ahead`) scans (sign, log|det|)
 upwards until it has seen enough candidates, polishes them all at once and
-keeps the result only if one count from OMEGA_FLOOR agrees: the count of
+keeps the result only if one count from the floor agrees: the count of
 det with the found roots divided out (:func:`~linmstmm.counting.deflated`)
 must be zero, which a missed root or a false one would break. Where it is
 not, the missing roots are looked for in the stored scan and by deflated
@@ -32,11 +32,11 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from linmstmm.counting import DEFLATED_ASPECT, count_in_disc, count_zeros, count_zeros_many, deflated, divided_out
+from linmstmm.counting import count_in_disc, count_zeros, count_zeros_many, deflated, divided_out
 from linmstmm.nullspace import equilibration
 from linmstmm.predicted import predicted_roots
 
-#: Grid points per octave of the scans (the fast path's above 1 rad/s, an
+#: Grid points per octave of the scans (the fast path's above FINE_SCAN_RATIO × scale, an
 #: eighth of it below; every segment's).
 POINTS_PER_OCTAVE = 24
 #: Coarser scans are refused. They were never faster: a coarse scan leaves
@@ -55,23 +55,34 @@ CERTIFIED_STEP = 1e-9
 MAX_XTOL = 1e-6
 #: Widest segment scanned in one grid, octaves (wider ones are split by a count).
 SCAN_OCTAVES = 4
-#: Lowest scanned circular frequency, rad/s.
-OMEGA_FLOOR = 1e-3
-#: Where the lowest root found is below this many OMEGA_FLOOR, a count in the disc
-#: of radius OMEGA_FLOOR checks that no elastic root hides below it (:meth:`RootFinder._check_floor`).
+#: Every frequency the search decides by is a multiple of the model's own frequency
+#: scale (:attr:`RootFinder.scale`, rad/s; :func:`linmstmm.solve.frequency_finder` takes
+#: the lowest of :func:`linmstmm.nullspace.characteristic_frequencies`), so a model
+#: written in mm or km, or a slow one, is searched alike. A scale of DEFAULT_SCALE
+#: gives the absolute values (rad/s) the search was tuned with: floor 1e-3, first
+#: chunk 8, fine scan from 1, first segment 2π, ceiling 1e9.
+DEFAULT_SCALE = 10.0
+#: Lowest scanned circular frequency (:attr:`RootFinder.floor`), times the scale.
+FLOOR_RATIO = 1e-4
+#: Top of the fast path's first chunk, times the scale.
+FIRST_CHUNK_RATIO = 0.8
+#: The fast path's scan takes points_per_octave above this (times the scale), an eighth below.
+FINE_SCAN_RATIO = 0.1
+#: Top of the segment search's first segment, times the scale.
+FIRST_SEGMENT_RATIO = 2 * np.pi / DEFAULT_SCALE
+#: The scan for ``count`` roots gives up above this (:attr:`RootFinder.ceiling`), times the scale.
+CEILING_RATIO = 1e8
+#: Where the lowest root found is below this many times the floor, a count in the disc
+#: of the floor's radius checks that no elastic root hides below it (:meth:`RootFinder._check_floor`).
 FLOOR_CHECK = 1e3
 #: Predictions asked for beyond the count (plus a tenth of it): a coarse mesh can rank
 #: a true root among the first N one or two places too high (the launcher's 100th).
 PREDICTION_MARGIN = 2
-#: A predicted root below this many OMEGA_FLOOR is refused (an error, not a silently
-#: wrong list): a free strip 9.9 m long with Iz = 1e-12 m⁴ has its first bending mode at
-#: 1.4e-3 rad/s, which the counts from OMEGA_FLOOR took for a double root higher up;
-#: its coarse prediction was 4.7e-3. Two free bodies on a spring whose first mode is
-#: at 9.1e-3 rad/s are found exactly. The floor itself is absolute (rad/s): making it
-#: relative to the model's own frequencies is what would remove this limit.
+#: Predictions whose lowest is below this many times the floor are not used (the scan
+#: from the floor searches instead): with an absolute floor of 1e-3 rad/s a free strip
+#: 9.9 m long with Iz = 1e-12 m⁴ (first bending mode 1.4e-3 rad/s) was refused; the
+#: floor now follows the beam's own scale and it is found.
 FLOOR_MARGIN = 5.0
-#: The scan for ``count`` roots gives up above this circular frequency, rad/s.
-OMEGA_CEILING = 1e9
 #: Starting points of a half-ellipse count with the known roots divided out.
 DEFLATED_POINTS = 9
 #: Starting points of a count over a small circle (a multiplicity).
@@ -107,6 +118,8 @@ class RootFinder:
     (:meth:`divide_out_rigid_body_zeros`).
     predictor : callable n -> (m,) rad/s, the lowest n elastic roots predicted
     (e.g. :func:`linmstmm.predicted.predict_frequencies` of the model), or None.
+    scale : rad/s, the model's own frequency scale; the floor, ceiling and scan
+    chunks are multiples of it (see DEFAULT_SCALE).
 
     Candidates come from the scan; each is polished by local linearisation
     (Newton for the nonlinear eigenproblem Ū(ω) v = 0): with A = Ū(ω) and
@@ -119,8 +132,6 @@ class RootFinder:
 
     #: Offsets |μ|/ω below this are the same root (multiplicity).
     SAME_ROOT = 1e-9
-    #: rad/s, where every count starts
-    floor = OMEGA_FLOOR
     #: Newton steps |μ|/ω that stop shrinking below this have reached the rounding
     #: floor of Ū_all: the root is accepted, with that step as its uncertainty
     #: (:attr:`last_step`; the caller refines uncertain roots in mpmath).
@@ -157,7 +168,7 @@ class RootFinder:
 
     def __init__(self, log_det, matrix, xtol: float = 1e-14,
                  points_per_octave: int = POINTS_PER_OCTAVE, points_per_root: int = 6,
-                 rigid_body_modes: int = 0, predictor=None):
+                 rigid_body_modes: int = 0, predictor=None, scale: float = DEFAULT_SCALE):
         if not 0 < xtol <= MAX_XTOL:
             raise ValueError(f"xtol must be in (0, {MAX_XTOL:g}], got {xtol:g}: looser Newton "
                              "tolerances blur distinct roots into one")
@@ -165,8 +176,13 @@ class RootFinder:
             raise ValueError(f"points_per_octave must be at least {MIN_POINTS_PER_OCTAVE}, got "
                              f"{points_per_octave:g}: a coarser scan is slower, not faster (the roots "
                              "it misses cost more to recover than it saves; reports/speed_accuracy.md)")
+        if not (np.isfinite(scale) and scale > 0):
+            raise ValueError(f"scale must be a positive frequency (rad/s), got {scale!r}")
         self.log_det = log_det
         self.matrix = matrix
+        #: rad/s: the model's frequency scale, where every count starts, and where a
+        #: search for ``count`` roots gives up
+        self.scale, self.floor, self.ceiling = scale, FLOOR_RATIO * scale, CEILING_RATIO * scale
         self.xtol = xtol
         self.points_per_octave = points_per_octave
         self.points_per_root = points_per_root
@@ -185,8 +201,8 @@ class RootFinder:
         self.deferred_members: list[tuple[float, float]] = []  # (start, the root whose pencil gave it)
         #: sign-change brackets (lo, hi) Newton missed that :meth:`_needed` left out
         self.left_out: list[tuple[float, float]] = []
-        #: rad/s: a count found no root from OMEGA_FLOOR up to here (see :meth:`_scanned`)
-        self.root_free_below = OMEGA_FLOOR
+        #: rad/s: a count found no root from the floor up to here (see :meth:`_scanned`)
+        self.root_free_below = self.floor
         #: root -> (multiplicity, radius rad/s): roots float64 could not tell apart (:meth:`_separated`),
         #: or could not find where a count encloses them (:meth:`_isolate`)
         self.unseparated: dict[float, tuple[int, float]] = {}
@@ -197,13 +213,13 @@ class RootFinder:
         """Count and scan det Ū_all / ω^2r instead of det Ū_all.
 
         With r rigid-body modes det ∝ ω^2r at ω = 0: a contour that passes a
-        few 1e-3 rad/s from the origin sees the phase turn 2r times faster
+        few floors from the origin sees the phase turn 2r times faster
         than ω's own angle, and its sampling aliases (false counts of 2, 4,
         6 roots below the first elastic one). Dividing by ω^2r removes that
         known factor exactly; the roots elsewhere are unchanged. Checked
-        first: the disc |ω| < OMEGA_FLOOR must hold exactly 2r zeros.
+        first: the disc |ω| < floor must hold exactly 2r zeros.
         """
-        if rigid and count_in_disc(self.log_det, OMEGA_FLOOR) == 2 * rigid:
+        if rigid and count_in_disc(self.log_det, self.floor) == 2 * rigid:
             self.log_det = deflated(self.log_det, np.zeros(rigid))
             self._divided = True
 
@@ -632,7 +648,7 @@ class RootFinder:
         The argument-principle count says how many there are; a scan with at
         least ``points_per_root`` points per counted root finds them; bisection
         on the count finds any the scan missed. A segment wider than
-        SCAN_OCTAVES (the first one starts at OMEGA_FLOOR) is split by a count
+        SCAN_OCTAVES (the first one starts at the floor) is split by a count
         first, so an empty bottom is not scanned point by point.
         """
         if expected is None:
@@ -666,7 +682,7 @@ class RootFinder:
 
         Guesses (e.g. the roots of a neighbouring scene of the same model) are
         polished all at once; the result stands only if one count over
-        (OMEGA_FLOOR, just above the count-th root) confirms that none was
+        (floor, just above the count-th root) confirms that none was
         missed. Otherwise the full search runs.
         """
         found = self._confirmed(self._polished(guesses, []), count)
@@ -680,13 +696,13 @@ class RootFinder:
         """``found`` (left as it is) with each group's roots merged in (:meth:`_merge`), ascending."""
         found = list(found)
         for members in groups:
-            self._merge(found, members, OMEGA_FLOOR, np.inf)
+            self._merge(found, members, self.floor, np.inf)
         return sorted(found)
 
     def _confirmed(self, found: list[float], count: int | None, omega_max: float | None = None,
                    cap: float = np.inf):
         """The lowest ``count`` of ``found`` (or all up to omega_max) if one count from
-        OMEGA_FLOOR says there are no others below them; None otherwise.
+        the floor says there are no others below them; None otherwise.
         ``cap``: the count stops there at the latest (rad/s; above the count-th root).
         Multiplicities above one inside the count are counted over circles first
         (:meth:`_settled`)."""
@@ -745,7 +761,7 @@ class RootFinder:
         """
         reduced = deflated(self.log_det, [r for r in found if r < upper])
         try:
-            missing = count_zeros(reduced, OMEGA_FLOOR, upper, max_points=DEFLATED_MAX_POINTS)
+            missing = count_zeros(reduced, self.floor, upper, max_points=DEFLATED_MAX_POINTS)
         except RuntimeError:
             return found, upper
         floor = min(self.root_free_below, upper)  # the bisection starts above what a count found empty
@@ -782,7 +798,7 @@ class RootFinder:
         return kept, upper
 
     def confirm_no_other_zeros(self, known: list[float], upper: float) -> bool:
-        """True if (OMEGA_FLOOR, upper) holds no zeros of det Ū_all but ``known``.
+        """True if (floor, upper) holds no zeros of det Ū_all but ``known``.
 
         The count runs on det with the known roots divided out (:func:`~linmstmm.counting.deflated`),
         so its phase turns only for zeros not in ``known`` (or by −π for a
@@ -798,26 +814,25 @@ class RootFinder:
 
     def other_zeros(self, known: list[float], lo: float | None, hi: float) -> int | None:
         """Zeros of det Ū_all in (lo, hi) less those in ``known`` (negative where a known
-        one is not a zero); lo None: OMEGA_FLOOR. None where the count cannot be made."""
+        one is not a zero); lo None: the floor. None where the count cannot be made."""
         try:
-            return count_zeros(deflated(self.log_det, known), OMEGA_FLOOR if lo is None else lo, hi,
-                               max_points=DEFLATED_MAX_POINTS, initial_points=DEFLATED_POINTS,
-                               aspect=DEFLATED_ASPECT)
+            return count_zeros(deflated(self.log_det, known), self.floor if lo is None else lo, hi,
+                               max_points=DEFLATED_MAX_POINTS, initial_points=DEFLATED_POINTS)
         except RuntimeError:
             return None
 
     def _scan_ahead(self, count: int | None, omega_max: float | None):
         """Guess, polish, confirm: the fast path of :meth:`find`, or None.
 
-        A coarse scan (``points_per_octave`` above 1 rad/s, an eighth of it
-        below) goes up in chunks (to 8 rad/s, then up to ×4 each, less where
+        A coarse scan (``points_per_octave`` above FINE_SCAN_RATIO × scale, an eighth
+        of it below) goes up in chunks (to FIRST_CHUNK_RATIO × scale, then up to ×4 each, less where
         the candidates so far extrapolate to ``count`` sooner: :meth:`_next_top`;
         see :meth:`_scanned`)
         until it has seen ``count`` candidates (sign changes, and minima of
         log|det| without one), reached ``omega_max``, or scanned a chunk
         without a new candidate; all are polished at once (more chunks if their
         multiplicities leave fewer than ``count`` roots) and one count from
-        OMEGA_FLOOR must agree. Multiplicities are
+        the floor must agree. Multiplicities are
         read from the pencil offsets; those above one are counted over a circle
         first (a spurious one would cancel a missing root in that count), and a
         simple one misread changes the total, which that count sees. If the count
@@ -830,9 +845,9 @@ class RootFinder:
         falls back.
         """
         found: list[float] = []
-        self.deferred_members, self.left_out, self.root_free_below = [], [], OMEGA_FLOOR
+        self.deferred_members, self.left_out, self.root_free_below = [], [], self.floor
         brackets, minima = [], []  # (lo, hi, log|det(hi)| − log|det(lo)|) and grid points
-        lo, hi = OMEGA_FLOOR, 8.0
+        lo, hi = self.floor, FIRST_CHUNK_RATIO * self.scale
         scans = [(np.zeros(0),) * 3]  # every chunk's (grid, sign, log|det|), kept for _rescanned
         while True:
             if omega_max is not None:
@@ -871,7 +886,7 @@ class RootFinder:
             # fewer roots than count? (sign changes only: a shallow quiet minimum far
             # below the first root is no evidence that the roots have run out)
             seen = found + [b[0] for b in brackets]
-            if omega_max is None and (hi >= OMEGA_CEILING or (seen and hi > 1e3 * max(seen))):
+            if omega_max is None and (hi >= self.ceiling or (seen and hi > 1e3 * max(seen))):
                 return None
             lo, hi = hi, self._next_top(hi, sorted(seen + minima), count)
 
@@ -1042,11 +1057,11 @@ class RootFinder:
         points of ``below`` (the chunk under it, same form): a sign change or a
         quiet minimum at the edge between two chunks is seen (a double root of a
         round tube 1 % below a chunk's top was missed), and lo is not evaluated
-        twice. The first chunk, 13 octaves from OMEGA_FLOOR that hold no root in
+        twice. The first chunk, 13 octaves from the floor that hold no root in
         most models, is left out if a cheap count finds none there (and
         :attr:`root_free_below` says so)."""
         tail = tuple(part[-2:] for part in below)
-        if lo == OMEGA_FLOOR and self._holds_no_roots(lo, hi):
+        if lo == self.floor and self._holds_no_roots(lo, hi):
             self.root_free_below = hi
             return tail
         grid = self._quick_grid(lo, hi)
@@ -1063,14 +1078,15 @@ class RootFinder:
             return False
 
     def _quick_grid(self, lo: float, hi: float) -> np.ndarray:
-        """The fast path's scan of [lo, hi]: points_per_octave above 1 rad/s, an eighth below."""
+        """The fast path's scan of [lo, hi]: points_per_octave above FINE_SCAN_RATIO × scale,
+        an eighth below."""
         def geometric(a, b, per_octave):
             return np.geomspace(a, b, 1 + int(np.ceil(per_octave * np.log2(b / a)))) if b > a else np.zeros(0)
-        return np.unique(np.r_[geometric(lo, min(hi, 1.0), self.points_per_octave / 8),
-                               geometric(max(lo, 1.0), hi, self.points_per_octave)])
+        fine = FINE_SCAN_RATIO * self.scale
+        return np.unique(np.r_[geometric(lo, min(hi, fine), self.points_per_octave / 8),
+                               geometric(max(lo, fine), hi, self.points_per_octave)])
 
-    def find(self, count: int | None, omega_max: float | None,
-             omega_start: float = 2 * np.pi) -> list[float]:
+    def find(self, count: int | None, omega_max: float | None) -> list[float]:
         """Elastic roots (rad/s) ascending, each repeated per multiplicity.
 
         The lowest ``count``, or all up to ``omega_max``, with none missed:
@@ -1081,39 +1097,41 @@ class RootFinder:
         """
         if count is not None and self.predictor is not None:
             predictions = self.predictor(count + PREDICTION_MARGIN + count // 10)
-            if predictions.size and predictions[0] < FLOOR_MARGIN * OMEGA_FLOOR:
-                raise RuntimeError(
-                    f"the lowest elastic natural frequency is near {predictions[0] / (2 * np.pi):.3g} Hz "
-                    f"(a coarse finite-element model), below what the root search can certify "
-                    f"({FLOOR_MARGIN * OMEGA_FLOOR / (2 * np.pi):.3g} Hz): use `linmstmm fe` for this model")
-            found = predicted_roots(self, predictions, count)
+            found = predicted_roots(self, predictions, count) if self._usable(predictions) else None
             if found is not None:  # certified up to above the count-th: complete below omega_max too
                 found = self._separated(found)
                 self._check_floor(found)
                 return [w for w in found[:count] if omega_max is None or w <= omega_max]
         found = self._scan_ahead(count, omega_max) if count is not None or omega_max is not None else None
         if found is None:
-            found = self._search(count, omega_max, omega_start)
+            found = self._search(count, omega_max)
         found = self._separated(found)
         self._check_floor(found)
         return found[:count] if count is not None else found
 
+    def _usable(self, predictions: np.ndarray) -> bool:
+        """False where the lowest prediction (rad/s) is below FLOOR_MARGIN floors: the
+        coarse model's eigenvalues there are rounding of its stiffest ones (a strip with
+        bending stiffnesses 1e10 apart predicted 0 Hz), and the scan from the floor
+        decides instead (:meth:`_check_floor` says so if a root lies below it)."""
+        return not (predictions.size and predictions[0] < FLOOR_MARGIN * self.floor)
+
     def _check_floor(self, found: list[float]) -> None:
-        """Raise RuntimeError if det has zeros below OMEGA_FLOOR besides the rigid-body
+        """Raise RuntimeError if det has zeros below the floor besides the rigid-body
         modes' (every count starts there, so such roots would be missing from the
         list without a word: a cantilever with Iy = 1e-20 m⁴ has its first four
         between 1.5e-6 and 7e-5 Hz). Checked with one count in that disc, only where
         the lowest root found is within FLOOR_CHECK times the floor."""
-        if not found or found[0] > FLOOR_CHECK * OMEGA_FLOOR:
+        if not found or found[0] > FLOOR_CHECK * self.floor:
             return
         expected = 0 if self._divided else 2 * self._rigid
         try:
-            below = count_in_disc(self.log_det, OMEGA_FLOOR)
+            below = count_in_disc(self.log_det, self.floor)
         except RuntimeError:
             below = None
         if below != expected:
-            raise RuntimeError(f"det Ū_all has zeros below {OMEGA_FLOOR:g} rad/s "
-                               f"({OMEGA_FLOOR / (2 * np.pi):.3g} Hz) besides the rigid-body modes', which "
+            raise RuntimeError(f"det Ū_all has zeros below {self.floor:.3g} rad/s "
+                               f"({self.floor / (2 * np.pi):.3g} Hz) besides the rigid-body modes', which "
                                "the root search cannot certify: use `linmstmm fe` for this model")
 
     def _separated(self, roots: list[float]) -> list[float]:
@@ -1162,18 +1180,18 @@ class RootFinder:
         guess = roots[-1] * ((count + 2) / len(roots)) ** 2
         return min(4 * lo, max(1.25 * lo, guess))
 
-    def _search(self, count: int | None, omega_max: float | None,
-                omega_start: float = 2 * np.pi) -> list[float]:
+    def _search(self, count: int | None, omega_max: float | None) -> list[float]:
         """Elastic roots (rad/s) ascending, each repeated per multiplicity.
 
         The lowest ``count``, or all up to ``omega_max``, with none missed:
         each scanned segment is checked against the root count. Scans
-        upwards from OMEGA_FLOOR; ``omega_start`` is the top of the first
-        segment. Fewer than ``count`` come back if there are no more below
-        OMEGA_CEILING.
+        upwards from the floor, the first segment up to FIRST_SEGMENT_RATIO ×
+        scale. Fewer than ``count`` come back if there are no more below the
+        ceiling.
         """
         roots: list[float] = []
-        lo, hi = OMEGA_FLOOR, min(omega_start, omega_max) if omega_max else omega_start
+        start = FIRST_SEGMENT_RATIO * self.scale
+        lo, hi = self.floor, min(start, omega_max) if omega_max else start
         while True:
             try:
                 roots += self._lowest(lo, hi, None if count is None else count - len(roots))
@@ -1187,7 +1205,7 @@ class RootFinder:
                 break
             done_by_count = count is not None and len(roots) >= count
             done_by_range = omega_max is not None and hi >= omega_max
-            if done_by_count or done_by_range or hi >= OMEGA_CEILING:
+            if done_by_count or done_by_range or hi >= self.ceiling:
                 break
             lo, hi = hi, self._next_top(hi, roots, count)
             if omega_max is not None:

@@ -10,13 +10,13 @@ import numpy as np
 from linmstmm.deduction import Deduction
 from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
-from linmstmm.nullspace import release_indeterminate
+from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
 from linmstmm.precision import refine_roots, separated_cluster
 from linmstmm.predicted import predict_frequencies
 from linmstmm.determinant import determinant
 from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.stages import report
-from linmstmm.roots import CERTIFIED_STEP, OMEGA_CEILING, RootFinder
+from linmstmm.roots import CERTIFIED_STEP, RootFinder
 from linmstmm.threads import single_blas_thread
 from linmstmm.topology import build_topology
 
@@ -93,7 +93,10 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     The finder knows the rigid-body modes (counted from the model's kinematics,
     :func:`~linmstmm.rigid_motion.rigid_body_mode_count`) and divides their zeros out of
     det Ū_all (:meth:`~linmstmm.roots.RootFinder.divide_out_rigid_body_zeros`),
-    so every caller's counts see the elastic roots only.
+    so every caller's counts see the elastic roots only. Its frequency scale (floor,
+    ceiling, scan chunks) is the lowest of the model's
+    :func:`~linmstmm.nullspace.characteristic_frequencies`, so that no decision
+    depends on the units the model is written in.
     Returns (deduction, finder, number of indeterminate unknowns released).
     """
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
@@ -101,7 +104,8 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     evaluator = determinant(deduction, engine)
     finder = RootFinder(evaluator.log_det, lambda omega: evaluator.matrix(omega)[0],
                         rigid_body_modes=rigid_body_mode_count(model),
-                        predictor=lambda n: predict_frequencies(model, n), **options)
+                        predictor=lambda n: predict_frequencies(model, n),
+                        scale=min(characteristic_frequencies(deduction.topology)), **options)
     finder.determinant = evaluator
     finder.divide_out_rigid_body_zeros(finder.rigid_body_modes())
     return deduction, finder, released
@@ -268,7 +272,7 @@ def search_note(finder: RootFinder, found: int, unseparated: dict, count: int | 
     if finder.note and (fewer or count is None):  # the search stopped short of what was asked
         notes.append(f"only {found} elastic natural frequencies were found: {finder.note}")
     elif fewer and fmax is None:
-        notes.append(f"only {found} elastic natural frequencies exist below {OMEGA_CEILING:.3g} rad/s")
+        notes.append(f"only {found} elastic natural frequencies exist below {finder.ceiling:.3g} rad/s")
     return "; ".join(notes)
 
 

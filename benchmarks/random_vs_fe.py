@@ -1,0 +1,167 @@
+"""Hundreds of random models with the extremes against the FE route.
+
+    python benchmarks/random_vs_fe.py --seeds 0 300 [--count 10] [--report reports/random_vs_fe.md]
+
+For each seed of ``tests/varied_models.py`` (slender beams down to A = 1e-5 m²,
+bending stiffnesses up to 1e12 apart between the planes, massless dangling
+points, bodies held by one zero-length spring, other units, clamped / pinned /
+free ends) it solves the lowest ``--count`` frequencies with
+``natural_frequencies`` and with ``fe_frequencies`` (refined until its own
+error estimate is below rtol 1e-9, or its mesh cap) and checks:
+
+* the same number of rigid-body modes and of elastic frequencies (none from
+  either for a model with only massless dangling points to move);
+* each frequency within the FE route's own error: |f / f_FE − 1| <=
+  max(TOLERANCE_FACTOR × FE error estimate, FLOOR);
+* for a model written in other units, the same frequencies as its SI copy by
+  ``natural_frequencies`` to UNITS_AGREEMENT.
+
+Every disagreement and error is listed with its seed; the report (Markdown)
+gives counts, the disagreements and timings. Not part of the test suite.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+from common import REPO
+
+sys.path.insert(0, str(REPO / "tests"))
+from varied_models import UNITS, in_units, varied_model  # noqa: E402
+
+from linmstmm.fe import fe_frequencies  # noqa: E402
+from linmstmm.solve import natural_frequencies  # noqa: E402
+
+#: A frequency agrees where it is within this many times FE's own error estimate ...
+TOLERANCE_FACTOR = 3.0
+#: ... or within this (relative), whichever is larger (FE's estimate can be rounding).
+FLOOR = 1e-9
+#: A model in other units must give its SI copy's frequencies to this (relative).
+UNITS_AGREEMENT = 1e-9
+#: The report counts the models whose FE error estimates are all below this.
+TIGHT = 1e-8
+
+
+def compare(seed: int, count: int) -> dict:
+    """One model: its variety, timings, verdict ("agree", "disagree" or "error") and
+    what differs."""
+    model, variety = varied_model(seed)
+    row = {"seed": seed, "variety": variety.label(), "family": variety.family, "problems": []}
+    try:
+        started = time.perf_counter()
+        ours = natural_frequencies(model, count)
+        row["mstmm_s"] = time.perf_counter() - started
+    except Exception as error:  # a sweep reports every failure and goes on
+        row["problems"].append(f"MSTMM {type(error).__name__}: {error}")
+        ours = None
+    try:
+        started = time.perf_counter()
+        theirs = fe_frequencies(model, count=count)
+        row["fe_s"] = time.perf_counter() - started
+    except Exception as error:
+        row["problems"].append(f"FE {type(error).__name__}: {error}")
+        theirs = None
+    if ours is None or theirs is None:
+        row["verdict"] = "error"
+        return row
+    row["problems"] += differences(ours, theirs)
+    if variety.units != UNITS[0][0]:
+        row["problems"] += unit_differences(model, variety.units, ours.frequencies_hz, count)
+    row["elastic"] = len(theirs.frequencies_hz)
+    row["fe_error"] = float(np.max(theirs.error_estimate, initial=0.0))
+    row["difference"] = float(np.max(np.abs(ours.frequencies_hz / theirs.frequencies_hz - 1), initial=0.0)) \
+        if len(ours.frequencies_hz) == len(theirs.frequencies_hz) else np.inf
+    row["verdict"] = "disagree" if row["problems"] else "agree"
+    return row
+
+
+def differences(ours, theirs) -> list[str]:
+    """What differs between an MSTMM and an FE result of the same model."""
+    problems = []
+    if ours.rigid_body_modes != theirs.rigid_body_modes:
+        problems.append(f"rigid-body modes {ours.rigid_body_modes} (MSTMM) vs {theirs.rigid_body_modes} (FE)")
+    a, b, error = ours.frequencies_hz, theirs.frequencies_hz, theirs.error_estimate
+    if len(a) != len(b):
+        problems.append(f"{len(a)} elastic frequencies (MSTMM) vs {len(b)} (FE); "
+                        f"MSTMM {np.array2string(a, precision=6)}, FE {np.array2string(b, precision=6)}"
+                        + (f"; MSTMM note: {ours.note}" if ours.note else "")
+                        + (f"; FE note: {theirs.note}" if theirs.note else ""))
+        return problems
+    off = np.abs(a / b - 1)
+    bad = np.flatnonzero(off > np.maximum(TOLERANCE_FACTOR * error, FLOOR))
+    problems += [f"f{i + 1}: MSTMM {a[i]:.10g} Hz, FE {b[i]:.10g} Hz ({off[i]:.1e} off, FE error "
+                 f"{error[i]:.1e})" for i in bad]
+    return problems
+
+
+def unit_differences(model, units: str, frequencies, count: int) -> list[str]:
+    """Differences from the same model converted back to SI."""
+    _, length, mass = next(u for u in UNITS if u[0] == units)
+    si = natural_frequencies(in_units(model, 1 / length, 1 / mass), count).frequencies_hz
+    if len(si) != len(frequencies):
+        return [f"{len(frequencies)} frequencies in {units}, {len(si)} in SI"]
+    off = float(np.max(np.abs(frequencies / si - 1), initial=0.0))
+    return [f"{units} differs from SI by {off:.1e}"] if off > UNITS_AGREEMENT else []
+
+
+def report(rows: list[dict], command: str, seconds: float) -> str:
+    """The Markdown report."""
+    verdicts = Counter(row["verdict"] for row in rows)
+    lines = [f"`{command}`", "", "# Random models with the extremes against the FE route", "",
+             f"{len(rows)} models of `tests/varied_models.py` (seeds {rows[0]['seed']}–{rows[-1]['seed']}): "
+             f"**{verdicts['agree']} agree**, {verdicts['disagree']} disagree, {verdicts['error']} raised. "
+             f"Agreement: the same rigid-body and elastic counts, every frequency within "
+             f"max({TOLERANCE_FACTOR:g} × FE's error estimate, {FLOOR:g}); models in other units also "
+             f"give their SI copy's frequencies to {UNITS_AGREEMENT:g}. Wall time {seconds:.0f} s.", "",
+             f"Of the models that agree, {sum(r['verdict'] == 'agree' and r['fe_error'] <= TIGHT for r in rows)} "
+             f"are checked to FE errors of {TIGHT:g} or less throughout; in the others FE's own estimate "
+             f"(up to {max((r['fe_error'] for r in rows if r['verdict'] == 'agree'), default=0):.1e}) "
+             "bounds the check.", "",
+             "## By family", "", "| family | models | agree | largest difference | largest FE error |",
+             "|---|---|---|---|---|"]
+    for family in sorted({row["family"] for row in rows}):
+        group = [row for row in rows if row["family"] == family]
+        done = [row for row in group if "difference" in row]
+        lines.append(f"| {family} | {len(group)} | {sum(r['verdict'] == 'agree' for r in group)} | "
+                     f"{max((r['difference'] for r in done), default=0):.1e} | "
+                     f"{max((r['fe_error'] for r in done), default=0):.1e} |")
+    lines += ["", "Models with only massless dangling points to move: "
+              f"{sum(r['family'] == 'dangling only' and r.get('elastic') == 0 for r in rows)} of "
+              f"{sum(r['family'] == 'dangling only' for r in rows)} give no elastic frequency from either route.",
+              "", "## Disagreements and errors", ""]
+    failed = [row for row in rows if row["verdict"] != "agree"]
+    lines += [f"* seed {row['seed']} ({row['variety']}): " + "; ".join(row["problems"]) for row in failed] or ["None."]
+    lines += ["", "## Timings (s per model)", "", "| route | median | 90 % | max |", "|---|---|---|---|"]
+    for key, label in (("mstmm_s", "natural_frequencies"), ("fe_s", "fe_frequencies (refined)")):
+        times = np.array([row[key] for row in rows if key in row])
+        if times.size:
+            lines.append(f"| {label} | {np.median(times):.3f} | {np.quantile(times, 0.9):.3f} | {times.max():.2f} |")
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, nargs=2, default=(0, 300), metavar=("FIRST", "STOP"))
+    parser.add_argument("--count", type=int, default=10)
+    parser.add_argument("--report", default=None, help="write the Markdown report here")
+    args = parser.parse_args(argv)
+    started, rows = time.perf_counter(), []
+    for seed in range(*args.seeds):
+        rows.append(compare(seed, args.count))
+        row = rows[-1]
+        print(f"{seed:4d} {row['verdict']:8s} {row.get('mstmm_s', np.nan):7.3f} {row.get('fe_s', np.nan):7.3f} "
+              f"{row['variety']} {'; '.join(row['problems'])}", flush=True)
+    command = "python benchmarks/random_vs_fe.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    text = report(rows, command.strip(), time.perf_counter() - started)
+    if args.report:
+        Path(args.report).write_text(text)
+    print(text)
+    return 0 if all(row["verdict"] == "agree" for row in rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -289,7 +289,7 @@ def test_free_beam_modes_far_above_its_first_agree_with_fe_or_say_they_are_not_a
     from random_models import to_toml
 
     from linmstmm.cli import main
-    from linmstmm.mode_commands import fe_mac
+    from linmstmm.compare import fe_mac
 
     model = single_beam_model()
     result = mode_shapes(model, 15)

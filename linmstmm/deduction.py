@@ -216,11 +216,48 @@ class Deduction:
         outputs, rows, _ = self._carry(frequencies(omega), stable=False)
         return outputs, rows
 
-    def _carry(self, omega, stable: bool):
+    def forced(self, omega, jumps):
+        """Ū_all(ω) and the load term of point loads: Ū_all z̄ + load = 0.
+
+        Parameters
+        ----------
+        omega : (n,) frequencies of the carry, rad/s (complex allowed).
+        jumps : {(element, port): (12,) or (n, 12)}: the state on the side of
+            port ``port`` of transfer element ``element`` towards the root is
+            the state on the other side plus this jump (a point force F and
+            moment T there: ``[0, 0, T, F]``, N m and N; see
+            :func:`linmstmm.forced.load_jumps`).
+
+        Returns
+        -------
+        ubar : (n, N, N) Ū_all, as :meth:`matrix` without ``stable``.
+        load : (n, N) the load's column (its unknown is 1).
+        outputs : element -> :class:`PortState` at its output, on the unknowns
+            and the load column ``full_order``.
+        """
+        omega = frequencies(omega)
+        outputs, rows, _ = self._carry(omega, stable=False, jumps=jumps)
+        system = self._assemble(omega, outputs, rows, loads=1)
+        return system[..., :-1], system[..., -1], outputs
+
+    def _jumped(self, state: PortState, jump) -> PortState:
+        """``state`` plus ``jump`` (12,) or (n, 12) on the load column ``full_order``."""
+        n = state.matrix.shape[0]
+        jump = np.broadcast_to(jump, (n, 12))
+        dtype = np.result_type(state.matrix, jump)
+        if state.columns.size and state.columns[-1] == self.full_order:
+            matrix = state.matrix.astype(dtype, copy=True)
+            matrix[:, :, -1] += jump
+            return PortState(state.columns, matrix)
+        return PortState(np.r_[state.columns, self.full_order],
+                         np.concatenate([state.matrix.astype(dtype), jump[:, :, None]], axis=2))
+
+    def _carry(self, omega, stable: bool, jumps=None):
         """Carry states from the tips to the root.
 
         stable : orthonormalise columns on the way (:class:`_Orthonormaliser`)
         and split beams into pieces of βL <= _BEAM_PIECE_BETA_L.
+        jumps : point loads as in :meth:`forced`, only without ``stable``.
 
         rows[0] is the main equation's known side, ``−Z_root`` (12 rows); the
         geometric rows follow (6 each). For a boundary-less model Z_root is the
@@ -232,6 +269,9 @@ class Deduction:
         with det Ū_all = det(Ū built from these) · exp(log_scale).
         """
         n = omega.size
+        jumps = jumps or {}
+        if stable and jumps:
+            raise ValueError("point loads are carried without orthonormalisation")
         elements = self.topology.elements
         outputs: dict[int, PortState] = {}
         open_states: dict[int, PortState] = {}
@@ -253,6 +293,8 @@ class Deduction:
                     inputs.append(normaliser.enter_cut_side(link, lambda side: self.tip_state(side, n)))
                 else:
                     inputs.append(self.tip_state(link, n))
+                if (e, p) in jumps:
+                    inputs[-1] = self._jumped(inputs[-1], jumps[e, p])
             run = runs.get(position)
             powered = None if run is None else self._carry_run(run, omega, inputs[0], normaliser, rows, open_states)
             if powered is not None:
@@ -272,6 +314,8 @@ class Deduction:
                 rows.append([label, *self._combined((e, k), [(inputs[0].columns, -inputs[0].matrix[:, :6]),
                                                              (state.columns, constant_times(incidence, state.matrix))])])
             state = PortState(*self._combined((e,), terms), reference=_largest([state.reference for state in inputs]))
+            if (e, element.output) in jumps:
+                state = self._jumped(state, jumps[e, element.output])
             if stable:
                 state = normaliser.apply(state, rows, open_states)
             outputs[e] = open_states[e] = state
@@ -333,10 +377,12 @@ class Deduction:
         ubar = self._assemble(omega, outputs, rows)
         return (ubar, scale) if stable else ubar
 
-    def _assemble(self, omega, outputs, rows) -> np.ndarray:
-        """Ū_all (n, N, N) from the carried root state and the rows, less released ones."""
+    def _assemble(self, omega, outputs, rows, loads: int = 0) -> np.ndarray:
+        """Ū_all (n, N, N) from the carried root state and the rows, less released ones;
+        with ``loads`` (n, N, N + loads), the load columns last (complex)."""
         root = self.root_state(outputs)
-        ubar = zeros_like_stack(omega, (self.full_order, self.full_order))
+        ubar = zeros_like_stack(omega.astype(complex) if loads else omega,
+                                (self.full_order, self.full_order + loads))
         ubar[:, :12, _index(root.columns)] = root.matrix
         ubar[:, :12, _index(rows[0][1])] += rows[0][2]  # −Z_root: a ring's shares the root state's columns
         start = 12

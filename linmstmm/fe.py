@@ -371,21 +371,75 @@ def _add_beams(model, layout, n, strains, stiffness, mass, constraints):
             constraints.add(rows[:, :, None], dofs[:, None, :], c @ to_local)
 
 
+def _spring_directions(spring, index: DofIndex):
+    """Per component of ``spring`` (its six local directions): (component,
+    full-vector columns (6,), values (6,)) of the elongation b − a along it."""
+    a, b = (index.point(end) for end in spring.ends)
+    axes = np.asarray(spring.axes, float)
+    for component in range(6):
+        block = slice(0, 3) if component < 3 else slice(3, 6)
+        direction = axes[component % 3]
+        yield component, np.concatenate([a[block], b[block]]), np.concatenate([-direction, direction])
+
+
 def _add_springs(model, layout, strains, stiffness, constraints):
     """Finite spring directions become strains, ``inf`` ones constraints."""
     for spring in model.springs:
-        a, b = (_node_dofs(layout.index.points[end]) for end in spring.ends)
-        axes = np.asarray(spring.axes, float)
-        for component, k in enumerate(np.asarray(spring.k, float)):
-            block = slice(0, 3) if component < 3 else slice(3, 6)
-            direction = axes[component % 3]
-            cols = np.concatenate([a[block], b[block]])
-            values = np.concatenate([-direction, direction])
+        for component, cols, values in _spring_directions(spring, layout.index):
+            k = float(spring.k[component])
             if np.isinf(k):
                 constraints.add(constraints.new_rows(1), cols, values)
             else:
                 strains.add(strains.new_rows(1), cols, values)
                 stiffness.append([k])
+
+
+def dashpot_matrix(model: Model, fe: FEModel) -> sp.csr_matrix:
+    """(n_dof, n_dof) sparse viscous damping of the springs' dashpots ``c``.
+
+    Assembled as the springs' stiffness is: ``C = Hᵀ diag(c) H`` with H the
+    elongation of each spring direction that has a dashpot (N s/m, N m s/rad),
+    in the reduced DOFs of ``fe`` (assembled from the same ``model``).
+    """
+    rows, damping = _Triplets(), []
+    for spring in model.springs:
+        for component, cols, values in _spring_directions(spring, fe.dof_index):
+            if spring.c is not None and spring.c[component] > 0:
+                rows.add(rows.new_rows(1), cols, values)
+                damping.append(float(spring.c[component]))
+    H = rows.matrix(fe.n_full) @ fe.T
+    return _symmetric(H.T @ sp.diags(np.asarray(damping)) @ H)
+
+
+def harmonic_receptance(model: Model, point: str, vector, frequencies_hz, points,
+                        elements_per_beam: int = 8, damping=None) -> np.ndarray:
+    """Receptance by the direct complex solve (K + iΩ(C + αM + βK) − Ω²M) x = f.
+
+    Parameters
+    ----------
+    model : the model; C holds its springs' dashpots (:func:`dashpot_matrix`).
+    point : the loaded point. vector : (6,) [force N, moment N m], inertial axes.
+    frequencies_hz : (n_f,) Hz. points : response point names.
+    elements_per_beam : the mesh. damping : Rayleigh (α 1/s, β s) or None.
+
+    Returns
+    -------
+    (n_f, n_points, 6) complex displacements (m) and rotations (rad) per unit
+    of ``vector``, inertial axes: exact for springs and rigid bodies, with the
+    mesh's discretisation error for beams.
+    """
+    fe = assemble(model, elements_per_beam)
+    alpha, beta = (0.0, 0.0) if damping is None else damping
+    viscous = dashpot_matrix(model, fe) + alpha * fe.M + beta * fe.K
+    load = np.zeros(fe.n_full)
+    load[fe.dof_index.point(point)] = vector
+    load = fe.T.T @ load
+    picks = np.concatenate([fe.dof_index.point(p) for p in points])
+    out = np.empty((len(frequencies_hz), len(points) * 6), dtype=complex)
+    for i, omega in enumerate(_TWO_PI * np.asarray(frequencies_hz, float)):
+        dynamic = (fe.K + 1j * omega * viscous - omega**2 * fe.M).tocsc()
+        out[i] = (fe.T @ splu(dynamic).solve(load.astype(complex)))[picks]
+    return out.reshape(len(frequencies_hz), len(points), 6)
 
 
 def _negligible_mass_removed(model: Model) -> Model:

@@ -1,0 +1,164 @@
+"""Direct frequency response by the transfer matrix method, dashpots included.
+
+At each excitation frequency Ω the transfer equations are solved in complex
+arithmetic with the load as an inhomogeneous term, with no modes in between:
+
+* a spring with dashpots has the complex stiffness k + iΩc in each direction
+  (:func:`~linmstmm.elements.spring.damped_spring_transfer`);
+* a point force F and moment T at a point make the internal force jump there:
+  the state on the side towards the root is the state on the other side plus
+  ``[0, 0, T, F]``. The jump enters the carry of the automatic deduction
+  theorem as one more column (:meth:`linmstmm.deduction.Deduction.forced`),
+  so Ū_all(Ω) z̄ + load = 0 is solved for the boundary unknowns z̄ (after
+  equilibration), and the state at every port follows from the same carry;
+* Rayleigh damping C = αM + βK (the model's ``[damping]``) is honoured
+  exactly: the dynamic stiffness K(1 + iΩβ) + iΩC_d − (Ω² − iαΩ)M divided by
+  1 + iΩβ is that of the undamped elements at the complex frequency
+  ω̃ = √((Ω² − iαΩ) / (1 + iΩβ)) (every element matrix depends on ω² only),
+  with dashpot rates iΩ / (1 + iΩβ), and the load divided by 1 + iΩβ.
+
+Modal damping ratios have no meaning here (there are no modes): they belong
+to the modal route (:mod:`linmstmm.response`).
+
+The carry is not orthonormalised (the load column must stay the load's), as
+for the mode shapes of :mod:`linmstmm.modes`: accurate while the beams'
+growing solutions e^{βL} stay far below 1/ε, i.e. over the frequencies of the
+modes that the mode shapes are computed for.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from linmstmm.deduction import Deduction, PortState
+from linmstmm.elements.frames import FORCE_INDEX
+from linmstmm.elements.spring import damped_spring_transfer
+from linmstmm.model import Model
+from linmstmm.nullspace import equilibration, release_indeterminate
+from linmstmm.response import FRFResult
+from linmstmm.threads import single_blas_thread
+from linmstmm.topology import Topology, build_topology
+
+#: Frequencies solved together (bounds the memory of the Ū_all stacks).
+CHUNK = 256
+
+
+def has_dashpots(model: Model) -> bool:
+    """True if any spring of ``model`` has a nonzero dashpot ``c``."""
+    return any(spring.c is not None and np.any(spring.c > 0) for spring in model.springs)
+
+
+class DampedDeduction(Deduction):
+    """The deduction of a topology whose springs with dashpots have complex stiffness.
+
+    rate : (n,) complex, 1/s, the dashpot rate of each frequency of the stack
+    the carry is given (iΩ for a harmonic motion at Ω): a spring with ``c`` has
+    the stiffness k + rate c. Everything else is :class:`Deduction`.
+    """
+
+    def __init__(self, topology: Topology, rate):
+        super().__init__(topology)
+        self.rate = np.asarray(rate, dtype=complex)
+
+    def carried(self, e: int, omega, matrix) -> np.ndarray:
+        """U_j @ matrix as :meth:`Deduction.carried`; a spring with dashpots complex."""
+        record = self.topology.elements[e].record
+        if getattr(record, "kind", None) == "spring" and record.c is not None:
+            return damped_spring_transfer(record.k, record.c, record.axes, self.rate) @ matrix
+        return super().carried(e, omega, matrix)
+
+
+def load_jumps(topology: Topology, point: str, vector) -> dict:
+    """The jump of a point load, for :meth:`linmstmm.deduction.Deduction.forced`.
+
+    Parameters
+    ----------
+    topology : the model's transfer structure.
+    point : the loaded point.
+    vector : (6,) or (n, 6) [force N, moment N m], inertial axes.
+
+    Returns
+    -------
+    {(element, port): (12,) or (n, 12)}: one port at ``point`` (an element's
+    output if there is one, else an input) and the jump of the state there.
+    """
+    vector = np.asarray(vector)
+    jump = np.zeros(vector.shape[:-1] + (12,), dtype=vector.dtype)
+    jump[..., FORCE_INDEX] = vector
+    return {_port_at(topology, point, prefer_output=True): jump}
+
+
+def _port_at(topology: Topology, point: str, prefer_output: bool) -> tuple[int, int]:
+    """(element, port) of a port at ``point``: an element's output first if
+    ``prefer_output`` (and there is one), else the first port found."""
+    ports = [(e, p) for e, element in enumerate(topology.elements)
+             for p, port in enumerate(element.ports) if port.point == point]
+    outputs = [(e, p) for e, p in ports if p == topology.elements[e].output]
+    return (outputs if prefer_output and outputs else ports)[0]
+
+
+def _displacement_rows(deduction: Deduction, outputs, point: str, n: int) -> PortState:
+    """The state at ``point`` whose rows 0:6 are its displacement and rotation:
+    an element's output there, else the tip (boundary end or cut side) there."""
+    e, p = _port_at(deduction.topology, point, prefer_output=True)
+    if p == deduction.topology.elements[e].output:
+        return outputs[e]
+    return deduction.tip_state(deduction.topology.elements[e].ports[p].link, n)
+
+
+@single_blas_thread
+def direct_frf(model: Model, point: str, vector, frequencies_hz, points=None, *,
+               damping=None, root: str | None = None) -> FRFResult:
+    """Receptance by the direct transfer-matrix solve, dashpots and Rayleigh damping exact.
+
+    Parameters
+    ----------
+    model : the model; its springs' dashpots ``c`` act.
+    point : the loaded point.
+    vector : (6,) load [force N, moment N m] at ``point``, inertial axes.
+    frequencies_hz : (n_f,) excitation frequencies, Hz, > 0.
+    points : response points (default: every point of the model).
+    damping : (α 1/s, β s) of Rayleigh damping C = αM + βK added to the
+        dashpots, or None (the model's ``[damping]`` is not read here: pass
+        ``model.damping`` to use it).
+    root : boundary end to use as the root of the transfer tree.
+
+    Returns
+    -------
+    :class:`linmstmm.response.FRFResult`: receptance (n_f, n_points, 6)
+    complex, displacement (m) and rotation (rad) per unit of ``vector``.
+    Exact for springs and rigid bodies, and for beams (continuous, no
+    discretisation) to rounding.
+    """
+    frequencies_hz = np.asarray(frequencies_hz, dtype=float)
+    points = tuple(model.points) if points is None else tuple(points)
+    topology = build_topology(model, root=root)
+    plain = Deduction(topology)
+    release_indeterminate(plain)
+    alpha, beta = (0.0, 0.0) if damping is None else damping
+    receptance = np.zeros((frequencies_hz.size, len(points), 6), dtype=complex)
+    for start in range(0, frequencies_hz.size, CHUNK):
+        omega = 2 * np.pi * frequencies_hz[start:start + CHUNK]
+        factor = 1 + 1j * omega * beta
+        deduction = DampedDeduction(topology, 1j * omega / factor)
+        deduction.release(plain.released_columns, plain.released_rows)
+        carried = np.sqrt((omega**2 - 1j * alpha * omega) / factor)
+        loads = np.asarray(vector, dtype=float) / factor[:, None]
+        receptance[start:start + CHUNK] = _solve(deduction, carried, load_jumps(topology, point, loads), points)
+    return FRFResult(frequencies_hz, points, receptance)
+
+
+def _solve(deduction: Deduction, omega, jumps, points) -> np.ndarray:
+    """(n, n_points, 6) displacements of ``points`` under the loads ``jumps`` at ``omega`` (n,)."""
+    ubar, load, outputs = deduction.forced(omega, jumps)
+    rows, cols = equilibration(ubar)
+    scaled = rows[:, :, None] * ubar * cols[:, None, :]
+    kept = -cols * np.linalg.solve(scaled, (rows * load)[:, :, None])[:, :, 0]
+    n, order = omega.size, deduction.full_order
+    unknowns = np.zeros((n, order + 1), dtype=complex)
+    unknowns[:, np.delete(np.arange(order), deduction.released_columns)] = kept
+    unknowns[:, order] = 1.0
+    result = np.empty((n, len(points), 6), dtype=complex)
+    for i, name in enumerate(points):
+        state = _displacement_rows(deduction, outputs, name, n)
+        result[:, i] = np.einsum("nik,nk->ni", state.matrix[:, :6], unknowns[:, state.columns])
+    return result

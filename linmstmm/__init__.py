@@ -19,7 +19,8 @@ Public names (each documented where it is defined):
 * modes: :func:`mode_shapes` -> :class:`ModalResult`, :func:`mac_matrix`;
 * response: :func:`load_loads` -> :class:`LoadCase`, :func:`respond` and
   :func:`modal_response` -> :class:`ResponseResult` (time histories),
-  :func:`frf` -> :class:`FRFResult` (receptance), :class:`PointLoad`.
+  :func:`frf` -> :class:`FRFResult` (receptance), :class:`PointLoad`;
+  :func:`direct_frf` (the direct solve, spring dashpots acting).
 
 The names are imported on first use, so ``import linmstmm`` stays light
 (in particular, matplotlib is only imported by the plotting functions).
@@ -48,6 +49,7 @@ _SOURCES = {
     "respond": "linmstmm.response",
     "modal_response": "linmstmm.response",
     "frf": "linmstmm.response",
+    "direct_frf": "linmstmm.forced",
     "LoadCase": "linmstmm.response",
     "PointLoad": "linmstmm.response",
     "ResponseResult": "linmstmm.response",

@@ -19,8 +19,10 @@
 ``--zeta`` gives modal damping ratios: one for every elastic mode, or a comma
 list with one per elastic mode in the sum. They replace the model's
 ``[damping]`` (Rayleigh α, β) for that run; the output names the damping used.
-Both commands refuse a model with a spring dashpot ``c`` (the modal route
-cannot honour it).
+``response`` refuses a model with a spring dashpot ``c`` (the modal route
+cannot honour it); ``frf`` solves such a model directly
+(:func:`linmstmm.forced.direct_frf`) and refuses ``--zeta`` and ``--modes``
+for it.
 
 Bad input raises :class:`linmstmm.model.ModelError` (exit status 2, one line);
 a file that cannot be written is a ModelError on the option that named it.
@@ -419,37 +421,41 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
     sum); given, they replace the model's damping; without them the model's
     Rayleigh damping is used (undamped without it). plot : PNG to write, or None.
 
+    A model with a spring dashpot ``c`` takes the direct route
+    (:func:`linmstmm.forced.direct_frf`: exact, dashpots and Rayleigh damping
+    included, no modes), which neither ``modes`` nor ``damping_ratio`` fits.
+
     Returns (FRFResult, summary): summary is JSON-ready (model, load, fmax_hz,
-    damping, damping_ratio, modes_in_sum, natural_freq_hz up to fmax,
+    damping, damping_ratio, route ("modal" or "direct"), modes_in_sum (0 on
+    the direct route), natural_freq_hz up to fmax (of the undamped model),
     load_unit, receptance_units per component). Raises ModelError for
     unknown points (keys ``--point``, ``--response-points``), ratios that do
-    not fit the modes (``--zeta``), a spring with a dashpot (key ``c``) or a
-    figure that cannot be written (``--plot``).
+    not fit the modes (``--zeta``), ``modes`` or ``damping_ratio`` given for a
+    model with dashpots (``--modes``, ``--zeta``) or a figure that cannot be
+    written (``--plot``).
     """
-    from linmstmm.response import frf, refuse_dashpots
+    from linmstmm.forced import has_dashpots
 
-    refuse_dashpots(model, "FRF")
+    direct = has_dashpots(model)
+    if direct:
+        _refuse_modal_options(model, modes, damping_ratio)
     targets = [point] if response_points is None else list(response_points)
     _check_points(model, "--point", [point])
     _check_points(model, "--response-points", targets)
     if direction not in COMPONENTS:
         raise ModelError(model.source or model.name, f"direction must be one of {', '.join(COMPONENTS)}, "
                          f"got {direction!r}", key="--direction")
-    if not modes:
-        check_range_request(model, FRF_MODE_REACH * fmax, f"--fmax {fmax:g} Hz (the modal sum takes every mode "
-                            f"up to {FRF_MODE_REACH:g} x fmax)", "ask for a lower fmax, or for N modes by --modes")
-    shapes = _mode_shapes(model, modes, None if modes else FRF_MODE_REACH * fmax)
     sweep = fmax * np.arange(1, frequencies + 1) / frequencies
     damping = _damping_in_use(model, damping_ratio)
-    with _zeta_option(model):
-        result = frf(shapes, point, np.eye(6)[COMPONENTS.index(direction)], sweep, targets,
-                     damping["damping"], damping_ratio=damping_ratio)
-    elastic = shapes.omega > 0
+    unit = np.eye(6)[COMPONENTS.index(direction)]
+    if direct:
+        result, in_sum, natural = _direct_sweep(model, point, unit, sweep, targets, fmax)
+    else:
+        result, in_sum, natural = _modal_sweep(model, point, unit, sweep, targets, fmax, modes, damping)
     load_unit = "N m" if direction.startswith("r") else "N"
     summary = {"model": model.name, "load": {"point": point, "direction": direction}, "fmax_hz": fmax,
-               **damping, "modes_in_sum": int(elastic.sum()),
-               "natural_freq_hz": shapes.natural_freq[elastic & (shapes.natural_freq <= fmax)].tolist(),
-               "load_unit": load_unit, "receptance_units": receptance_units(load_unit)}
+               **damping, "route": "direct" if direct else "modal", "modes_in_sum": in_sum,
+               "natural_freq_hz": natural, "load_unit": load_unit, "receptance_units": receptance_units(load_unit)}
     if plot:
         from linmstmm.plot import plot_frf
 
@@ -458,6 +464,39 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
             plot_frf(result, plot, summary["natural_freq_hz"], summary["load_unit"],
                      title=f"{model.name}: unit {kind} {direction} at {point}")
     return result, summary
+
+
+def _modal_sweep(model: Model, point: str, unit, sweep, targets, fmax: float, modes, damping: dict):
+    """(FRFResult, elastic modes in the sum, their natural frequencies up to fmax, Hz) of the modal sum."""
+    from linmstmm.response import frf
+
+    if not modes:
+        check_range_request(model, FRF_MODE_REACH * fmax, f"--fmax {fmax:g} Hz (the modal sum takes every mode "
+                            f"up to {FRF_MODE_REACH:g} x fmax)", "ask for a lower fmax, or for N modes by --modes")
+    shapes = _mode_shapes(model, modes, None if modes else FRF_MODE_REACH * fmax)
+    with _zeta_option(model):
+        result = frf(shapes, point, unit, sweep, targets, damping["damping"], damping_ratio=damping["damping_ratio"])
+    elastic = shapes.omega > 0
+    return result, int(elastic.sum()), shapes.natural_freq[elastic & (shapes.natural_freq <= fmax)].tolist()
+
+
+def _direct_sweep(model: Model, point: str, unit, sweep, targets, fmax: float):
+    """(FRFResult, 0, the undamped natural frequencies up to fmax, Hz) of the direct route."""
+    from linmstmm.forced import direct_frf
+    from linmstmm.solve import natural_frequencies
+
+    result = direct_frf(model, point, unit, sweep, targets, damping=model.damping)
+    return result, 0, natural_frequencies(model, count=None, fmax=fmax).frequencies_hz.tolist()
+
+
+def _refuse_modal_options(model: Model, modes, damping_ratio) -> None:
+    """ModelError on ``--modes`` or ``--zeta`` for a model whose dashpots take the direct route."""
+    for key, value in (("--modes", modes), ("--zeta", damping_ratio)):
+        if value is not None:
+            raise ModelError(model.source or model.name,
+                             f"the model's spring dashpots 'c' take the direct route, which sums no modes: "
+                             f"{key} belongs to the modal route; give [damping] for more damping",
+                             key=key)
 
 
 def receptance_units(load_unit: str) -> list[str]:
@@ -480,11 +519,15 @@ def print_frf(result, summary: dict) -> None:
     load = summary["load"]
     damping = _damping_text(summary)
     if damping == "undamped":
-        damping += " (unbounded at the natural frequencies)"
+        damping = ("undamped (unbounded at the natural frequencies)" if summary["route"] == "modal"
+                   else "no Rayleigh damping")
+    route = (f"{summary['modes_in_sum']} elastic modes in the sum" if summary["route"] == "modal"
+             else "direct transfer-matrix solve, spring dashpots acting")
     print(f"{summary['model']}: receptance to a unit load {load['direction']} at {load['point']} "
-          f"[per {summary['load_unit']}], 0-{summary['fmax_hz']:g} Hz, "
-          f"{summary['modes_in_sum']} elastic modes in the sum, {damping}")
-    print(f"  natural frequencies [Hz]: {', '.join(f'{f:.6g}' for f in summary['natural_freq_hz']) or 'none'}")
+          f"[per {summary['load_unit']}], 0-{summary['fmax_hz']:g} Hz, {route}, {damping}")
+    undamped = " (undamped)" if summary["route"] == "direct" else ""
+    print(f"  natural frequencies{undamped} [Hz]: "
+          f"{', '.join(f'{f:.6g}' for f in summary['natural_freq_hz']) or 'none'}")
     magnitude = np.abs(result.receptance)
     print(f"  {'point':<20}{'component':>10}{'largest |H|':>14}{'unit':>12}{'at [Hz]':>12}")
     for p, c in significant_components(result.receptance):

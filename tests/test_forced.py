@@ -13,6 +13,8 @@
 from __future__ import annotations
 
 import dataclasses
+import json
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +22,7 @@ import pytest
 from builders import fixed, make_beam, make_rigid, spring_mass_chain
 from random_models import random_model
 
+from linmstmm import cli
 from linmstmm.fe import harmonic_receptance
 from linmstmm.forced import direct_frf, has_dashpots
 from linmstmm.model import Model, Spring, load_model
@@ -103,7 +106,7 @@ def test_beam_with_dashpot_to_ground_converges_to_the_direct_route():
     got = direct_frf(model, "tip", vector, frequencies, ["tip"]).receptance
     errors = [relative(got, harmonic_receptance(model, "tip", vector, frequencies, ["tip"], n))
               for n in (4, 8, 16, 32)]
-    assert all(finer < coarser / 3.5 for coarser, finer in zip(errors, errors[1:])), errors
+    assert all(finer < coarser / 3.5 for coarser, finer in pairwise(errors)), errors
     assert errors[-1] < 1e-5
 
 
@@ -156,3 +159,46 @@ def test_launcher_with_damped_jacks_agrees_with_fe():
     assert errors[1] < errors[0] / 8 and errors[2] < errors[1] / 8 and errors[2] < 1e-4, errors
     undamped = direct_frf(model, "tube_rear", vector, frequencies, ["tube_rear"]).receptance
     assert relative(got, undamped) > 1e-2
+
+
+# --- the command line ------------------------------------------------------------
+
+DASHPOT_CHAIN_FILE = ROOT / "models/dashpot_chain.toml"
+
+
+def command(capsys, *argv):
+    status = cli.main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def test_frf_command_takes_the_direct_route_for_dashpots(capsys):
+    """The bundled chain with a dashpot is :func:`dashpot_chain`; its JSON has the
+    modal route's keys, and the receptance is the hand-written direct solve."""
+    status, out, _ = command(capsys, "frf", DASHPOT_CHAIN_FILE, "--point", "b2", "--direction", "y",
+                             "--fmax", "10", "--frequencies", "20", "--response-points", "b1", "b2", "--json")
+    assert status == 0
+    data = json.loads(out)
+    modal = json.loads(command(capsys, "frf", ROOT / "models/spring_mass_chain.toml", "--point", "b2",
+                               "--direction", "y", "--fmax", "10", "--frequencies", "20", "--json")[1])
+    assert set(data) == set(modal) and (data["route"], modal["route"]) == ("direct", "modal")
+    assert data["modes_in_sum"] == 0 and len(data["natural_freq_hz"]) == 6
+    got = np.array([[np.array(data["receptance"][p]["real"]) + 1j * np.array(data["receptance"][p]["imag"])]
+                    for p in ("b1", "b2")])[:, 0]  # (2, n_f, 6)
+    for f, H in zip(data["frequencies_hz"], np.moveaxis(got, 1, 0)):
+        W = 2 * np.pi * f
+        want = np.linalg.solve(K_HAND + 1j * W * C_HAND - W**2 * M_HAND, np.eye(2)[:, 1])
+        assert relative(H[:, 1], want) < 1e-12 and np.abs(H[:, [0, 2, 3, 4, 5]]).max() < 1e-12 * np.abs(want).max()
+    status, out, _ = command(capsys, "frf", DASHPOT_CHAIN_FILE, "--point", "b2", "--direction", "y",
+                             "--fmax", "10", "--frequencies", "20")
+    assert status == 0 and "direct transfer-matrix solve" in out and "no Rayleigh damping" in out
+
+
+@pytest.mark.parametrize("option", [("--zeta", "0.02"), ("--modes", "3")])
+def test_modal_options_with_dashpots_exit_2(capsys, option):
+    status, out, err = command(capsys, "frf", DASHPOT_CHAIN_FILE, "--point", "b2", "--direction", "y",
+                               "--fmax", "10", *option)
+    assert status == 2 and out == ""
+    assert err.strip() == (f"linmstmm: error: {DASHPOT_CHAIN_FILE}: key '{option[0]}': the model's spring "
+                           f"dashpots 'c' take the direct route, which sums no modes: {option[0]} belongs to "
+                           f"the modal route; give [damping] for more damping")

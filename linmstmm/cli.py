@@ -13,6 +13,7 @@ import sys
 
 from linmstmm import __version__
 from linmstmm.model import ModelError, load_model
+from linmstmm.damped_command import add_damped_option
 from linmstmm.fe_command import add_fe_command
 from linmstmm.mode_commands import add_mode_commands
 from linmstmm.structure import add_check_command
@@ -102,6 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "(about 5x cheaper per evaluation, 0.5-1.5 s to start in a new process); "
                             "auto: numpy in a new process")
     freqs.set_defaults(run=_run_freqs)
+    add_damped_option(freqs)
     add_check_command(sub)
     add_fe_command(sub)
     add_mode_commands(sub)

@@ -442,6 +442,31 @@ def harmonic_receptance(model: Model, point: str, vector, frequencies_hz, points
     return out.reshape(len(frequencies_hz), len(points), 6)
 
 
+def damped_roots(model: Model, elements_per_beam: int = 8) -> np.ndarray:
+    """Complex roots s (1/s) of the quadratic eigenproblem (K + sC + s²M) x = 0.
+
+    C holds the springs' dashpots (:func:`dashpot_matrix`) and the model's
+    Rayleigh ``[damping]`` αM + βK. Linearised to the generalized eigenproblem
+    s [[I, 0], [0, M]] y = [[0, I], [−K, −C]] y, y = (x, s x), solved densely.
+
+    Returns
+    -------
+    (m,) the finite roots with Im s > 0 (one of each conjugate pair:
+    s = −ζω_n + iω_d), ascending in Im s. Massless DOFs give infinite roots,
+    which are dropped; overdamped and zero (rigid-body) roots are real and
+    left out.
+    """
+    fe = assemble(model, elements_per_beam)
+    alpha, beta = (0.0, 0.0) if model.damping is None else model.damping
+    damping = (dashpot_matrix(model, fe) + alpha * fe.M + beta * fe.K).toarray()
+    n = fe.n_dof
+    identity, zero = np.eye(n), np.zeros((n, n))
+    roots = la.eigvals(np.block([[zero, identity], [-fe.K.toarray(), -damping]]),
+                      np.block([[identity, zero], [zero, fe.M.toarray()]]))
+    roots = roots[np.isfinite(roots) & (roots.imag > 0)]
+    return roots[np.argsort(roots.imag)]
+
+
 def _negligible_mass_removed(model: Model) -> Model:
     """``model`` with every mass below MASSLESS of the model's own scale set to zero.
 

@@ -52,7 +52,9 @@ class DampedDeduction(Deduction):
 
     rate : (n,) complex, 1/s, the dashpot rate of each frequency of the stack
     the carry is given (iΩ for a harmonic motion at Ω): a spring with ``c`` has
-    the stiffness k + rate c. Everything else is :class:`Deduction`.
+    the stiffness k + rate c. Set it before each carry (it belongs to that
+    stack). Periodic runs are not powered (cells that differ only in their
+    dashpots would pass for equal). Everything else is :class:`Deduction`.
     """
 
     def __init__(self, topology: Topology, rate):
@@ -65,6 +67,41 @@ class DampedDeduction(Deduction):
         if getattr(record, "kind", None) == "spring" and record.c is not None:
             return damped_spring_transfer(record.k, record.c, record.axes, self.rate) @ matrix
         return super().carried(e, omega, matrix)
+
+    def periodic_runs(self) -> list:
+        """None: every cell is carried on its own."""
+        return []
+
+
+def released_deduction(topology: Topology) -> DampedDeduction:
+    """A :class:`DampedDeduction` of ``topology`` with its statically indeterminate
+    unknowns released (:func:`~linmstmm.nullspace.release_indeterminate`, found on
+    the undamped system: they are the same), its ``rate`` still to be set."""
+    plain = Deduction(topology)
+    release_indeterminate(plain)
+    damped = DampedDeduction(topology, np.zeros(0))
+    damped.release(plain.released_columns, plain.released_rows)
+    return damped
+
+
+def rayleigh_equivalent(omega, damping):
+    """The undamped problem equivalent to Rayleigh damping C = αM + βK at ``omega``.
+
+    Parameters
+    ----------
+    omega : (n,) circular frequencies, rad/s, real or complex.
+    damping : (α 1/s, β s) or None.
+
+    Returns
+    -------
+    (carried, rate, factor), each (n,) complex: the elements' frequency
+    ω̃ = √((ω² − iαω)/(1 + iωβ)), rad/s; the dashpots' rate iω/(1 + iωβ), 1/s;
+    and 1 + iωβ, by which the dynamic stiffness was divided (a load is too).
+    """
+    alpha, beta = (0.0, 0.0) if damping is None else damping
+    omega = np.asarray(omega, dtype=complex)
+    factor = 1 + 1j * omega * beta
+    return np.sqrt((omega**2 - 1j * alpha * omega) / factor), 1j * omega / factor, factor
 
 
 def load_jumps(topology: Topology, point: str, vector) -> dict:
@@ -132,16 +169,11 @@ def direct_frf(model: Model, point: str, vector, frequencies_hz, points=None, *,
     frequencies_hz = np.asarray(frequencies_hz, dtype=float)
     points = tuple(model.points) if points is None else tuple(points)
     topology = build_topology(model, root=root)
-    plain = Deduction(topology)
-    release_indeterminate(plain)
-    alpha, beta = (0.0, 0.0) if damping is None else damping
+    deduction = released_deduction(topology)
     receptance = np.zeros((frequencies_hz.size, len(points), 6), dtype=complex)
     for start in range(0, frequencies_hz.size, CHUNK):
-        omega = 2 * np.pi * frequencies_hz[start:start + CHUNK]
-        factor = 1 + 1j * omega * beta
-        deduction = DampedDeduction(topology, 1j * omega / factor)
-        deduction.release(plain.released_columns, plain.released_rows)
-        carried = np.sqrt((omega**2 - 1j * alpha * omega) / factor)
+        carried, deduction.rate, factor = rayleigh_equivalent(2 * np.pi * frequencies_hz[start:start + CHUNK],
+                                                              damping)
         loads = np.asarray(vector, dtype=float) / factor[:, None]
         receptance[start:start + CHUNK] = _solve(deduction, carried, load_jumps(topology, point, loads), points)
     return FRFResult(frequencies_hz, points, receptance)

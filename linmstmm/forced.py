@@ -22,8 +22,10 @@ to the modal route (:mod:`linmstmm.response`).
 
 The carry is not orthonormalised (the load column must stay the load's), as
 for the mode shapes of :mod:`linmstmm.modes`: accurate while the beams'
-growing solutions e^{βL} stay far below 1/ε, i.e. over the frequencies of the
-modes that the mode shapes are computed for.
+growing solutions e^{βL} stay far below 1/ε. Measured on a 2 m steel
+cantilever (tests/test_forced.py), rooted at either end: the two agree to
+3e-13 at βL ≈ 10, 3e-10 at βL ≈ 18, 3e-6 at βL ≈ 26, and not at all beyond
+βL ≈ 35.
 """
 from __future__ import annotations
 

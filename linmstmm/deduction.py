@@ -216,8 +216,8 @@ class Deduction:
         outputs, rows, _ = self._carry(frequencies(omega), stable=False)
         return outputs, rows
 
-    def forced(self, omega, jumps):
-        """Ū_all(ω) and the load term of point loads: Ū_all z̄ + load = 0.
+    def forced(self, omega, jumps, probes, stable: bool = True):
+        """The overall transfer equation with point loads, and the states they give.
 
         Parameters
         ----------
@@ -227,37 +227,35 @@ class Deduction:
             the state on the other side plus this jump (a point force F and
             moment T there: ``[0, 0, T, F]``, N m and N; see
             :func:`linmstmm.forced.load_jumps`).
+        probes : {name: (element, port)}: the ports whose displacement and
+            rotation are wanted (an element's output, or a tip's input).
+        stable : orthonormalise on the way, as :meth:`log_det` does (each
+            jump is one more unknown, pinned to 1 by a row of its own, so it is
+            transformed like the others), without periodic runs.
 
         Returns
         -------
-        ubar : (n, N, N) Ū_all, as :meth:`matrix` without ``stable``.
-        load : (n, N) the load's column (its unknown is 1).
-        outputs : element -> :class:`PortState` at its output, on the unknowns
-            and the load column ``full_order``.
+        system : (n, N + L, N + L) Ū_all with one more column (the jump's
+            unknown) and row (its value) per jump, L = len(jumps), less the
+            released unknowns; ``system @ w = rhs`` holds the unknowns w.
+        rhs : (n, N + L): 1 in the rows of the jumps, 0 elsewhere.
+        probes : name -> :class:`PortState` (n, 6, k) on the full labels of w
+            (``full_order + L`` of them; released ones are 0).
         """
         omega = frequencies(omega)
-        outputs, rows, _ = self._carry(omega, stable=False, jumps=jumps)
-        system = self._assemble(omega, outputs, rows, loads=1)
-        return system[..., :-1], system[..., -1], outputs
+        loads = _Loads(self, jumps, probes, omega.size)
+        outputs, rows, _ = self._carry(omega, stable, loads)
+        system = self._assemble(omega, outputs, rows, loads=len(jumps))
+        rhs = np.zeros(system.shape[:2], dtype=system.dtype)
+        rhs[:, system.shape[1] - len(jumps):] = 1.0
+        return system, rhs, loads.states
 
-    def _jumped(self, state: PortState, jump) -> PortState:
-        """``state`` plus ``jump`` (12,) or (n, 12) on the load column ``full_order``."""
-        n = state.matrix.shape[0]
-        jump = np.broadcast_to(jump, (n, 12))
-        dtype = np.result_type(state.matrix, jump)
-        if state.columns.size and state.columns[-1] == self.full_order:
-            matrix = state.matrix.astype(dtype, copy=True)
-            matrix[:, :, -1] += jump
-            return PortState(state.columns, matrix)
-        return PortState(np.r_[state.columns, self.full_order],
-                         np.concatenate([state.matrix.astype(dtype), jump[:, :, None]], axis=2))
-
-    def _carry(self, omega, stable: bool, jumps=None):
+    def _carry(self, omega, stable: bool, loads=None):
         """Carry states from the tips to the root.
 
         stable : orthonormalise columns on the way (:class:`_Orthonormaliser`)
         and split beams into pieces of βL <= _BEAM_PIECE_BETA_L.
-        jumps : point loads as in :meth:`forced`, only without ``stable``.
+        loads : the point loads and probes of :meth:`forced` (:class:`_Loads`), or None.
 
         rows[0] is the main equation's known side, ``−Z_root`` (12 rows); the
         geometric rows follow (6 each). For a boundary-less model Z_root is the
@@ -269,9 +267,7 @@ class Deduction:
         with det Ū_all = det(Ū built from these) · exp(log_scale).
         """
         n = omega.size
-        jumps = jumps or {}
-        if stable and jumps:
-            raise ValueError("point loads are carried without orthonormalisation")
+        loads = loads or _Loads(self, {}, {}, n)
         elements = self.topology.elements
         outputs: dict[int, PortState] = {}
         open_states: dict[int, PortState] = {}
@@ -279,7 +275,8 @@ class Deduction:
         rows = [["root", given.columns, -given.matrix]]
         normaliser = _Orthonormaliser(omega) if stable else None
         order = self.topology.order
-        runs = {run.start: run for run in self.periodic_runs()} if stable else {}
+        runs = {run.start: run for run in self.periodic_runs()} if stable and not loads.active else {}
+        loads.watch_tips(open_states)
         position = 0
         while position < len(order):
             e = order[position]
@@ -293,8 +290,7 @@ class Deduction:
                     inputs.append(normaliser.enter_cut_side(link, lambda side: self.tip_state(side, n)))
                 else:
                     inputs.append(self.tip_state(link, n))
-                if (e, p) in jumps:
-                    inputs[-1] = self._jumped(inputs[-1], jumps[e, p])
+                inputs[-1] = loads.jumped((e, p), inputs[-1], rows)
             run = runs.get(position)
             powered = None if run is None else self._carry_run(run, omega, inputs[0], normaliser, rows, open_states)
             if powered is not None:
@@ -314,11 +310,12 @@ class Deduction:
                 rows.append([label, *self._combined((e, k), [(inputs[0].columns, -inputs[0].matrix[:, :6]),
                                                              (state.columns, constant_times(incidence, state.matrix))])])
             state = PortState(*self._combined((e,), terms), reference=_largest([state.reference for state in inputs]))
-            if (e, element.output) in jumps:
-                state = self._jumped(state, jumps[e, element.output])
+            state = loads.jumped((e, element.output), state, rows)
             if stable:
                 state = normaliser.apply(state, rows, open_states)
             outputs[e] = open_states[e] = state
+            loads.watch((e, element.output), state, open_states)
+        loads.finish(rows, open_states)
         log_scale = normaliser.log_scale if stable else np.zeros(n)
         return outputs, rows, log_scale
 
@@ -379,10 +376,10 @@ class Deduction:
 
     def _assemble(self, omega, outputs, rows, loads: int = 0) -> np.ndarray:
         """Ū_all (n, N, N) from the carried root state and the rows, less released ones;
-        with ``loads`` (n, N, N + loads), the load columns last (complex)."""
+        with ``loads`` (n, N + loads, N + loads), the loads' columns and rows last (complex)."""
         root = self.root_state(outputs)
         ubar = zeros_like_stack(omega.astype(complex) if loads else omega,
-                                (self.full_order, self.full_order + loads))
+                                (self.full_order + loads, self.full_order + loads))
         ubar[:, :12, _index(root.columns)] = root.matrix
         ubar[:, :12, _index(rows[0][1])] += rows[0][2]  # −Z_root: a ring's shares the root state's columns
         start = 12
@@ -414,6 +411,58 @@ class Deduction:
         ubar, log_scale = self.matrix(omega, stable=True)
         sign, log_abs = np.linalg.slogdet(ubar)
         return sign, log_abs + log_scale
+
+
+class _Loads:
+    """The point loads and probes of one forced carry (:meth:`Deduction.forced`).
+
+    Jump j enters as a fresh unknown, label ``full_order + j``, with a row of
+    its own that pins it to 1 (appended when it enters, moved after every
+    other row at the end): the orthonormalisation then transforms it like
+    any unknown. A probe is the displacement rows of the state at its port,
+    kept among the open states (key ``("probe", name)``) so that every
+    orthonormalisation rewrites it too.
+    """
+
+    def __init__(self, deduction: Deduction, jumps, probes, n: int):
+        self.deduction, self.jumps, self.probes, self.n = deduction, jumps, probes, n
+        self.labels = {port: deduction.full_order + j for j, port in enumerate(jumps)}
+        self.states: dict[str, PortState] = {}
+
+    @property
+    def active(self) -> bool:
+        return bool(self.jumps or self.probes)
+
+    def jumped(self, port, state: PortState, rows) -> PortState:
+        """``state`` plus the jump at ``port`` (if any) on its fresh unknown, whose row joins ``rows``."""
+        if port not in self.jumps:
+            return state
+        label = self.labels[port]
+        jump = np.broadcast_to(self.jumps[port], (self.n, 12))[:, :, None]
+        rows.append([("load", label), np.array([label]), np.ones((self.n, 1, 1), dtype=jump.dtype)])
+        columns = np.r_[state.columns, label]
+        order = np.argsort(columns, kind="stable")
+        matrix = np.concatenate([state.matrix.astype(np.result_type(state.matrix, jump)), jump], axis=2)
+        return PortState(columns[order], matrix[:, :, order])
+
+    def watch_tips(self, open_states) -> None:
+        """Start the probes at tips (a boundary end's or cut side's input) from their tip states."""
+        for name, (e, p) in self.probes.items():
+            if p != self.deduction.topology.elements[e].output:
+                tip = self.deduction.tip_state(self.deduction.topology.elements[e].ports[p].link, self.n)
+                open_states["probe", name] = PortState(tip.columns, tip.matrix[:, :6])
+
+    def watch(self, port, state: PortState, open_states) -> None:
+        """Start the probes at ``port`` (an element's output) from its ``state``."""
+        for name, where in self.probes.items():
+            if where == port:
+                open_states["probe", name] = PortState(state.columns, state.matrix[:, :6])
+
+    def finish(self, rows, open_states) -> None:
+        """Move the loads' rows last (in place) and collect the probes into ``states``."""
+        rows[:] = ([row for row in rows if not isinstance(row[0], tuple)]
+                   + [row for row in rows if isinstance(row[0], tuple)])
+        self.states = {name: open_states.pop(("probe", name)) for name in self.probes}
 
 
 def _index(columns):
@@ -529,7 +578,8 @@ class _Orthonormaliser:
         stacked = np.concatenate(parts, axis=1)
         if stacked.shape[1] < stacked.shape[2]:
             return state
-        row_scale = self._unit_scale(stacked, np.concatenate([np.arange(part.shape[1]) // 3 for part in parts]))
+        row_scale = self._unit_scale(stacked, np.concatenate([_row_kinds(block) for block in blocks]
+                                                             + [np.arange(state.matrix.shape[1]) // 3]))
         q, r = np.linalg.qr(stacked * row_scale[:, :, None])
         diagonal = np.diagonal(r, axis1=1, axis2=2)
         if not np.all(np.abs(diagonal) > 0):  # dependent columns (exactly at a root): keep as is
@@ -556,6 +606,18 @@ class _Orthonormaliser:
                 self.waiting[key] = PortState(columns, part, size_estimate(part).max(axis=(1, 2)))
         q = q[:, offset:]
         return PortState(columns, q, size_estimate(q).max(axis=(1, 2)))
+
+
+def _row_kinds(block) -> np.ndarray:
+    """The kind of each row of a block of :meth:`_Orthonormaliser.apply` (0 displacement,
+    1 rotation, 2 moment, 3 force, by threes). A point load's row (it pins the
+    load's unknown to 1, :class:`_Loads`) is weighed with the forces its unknown
+    brings in: weighed as a displacement, the QR lost up to 5 digits of a
+    cantilever's receptance (closed form, βL from 1 to 50)."""
+    kind, key, _, matrix = block
+    if kind == "row" and isinstance(key[0], tuple):
+        return np.full(matrix.shape[1], 3)
+    return np.arange(matrix.shape[1]) // 3
 
 
 def _embed(columns, block, onto):

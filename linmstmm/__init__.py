@@ -20,7 +20,9 @@ Public names (each documented where it is defined):
 * response: :func:`load_loads` -> :class:`LoadCase`, :func:`respond` and
   :func:`modal_response` -> :class:`ResponseResult` (time histories),
   :func:`frf` -> :class:`FRFResult` (receptance), :class:`PointLoad`;
-  :func:`direct_frf` (the direct solve, spring dashpots acting).
+* dashpots: :func:`direct_frf` -> :class:`FRFResult` (the direct solve,
+  spring dashpots acting), :func:`damped_frequencies` -> :class:`DampedResult`
+  (complex roots of det Ū_all).
 
 The names are imported on first use, so ``import linmstmm`` stays light
 (in particular, matplotlib is only imported by the plotting functions).
@@ -50,6 +52,8 @@ _SOURCES = {
     "modal_response": "linmstmm.response",
     "frf": "linmstmm.response",
     "direct_frf": "linmstmm.forced",
+    "damped_frequencies": "linmstmm.damped",
+    "DampedResult": "linmstmm.damped",
     "LoadCase": "linmstmm.response",
     "PointLoad": "linmstmm.response",
     "ResponseResult": "linmstmm.response",

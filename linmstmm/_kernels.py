@@ -180,7 +180,7 @@ def _unit_scale(stacked, kinds, scale):
         scale[i] = 1.0 / (size * peak)
 
 
-@njit(cache=True)
+@njit(cache=True, fastmath={"reassoc", "contract"})
 def _orthonormal_columns(columns, diagonal):
     """Orthonormalise the rows of ``columns`` (k, m) in place: classical Gram–Schmidt,
     twice (orthogonal to rounding), the QR of its transpose with R's diagonal real and

@@ -51,25 +51,37 @@ HEIGHT = 1.5
 class DampedResult:
     """Damped natural frequencies, ascending in damped frequency.
 
-    roots : (n,) complex s = −ζω_n + iω_d, 1/s, one per root and multiplicity.
-    undamped_hz : (n_u,) the undamped natural frequencies the search started from.
-    seconds : wall time of the whole solve.
+    Attributes
+    ----------
+    model : str
+        The model's name.
+    roots : numpy.ndarray, shape (n,), complex
+        s = −ζω_n + iω_d, 1/s, one per root and multiplicity.
+    undamped_frequencies_hz : numpy.ndarray, shape (n_u,)
+        The undamped natural frequencies the search started from, Hz.
+    rigid_body_modes : int
+        Zero-frequency modes (not in the lists).
+    seconds : float
+        Wall time of the whole solve, s.
+
+    The properties ``damped_frequencies_hz`` (ω_d / 2π), ``damping_ratio``
+    (ζ) and ``frequencies_hz`` (ω_n / 2π = |s| / 2π) derive from ``roots``.
     """
 
     model: str
     roots: np.ndarray
-    undamped_hz: np.ndarray
+    undamped_frequencies_hz: np.ndarray
     rigid_body_modes: int
     seconds: float
 
     @property
-    def damped_freq_hz(self) -> np.ndarray:
+    def damped_frequencies_hz(self) -> np.ndarray:
         """(n,) ω_d / 2π = Im s / 2π, Hz."""
         return self.roots.imag / (2 * np.pi)
 
     @property
-    def natural_freq_hz(self) -> np.ndarray:
-        """(n,) ω_n / 2π = |s| / 2π, Hz."""
+    def frequencies_hz(self) -> np.ndarray:
+        """(n,) ω_n / 2π = |s| / 2π, Hz (the undamped ones where there is no damping)."""
         return np.abs(self.roots) / (2 * np.pi)
 
     @property
@@ -78,12 +90,21 @@ class DampedResult:
         return -self.roots.real / np.abs(self.roots)
 
     def to_dict(self) -> dict:
-        """The ``linmstmm freqs --damped --json`` object (``docs/cli.md``)."""
-        return {"model": self.model, "damped_freq_hz": self.damped_freq_hz.tolist(),
-                "damping_ratio": self.damping_ratio.tolist(), "natural_freq_hz": self.natural_freq_hz.tolist(),
+        """The ``linmstmm freqs --damped --json`` object (``docs/cli.md``).
+
+        Returns
+        -------
+        dict
+            JSON-ready: ``model``, ``damped_frequencies_hz``, ``damping_ratio``,
+            ``frequencies_hz`` (|s| / 2π), ``roots`` ([re, im] of s, 1/s),
+            ``undamped_frequencies_hz``, ``rigid_body_modes``, ``seconds``, ``method``.
+        """
+        return {"model": self.model, "damped_frequencies_hz": self.damped_frequencies_hz.tolist(),
+                "damping_ratio": self.damping_ratio.tolist(), "frequencies_hz": self.frequencies_hz.tolist(),
                 "roots": [[float(s.real), float(s.imag)] for s in self.roots],
-                "undamped_freq_hz": self.undamped_hz.tolist(), "rigid_body_modes": int(self.rigid_body_modes),
-                "seconds": float(self.seconds), "method": "mstmm-damped"}
+                "undamped_frequencies_hz": self.undamped_frequencies_hz.tolist(),
+                "rigid_body_modes": int(self.rigid_body_modes), "seconds": float(self.seconds),
+                "method": "mstmm-damped"}
 
 
 def damped_log_det(model: Model, root: str | None = None):
@@ -104,13 +125,32 @@ def damped_frequencies(model: Model, count: int | None = 10, fmax: float | None 
     """Damped natural frequencies and damping ratios of ``model`` (dashpots ``c``
     and the model's Rayleigh ``[damping]`` acting), from its lowest undamped ones.
 
-    count, fmax : which undamped frequencies to start from (as
-    :func:`linmstmm.solve.natural_frequencies`; a repeated frequency comes
-    with its whole eigenspace); one damped root comes from each.
-    root : boundary end to use as the root of the transfer tree.
+    Parameters
+    ----------
+    model : Model
+        The model.
+    count : int or None
+        The lowest ``count`` undamped frequencies to start from (as
+        :func:`linmstmm.solve.natural_frequencies`; a repeated frequency comes
+        with its whole eigenspace); one damped root comes from each.
+    fmax : float or None
+        Hz: start from every undamped frequency up to fmax (with ``count``:
+        whichever stops first).
+    root : str or None
+        Boundary end to use as the root of the transfer tree.
 
-    Returns :class:`DampedResult`. Raises RuntimeError when a root cannot be
-    found or the certifying count finds roots the search did not.
+    Returns
+    -------
+    DampedResult
+
+    Raises
+    ------
+    ModelError
+        For ``root`` that is no boundary end (key ``root``) or ``fmax`` alone
+        that holds too many modes (as :func:`linmstmm.solve.natural_frequencies`).
+    RuntimeError
+        When a root cannot be found or the certifying count finds roots the
+        search did not.
     """
     started = time.perf_counter()
     asked = natural_frequencies(model, count=count, fmax=fmax, root=root)

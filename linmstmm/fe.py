@@ -484,6 +484,8 @@ def _negligible_mass_removed(model: Model) -> Model:
     inertia = total * extent ** 2 + sum(np.trace(body.inertia) for body in model.rigids)
     rigids = tuple(_body_mass_kept(body, MASSLESS * total, MASSLESS * inertia) for body in model.rigids)
     beams = tuple(beam if beam.mass > MASSLESS * total else replace(beam, rho=0.0) for beam in model.beams)
+    if all(a is b for a, b in zip(rigids + beams, model.rigids + model.beams)):
+        return model  # nothing negligible: no copy (a copy validates the whole model again)
     return replace(model, rigids=rigids, beams=beams)
 
 
@@ -1089,7 +1091,14 @@ class FEResult:
     note: str = ""
 
     def to_dict(self) -> dict:
-        """JSON-ready summary (the CLI ``--json`` keys plus the FE ones; ``note`` only when set)."""
+        """JSON-ready summary (the ``freqs --json`` keys plus the FE ones).
+
+        Returns
+        -------
+        dict
+            ``model``, ``frequencies_hz``, ``rigid_body_modes``, ``n_dof``, ``elements_per_beam``,
+            ``error_estimate``, ``seconds``, ``method`` and, when set, ``note``.
+        """
         return {"model": self.model,
                 "frequencies_hz": [float(f) for f in self.frequencies_hz],
                 "rigid_body_modes": int(self.rigid_body_modes),
@@ -1154,17 +1163,32 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
 
     Parameters
     ----------
-    count : int or None, the lowest ``count`` frequencies.
-    fmax : float or None, all frequencies up to ``fmax`` Hz. Both: whichever
-        stops first; neither: ``count = 10``.
-    elements_per_beam : None = refine: double the mesh from 4 elements per
-        beam, Richardson-extrapolate each frequency, and stop when every
-        estimated relative error is <= ``rtol`` (at least three meshes) or
-        the next mesh would exceed ``max_elements_per_beam``. An int = that
-        mesh, no extrapolation; its error is estimated from one solve on half
-        the mesh unless ``estimate_error`` is False (then NaN).
-    rtol : target relative error of the frequencies when refining.
-    mode_shapes : also return mass-normalised full mode vectors.
+    model : Model
+        The model.
+    count : int or None
+        The lowest ``count`` frequencies.
+    fmax : float or None
+        All frequencies up to ``fmax`` Hz. Both: whichever stops first;
+        neither: ``count = 10``.
+    elements_per_beam : int or None
+        None = refine: double the mesh from 4 elements per beam,
+        Richardson-extrapolate each frequency, and stop when every estimated
+        relative error is <= ``rtol`` (at least three meshes) or the next
+        mesh would exceed ``max_elements_per_beam``. An int = that mesh, no
+        extrapolation; its error is estimated from one solve on half the mesh
+        unless ``estimate_error`` is False (then NaN).
+    rtol : float
+        Target relative error of the frequencies when refining.
+    estimate_error : bool
+        With a fixed mesh: estimate the error from half the mesh.
+    max_elements_per_beam : int
+        The finest mesh the refinement may reach.
+    mode_shapes : bool
+        Also return mass-normalised full mode vectors.
+
+    Returns
+    -------
+    FEResult
 
     Zero-frequency rigid-body modes are counted structurally (see the module
     notes), not by a threshold on computed eigenvalues. No value whose estimated

@@ -53,7 +53,17 @@ PLAIN_BETA_L = 4.0
 
 
 def has_dashpots(model: Model) -> bool:
-    """True if any spring of ``model`` has a nonzero dashpot ``c``."""
+    """Whether any spring of ``model`` has a nonzero dashpot ``c``.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+
+    Returns
+    -------
+    bool
+    """
     return any(spring.c is not None and np.any(spring.c > 0) for spring in model.springs)
 
 
@@ -150,25 +160,34 @@ def direct_frf(model: Model, point: str, vector, frequencies_hz, points=None, *,
 
     Parameters
     ----------
-    model : the model; its springs' dashpots ``c`` act.
-    point : the loaded point.
-    vector : (6,) load [force N, moment N m] at ``point``, inertial axes.
-    frequencies_hz : (n_f,) excitation frequencies, Hz, > 0.
-    points : response points (default: every point of the model).
-    damping : (α 1/s, β s) of Rayleigh damping C = αM + βK added to the
-        dashpots, or None (the model's ``[damping]`` is not read here: pass
+    model : Model
+        The model; its springs' dashpots ``c`` act.
+    point : str
+        The loaded point.
+    vector : array_like, shape (6,)
+        The load [force N, moment N m] at ``point``, inertial axes.
+    frequencies_hz : array_like, shape (n_f,)
+        Excitation frequencies, Hz, > 0.
+    points : sequence of str, optional
+        Response points (default: every point of the model).
+    damping : (float, float) or None
+        (α 1/s, β s) of Rayleigh damping C = αM + βK added to the dashpots,
+        or None (the model's ``[damping]`` is not read here: pass
         ``model.damping`` to use it).
-    root : boundary end to use as the root of the transfer tree.
-    orthonormalise : carry with orthonormalisation (True), without (False), or
-        by the beams' βL at the top of each chunk of frequencies (None: above
+    root : str or None
+        Boundary end to use as the root of the transfer tree.
+    orthonormalise : bool or None
+        Carry with orthonormalisation (True), without (False), or by the
+        beams' βL at the top of each chunk of frequencies (None: above
         PLAIN_BETA_L).
 
     Returns
     -------
-    :class:`linmstmm.response.FRFResult`: receptance (n_f, n_points, 6)
-    complex, displacement (m) and rotation (rad) per unit of ``vector``.
-    Exact for springs and rigid bodies, and for beams (continuous, no
-    discretisation) to rounding.
+    FRFResult
+        :class:`linmstmm.response.FRFResult`: receptance (n_f, n_points, 6)
+        complex, displacement (m) and rotation (rad) per unit of ``vector``.
+        Exact for springs and rigid bodies, and for beams (continuous, no
+        discretisation) to rounding.
     """
     frequencies_hz = np.asarray(frequencies_hz, dtype=float)
     points = tuple(model.points) if points is None else tuple(points)

@@ -173,23 +173,62 @@ class Model:
         return self.rigids + self.beams + self.springs
 
     def element(self, name: str):
-        """The element called ``name`` (KeyError if none)."""
+        """The element called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            The element's name.
+
+        Returns
+        -------
+        Rigid, Beam or Spring
+
+        Raises
+        ------
+        KeyError
+            If the model has no element of that name.
+        """
         for element in self.elements:
             if element.name == name:
                 return element
         raise KeyError(name)
 
     def fixed_mask(self, point: str) -> np.ndarray:
-        """(6,) bool: which displacement components are fixed at ``point``."""
+        """Which displacement components are fixed at ``point``.
+
+        Parameters
+        ----------
+        point : str
+            A point name.
+
+        Returns
+        -------
+        numpy.ndarray of bool, shape (6,)
+            x, y, z, rx, ry, rz: True where fixed.
+        """
         return self.boundary.get(point, np.zeros(6, dtype=bool))
 
 
 def load_model(path) -> Model:
     """Read, validate and build the model in the TOML file ``path``.
 
-    Raises :class:`ModelError` (one line: file, element, key) on any breach
-    of the contract; no record is built before the file is validated, and the
-    :class:`Model` checks its records again on construction (the same checks).
+    No record is built before the file is validated, and the :class:`Model`
+    checks its records again on construction (the same checks).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The model file (format: ``docs/model-format.md``).
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    ModelError
+        One line (file, element, key) on any breach of the contract.
     """
     file = str(path)
     fields = _validate(_read_toml(path, file), file)

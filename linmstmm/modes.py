@@ -34,10 +34,10 @@ import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import beam_transfer
-from linmstmm.mode_bound import check_range_request
-from linmstmm.model import Model
+from linmstmm.model import Model, ModelError
 from linmstmm.nullspace import NULL_TOLERANCE, equilibration
-from linmstmm.solve import frequency_finder, search_note
+from linmstmm.solve import search_note, solve_roots
+from linmstmm.stages import report
 from linmstmm.threads import single_blas_thread
 
 #: Normalisations of the modes: unit modal mass, or unit largest translation.
@@ -46,8 +46,6 @@ NORMALIZATIONS = ("mass", "max")
 DEFAULT_NORMALIZATION = "mass"
 #: Frequencies closer than this (relative) are one repeated frequency.
 SAME_FREQUENCY = 1e-9
-#: Roots asked for beyond ``count``, so that an eigenspace cut by the count is completed.
-EIGENSPACE_MARGIN = 2
 #: Relative frequency offset of the matrices that scale Ū_all for its null space.
 SCALE_PROBE = 1e-3
 #: Gauss–Legendre points along a beam beyond its largest wavenumber × length.
@@ -77,7 +75,7 @@ class BeamField:
 class ModalResult:
     """Modes of a model, ascending in frequency (rigid-body modes first).
 
-    omega : (n,) rad/s; ``natural_freq`` (n,) Hz.
+    omega : (n,) rad/s; ``frequencies_hz`` (n,) Hz.
     rigid_body_modes : number of zero-frequency modes at the start.
     modal_mass : (n,) M_k = ⟨M V^k, V^k⟩ (1 for mass normalisation).
     modal_stiffness : (n,) K_k = ω_k² M_k.
@@ -110,7 +108,7 @@ class ModalResult:
     note: str = ""
 
     @property
-    def natural_freq(self) -> np.ndarray:
+    def frequencies_hz(self) -> np.ndarray:
         """(n,) natural frequencies, Hz."""
         return self.omega / (2 * np.pi)
 
@@ -139,19 +137,51 @@ class ModalResult:
         return float(np.max(np.abs(diagonal / self.omega[elastic] ** 2 - 1), initial=0.0))
 
     def shape_matrix(self, points=None) -> np.ndarray:
-        """(n, 6 p) point displacements of every mode, points in ``points`` order (default: all)."""
+        """The point displacements of every mode as one matrix.
+
+        Parameters
+        ----------
+        points : sequence of str, optional
+            The p points, in the order wanted (default: every point).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, 6 p)
+            x, y, z, rx, ry, rz of each point in turn, per mode.
+        """
         names = list(self.point_displacements) if points is None else list(points)
         return np.concatenate([self.point_displacements[p] for p in names], axis=1)
 
     def mac(self, other_shapes, points=None) -> np.ndarray:
-        """MAC matrix (n, n_other) between these modes and ``other_shapes`` (n_other, 6 p)."""
+        """MAC matrix between these modes and other shapes at the same points.
+
+        Parameters
+        ----------
+        other_shapes : array_like, shape (n_other, 6 p)
+            Shapes laid out as :meth:`shape_matrix` lays them out.
+        points : sequence of str, optional
+            The p points (default: every point).
+
+        Returns
+        -------
+        numpy.ndarray, shape (n, n_other)
+            In [0, 1] (:func:`mac_matrix`).
+        """
         return mac_matrix(self.shape_matrix(points), other_shapes)
 
     def to_dict(self) -> dict:
-        """Plain JSON-ready dictionary (lists of floats)."""
+        """Plain JSON-ready dictionary (lists of floats).
+
+        Returns
+        -------
+        dict
+            ``model``, ``frequencies_hz``, ``omega``, ``rigid_body_modes``, ``normalization``,
+            the modal masses and stiffnesses, orthogonality errors and matrices, and the
+            displacements by point, mass centre and beam field.
+        """
         return {
             "model": self.model,
-            "natural_freq_hz": self.natural_freq.tolist(),
+            "frequencies_hz": self.frequencies_hz.tolist(),
             "omega": self.omega.tolist(),
             "rigid_body_modes": self.rigid_body_modes,
             "normalization": self.normalization,
@@ -173,8 +203,17 @@ class ModalResult:
 def mac_matrix(a, b) -> np.ndarray:
     """Modal assurance criterion between two sets of shape vectors.
 
-    a : (n_a, d), b : (n_b, d), real or complex. Returns (n_a, n_b) in [0, 1]:
-    |a_i · conj(b_j)|² / ((a_i · conj(a_i)) (b_j · conj(b_j))).
+    Parameters
+    ----------
+    a : array_like, shape (n_a, d)
+        Shapes, real or complex.
+    b : array_like, shape (n_b, d)
+        Shapes, real or complex.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_a, n_b)
+        |a_i · conj(b_j)|² / ((a_i · conj(a_i)) (b_j · conj(b_j))), in [0, 1].
     """
     a, b = np.atleast_2d(a), np.atleast_2d(b)
     cross = np.abs(a @ b.conj().T) ** 2
@@ -187,35 +226,63 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
                 root: str | None = None) -> ModalResult:
     """Natural modes of ``model`` by the transfer matrix method.
 
-    count : the lowest ``count`` elastic modes; fmax : Hz, all up to fmax (both:
-        whichever stops first). A repeated frequency always comes with its whole
-        eigenspace, so one more mode than ``count`` may come back.
-    stations : number of equally spaced stations (ends included) of each beam field.
-    normalization : "mass" (the default, also of ``linmstmm modes``: M_k = 1 kg,
+    The frequencies come from the pipeline of
+    :func:`linmstmm.solve.natural_frequencies` (:func:`linmstmm.solve.solve_roots`:
+    the same deduction, root finder and mpmath refinement), so they agree
+    with it to the last digit.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    count : int or None
+        The lowest ``count`` elastic modes. A repeated frequency always comes
+        with its whole eigenspace, so one more mode than ``count`` may come back.
+    fmax : float or None
+        Hz: all modes up to fmax (with ``count``: whichever stops first);
+        ``fmax`` alone is checked as :func:`linmstmm.solve.natural_frequencies` checks it.
+    stations : int
+        Number of equally spaced stations (ends included) of each beam field.
+    normalization : str
+        "mass" (the default, also of ``linmstmm modes``: M_k = 1 kg,
         amplitudes in m/√kg and rad/√kg) or "max" (largest translation 1 m; a
         mode without translation: largest rotation 1 rad). The largest
         component is made positive either way.
-    rigid_body : include the zero-frequency modes first.
-    root : boundary end to use as the root of the transfer tree.
-    ``fmax`` alone is checked as :func:`linmstmm.solve.natural_frequencies` checks it.
+    rigid_body : bool
+        Include the zero-frequency modes first.
+    root : str or None
+        Boundary end to use as the root of the transfer tree.
+
+    Returns
+    -------
+    ModalResult
+
+    Raises
+    ------
+    ModelError
+        For a range holding too many modes, or no mode at all (key ``fmax``).
     """
     if normalization not in NORMALIZATIONS:
         raise ValueError(f"normalization must be one of {NORMALIZATIONS}, got {normalization!r}")
     if stations < 2:
         raise ValueError(f"stations must be >= 2, got {stations}")
-    if fmax is not None and count is None:
-        check_range_request(model, fmax)
-    deduction, finder, _ = frequency_finder(model, root)
-    omega_max = None if fmax is None else 2 * np.pi * fmax
-    eigenspaces = _group(finder.find(None if count is None else count + EIGENSPACE_MARGIN, omega_max))
-    if count is not None:  # whole eigenspaces that start within the first ``count`` modes
-        starts = np.cumsum([0] + [m for _, m in eigenspaces])
-        eigenspaces = eigenspaces[:int(np.searchsorted(starts, count))]
+    solution = solve_roots(model, count, fmax, root=root)
+    deduction, finder = solution.deduction, solution.finder
+    omegas = solution.omegas
+    if count and omegas.size == count:  # the count may cut the last eigenspace
+        omegas = _whole_last_eigenspace(finder, omegas)
+    eigenspaces = _group(omegas)
     elastic = sum(m for _, m in eigenspaces)
-    note = search_note(finder, elastic, finder.unseparated_among([w for w, _ in eigenspaces]), count, fmax)
+    kept = {w for w, _ in eigenspaces}
+    note = search_note(finder, elastic, {w: v for w, v in solution.unseparated.items() if w in kept}, count, fmax)
     if rigid_body and (rigid := finder.rigid_body_modes()):
         eigenspaces.insert(0, (0.0, rigid))
+    if not eigenspaces:
+        raise ModelError(model.source or model.name, "no mode to compute: " + (
+            f"no natural frequency up to {fmax:g} Hz" if count is None else "the model has no mode"),
+            key="fmax" if count is None else None)
     omega = np.repeat([w for w, _ in eigenspaces], [m for _, m in eigenspaces])
+    report("mode shapes")
     zbar = np.concatenate([_null_basis(deduction, w, m) for w, m in eigenspaces])
     raw = _Fields.of(model, deduction, omega, zbar, stations)
     gram = raw.mass_gram()
@@ -247,6 +314,20 @@ def _group(omegas) -> list[tuple[float, int]]:
         else:
             groups.append((float(omega), 1))
     return groups
+
+
+def _whole_last_eigenspace(finder, omegas: np.ndarray) -> np.ndarray:
+    """``omegas`` (rad/s, ascending) with the last root repeated up to its multiplicity.
+
+    The multiplicity is the finder's count of roots around it
+    (:meth:`~linmstmm.roots.RootFinder.multiplicity`), as the mpmath
+    refinement of a root cut by the count takes it; the roots before it are
+    left exactly as found.
+    """
+    last = omegas[-1]
+    present = int(np.count_nonzero(np.abs(omegas - last) <= SAME_FREQUENCY * last))
+    wanted = finder.multiplicity(last, sorted(set(omegas))) or present
+    return np.r_[omegas, np.full(max(wanted - present, 0), last)]
 
 
 def _null_basis(deduction: Deduction, omega: float, dimension: int) -> np.ndarray:

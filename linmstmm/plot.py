@@ -168,7 +168,7 @@ def _pieces(result: ModalResult, model: Model, k: int):
 
 
 def _mode_title(result: ModalResult, model: Model, k: int, moves: bool) -> str:
-    kind = "rigid-body mode" if result.omega[k] == 0 else f"f = {result.natural_freq[k]:.6g} Hz"
+    kind = "rigid-body mode" if result.omega[k] == 0 else f"f = {result.frequencies_hz[k]:.6g} Hz"
     mass = f"modal mass {result.modal_mass[k]:.4g} kg ({result.normalization} normalisation)"
     note = "" if moves else "; rotation only, drawn undeformed"
     return f"{model.name}\nmode {k + 1}: {kind}, {mass}{note}"
@@ -304,9 +304,9 @@ def plot_frf(result, path, natural_hz=(), load_unit: str = "N", title: str = "")
     top, bottom = axes[:, 0]
     for p, c in significant_components(result.receptance):
         unit = "m" if c < 3 else "rad"
-        line, = top.semilogy(result.frequencies_hz, np.abs(result.receptance[:, p, c]), lw=1.0,
+        line, = top.semilogy(result.excitation_hz, np.abs(result.receptance[:, p, c]), lw=1.0,
                              label=f"{result.points[p]} {COMPONENTS[c]} [{unit}/{load_unit}]")
-        bottom.plot(result.frequencies_hz, np.degrees(np.angle(result.receptance[:, p, c])),
+        bottom.plot(result.excitation_hz, np.degrees(np.angle(result.receptance[:, p, c])),
                     lw=1.0, color=line.get_color())
     for frequency in natural_hz:
         for axis in (top, bottom):

@@ -84,16 +84,21 @@ def sparse_determinant(matrix: np.ndarray) -> mpmath.mpf:
     return det
 
 
-def refine_roots(deduction, model, omegas, digits: int, multiplicities=None) -> list:
+def refine_roots(deduction, model, omegas, digits: int, multiplicities=None, log_det=None) -> list:
     """The roots ``omegas`` (rad/s, ascending, repeated per multiplicity) to ``digits`` digits.
 
     multiplicities : {root: multiplicity} where it differs from the number of
     repeats in ``omegas`` (the highest root of a list cut at a count may be
-    double with one entry). Returns mpf values, one per entry of ``omegas``.
+    double with one entry). log_det : callable ω (n,) -> (sign (n,), log|det Ū_all|
+    (n,)) in float64, or None; where given, a simple root's slope comes from it
+    (:func:`float64_slopes`), and the secant's second point is the Newton step
+    from the float64 root: two evaluations in mpmath per root, not three.
+    Returns mpf values, one per entry of ``omegas``.
     Raises RuntimeError for a root the refinement does not settle on, even at
     2**PRECISION_DOUBLINGS times the working precision.
     """
     refined = []
+    slopes = float64_slopes(log_det, omegas) if log_det is not None else {}
     i = 0
     while i < len(omegas):
         repeats = 1
@@ -105,7 +110,7 @@ def refine_roots(deduction, model, omegas, digits: int, multiplicities=None) -> 
             with mpmath.workdps(dps << attempt):
                 start, tolerance = mpmath.mpf(omegas[i]), mpmath.mpf(10) ** -(digits + 2)
                 try:
-                    root = (_secant(deduction, start, tolerance) if m == 1
+                    root = (_secant(deduction, start, tolerance, slopes.get(omegas[i])) if m == 1
                             else _multiple_newton(deduction, start, m, tolerance))
                 except RuntimeError:
                     if attempt == PRECISION_DOUBLINGS:
@@ -117,10 +122,40 @@ def refine_roots(deduction, model, omegas, digits: int, multiplicities=None) -> 
     return refined
 
 
-def _secant(deduction, start, tolerance):
-    """The simple root of det Ū_all next to ``start`` (mpf, rad/s), to ``tolerance`` relative."""
-    x0, x1 = start, start * (1 + mpmath.mpf(2) ** -40)
-    f0, f1 = mp_determinant(deduction, x0), mp_determinant(deduction, x1)
+#: Relative step of the float64 central difference that gives det's slope at a root.
+SLOPE_STEP = 1e-6
+
+
+def float64_slopes(log_det, omegas) -> dict:
+    """{ω: d det Ū_all / dω} at each of ``omegas`` (rad/s), from float64 values of det at
+    ω (1 ± SLOPE_STEP) (``log_det``: ω (n,) -> (sign, log|det|)), as mpf: accurate to
+    about 1e-10 relative at a simple root, enough for the mpmath secant's first step
+    to land within that fraction of the float64 root's error."""
+    omegas = np.unique(np.asarray(omegas, dtype=float))
+    if not omegas.size:
+        return {}
+    points = np.concatenate([omegas * (1 + SLOPE_STEP), omegas * (1 - SLOPE_STEP)])
+    sign, log_abs = log_det(points)
+    values = [mpmath.mpf(float(np.real(s))) * mpmath.exp(mpmath.mpf(float(v))) for s, v in zip(sign, log_abs)]
+    n = omegas.size
+    return {float(w): (values[i] - values[n + i]) / (2 * SLOPE_STEP * mpmath.mpf(float(w)))
+            for i, w in enumerate(omegas)}
+
+
+def _secant(deduction, start, tolerance, slope=None):
+    """The simple root of det Ū_all next to ``start`` (mpf, rad/s), to ``tolerance`` relative.
+
+    slope : det's derivative there (mpf, from :func:`float64_slopes`) or None: the
+    second point is then the Newton step from ``start`` (where that step is below
+    SLOPE_STEP relative), else ``start`` (1 + 2⁻⁴⁰)."""
+    x0 = start
+    f0 = mp_determinant(deduction, x0)
+    x1 = start * (1 + mpmath.mpf(2) ** -40)
+    if slope:
+        newton = x0 - f0 / slope
+        if abs(newton - x0) <= SLOPE_STEP * abs(x0) and newton != x0:
+            x1 = newton
+    f1 = mp_determinant(deduction, x1)
     for _ in range(MAX_STEPS):
         if f1 == 0:
             return x1

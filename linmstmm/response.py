@@ -87,7 +87,7 @@ the load and the key.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -224,6 +224,8 @@ class ResponseResult:
     elastic_modes : elastic modes in the modal sum.
     static_correction : whether the static correction (mode acceleration) is in.
     note : why it is not, when it was asked for ("" otherwise).
+    frequencies_hz : (elastic_modes,) natural frequencies of the elastic modes in the sum, Hz.
+    rigid_body_modes : zero-frequency modes in the sum.
     """
 
     times: np.ndarray
@@ -235,11 +237,22 @@ class ResponseResult:
     elastic_modes: int
     static_correction: bool = False
     note: str = ""
+    frequencies_hz: np.ndarray = field(default_factory=lambda: np.empty(0))
+    rigid_body_modes: int = 0
 
     def to_dict(self) -> dict:
-        """Plain JSON-ready dictionary: point -> lists (n_t, 6); ``units`` per quantity and component."""
+        """Plain JSON-ready dictionary: point -> lists (n_t, 6); ``units`` per quantity and component.
+
+        Returns
+        -------
+        dict
+            ``times``, ``points``, ``elastic_modes``, ``rigid_body_modes``, ``frequencies_hz``,
+            ``static_correction``, ``note`` when set, ``units``, ``displacement``,
+            ``velocity``, ``acceleration``.
+        """
         return {"times": self.times.tolist(), "points": list(self.points),
-                "elastic_modes": self.elastic_modes, "static_correction": self.static_correction,
+                "elastic_modes": self.elastic_modes, "rigid_body_modes": self.rigid_body_modes,
+                "frequencies_hz": self.frequencies_hz.tolist(), "static_correction": self.static_correction,
                 **({"note": self.note} if self.note else {}),
                 "units": {"times": "s", **{name: quantity_units(name) for name in QUANTITY_UNITS}},
                 **{name: {p: values[:, i].tolist() for i, p in enumerate(self.points)}
@@ -263,27 +276,33 @@ def quantity_units(quantity: str) -> list[str]:
 class FRFResult:
     """Receptance between one load direction and the points.
 
-    frequencies_hz : (n_f,). points : names. receptance : (n_f, n_points, 6)
+    excitation_hz : (n_f,) excitation frequencies, Hz. points : names. receptance : (n_f, n_points, 6)
     complex, m/N (or rad/N, m/(N m), rad/(N m)) per unit of the load vector.
     """
 
-    frequencies_hz: np.ndarray
+    excitation_hz: np.ndarray
     points: tuple[str, ...]
     receptance: np.ndarray
 
     @property
     def mobility(self) -> np.ndarray:
         """Velocity per load, iΩ H."""
-        return 2j * np.pi * self.frequencies_hz[:, None, None] * self.receptance
+        return 2j * np.pi * self.excitation_hz[:, None, None] * self.receptance
 
     @property
     def accelerance(self) -> np.ndarray:
         """Acceleration per load, −Ω² H."""
-        return -(2 * np.pi * self.frequencies_hz[:, None, None]) ** 2 * self.receptance
+        return -(2 * np.pi * self.excitation_hz[:, None, None]) ** 2 * self.receptance
 
     def to_dict(self) -> dict:
-        """Plain JSON-ready dictionary: point -> real and imaginary parts (n_f, 6)."""
-        return {"frequencies_hz": self.frequencies_hz.tolist(), "points": list(self.points),
+        """Plain JSON-ready dictionary: point -> real and imaginary parts (n_f, 6).
+
+        Returns
+        -------
+        dict
+            ``excitation_hz``, ``points`` and ``receptance`` (point -> ``{real, imag}``).
+        """
+        return {"excitation_hz": self.excitation_hz.tolist(), "points": list(self.points),
                 "receptance": {p: {"real": self.receptance[:, i].real.tolist(),
                                    "imag": self.receptance[:, i].imag.tolist()}
                                for i, p in enumerate(self.points)}}
@@ -477,8 +496,10 @@ def modal_response(modes: ModalResult, loads, times, points=None, damping=None, 
     physical = np.einsum("htk,kpc->htpc", histories, shapes)
     if static is not None:
         physical += _static_correction(modes, loads, times, shapes, np.asarray(static, dtype=float))
-    elastic = int(np.count_nonzero(modes.omega > 0))
-    return ResponseResult(times, points, *physical, histories[0], elastic, static is not None)
+    elastic = modes.omega > 0
+    return ResponseResult(times, points, *physical, histories[0], int(np.count_nonzero(elastic)),
+                          static is not None, frequencies_hz=modes.frequencies_hz[elastic],
+                          rigid_body_modes=modes.rigid_body_modes)
 
 
 def _static_correction(modes: ModalResult, loads, times, shapes, static) -> np.ndarray:
@@ -492,21 +513,39 @@ def _static_correction(modes: ModalResult, loads, times, shapes, static) -> np.n
     return correction
 
 
-def frf(modes: ModalResult, point: str, vector, frequencies_hz, points=None,
+def frf(modes: ModalResult, point: str, vector, excitation_hz, points=None,
         damping=None, *, damping_ratio=None) -> FRFResult:
-    """Receptance between the (6,) load ``vector`` [force, moment] at ``point`` and ``points``.
+    """Receptance between a load ``vector`` at ``point`` and the response ``points``.
 
-    frequencies_hz : (n_f,) Hz. damping, damping_ratio : Rayleigh (α, β) or
-    modal ratios ζ, see :func:`modal_damping` (neither: undamped, infinite at
-    the natural frequencies).
+    Parameters
+    ----------
+    modes : ModalResult
+        The modes in the sum (rigid-body modes included).
+    point : str
+        The load point.
+    vector : array_like, shape (6,)
+        The load [force (N), moment (N m)], inertial axes.
+    excitation_hz : array_like, shape (n_f,)
+        Excitation frequencies, Hz.
+    points : sequence of str, optional
+        Response points (default: every point of the modes).
+    damping : tuple of float, optional
+        Rayleigh (α 1/s, β s), see :func:`modal_damping`.
+    damping_ratio : float or sequence of float, optional
+        Modal damping ratios ζ instead (neither: undamped, infinite at the
+        natural frequencies).
+
+    Returns
+    -------
+    FRFResult
     """
-    frequencies_hz = np.asarray(frequencies_hz, dtype=float)
+    excitation_hz = np.asarray(excitation_hz, dtype=float)
     points = tuple(modes.point_displacements) if points is None else tuple(points)
-    Omega = 2 * np.pi * frequencies_hz[:, None]
+    Omega = 2 * np.pi * excitation_hz[:, None]
     rate = modal_damping(modes.omega, damping, damping_ratio)
     modal = participation(modes, point, vector) / (modes.omega**2 - Omega**2 + 1j * Omega * rate)
     shapes = np.stack([modes.point_displacements[p] for p in points], axis=1)
-    return FRFResult(frequencies_hz, points, np.einsum("fk,kpc->fpc", modal, shapes))
+    return FRFResult(excitation_hz, points, np.einsum("fk,kpc->fpc", modal, shapes))
 
 
 def respond(model: Model, case: LoadCase, damping_ratio=None,
@@ -525,8 +564,16 @@ def respond(model: Model, case: LoadCase, damping_ratio=None,
         mesh (its rigid-body motion is removed with the mesh's mass), so
         it would not be exact.
 
-    Raises :class:`linmstmm.model.ModelError` for a spring with a dashpot
-    (:func:`refuse_dashpots`).
+    Returns
+    -------
+    ResponseResult
+
+    Raises
+    ------
+    ModelError
+        For a spring with a dashpot (:func:`refuse_dashpots`).
+    DampingRatioError
+        For damping ratios that do not fit the modes.
     """
     from linmstmm.fe import static_displacements
 
@@ -574,7 +621,21 @@ _TIME_KEYS = {
 def load_loads(path, model: Model) -> LoadCase:
     """Read and validate the load file ``path`` (format: module docstring) for ``model``.
 
-    Raises :class:`linmstmm.model.ModelError`.
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The load file (format: ``docs/cli.md``, load files).
+    model : Model
+        The model whose points the loads name.
+
+    Returns
+    -------
+    LoadCase
+
+    Raises
+    ------
+    ModelError
+        One line naming the file, the load and the key at fault.
     """
     file = str(path)
     top = _Table(file, _read_toml(path, file))

@@ -73,7 +73,7 @@ FLOOR_MARGIN = 5.0
 #: The scan for ``count`` roots gives up above this circular frequency, rad/s.
 OMEGA_CEILING = 1e9
 #: Starting points of a half-ellipse count with the known roots divided out.
-DEFLATED_POINTS = 17
+DEFLATED_POINTS = 9
 #: Starting points of a count over a small circle (a multiplicity).
 CIRCLE_POINTS = 9
 #: Points a count over a small circle may take before it fails. One root of

@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import mpmath
 import numpy as np
@@ -15,6 +15,7 @@ from linmstmm.precision import refine_roots, separated_cluster
 from linmstmm.predicted import predict_frequencies
 from linmstmm.determinant import determinant
 from linmstmm.rigid_motion import rigid_body_mode_count
+from linmstmm.stages import report
 from linmstmm.roots import CERTIFIED_STEP, OMEGA_CEILING, RootFinder
 from linmstmm.threads import single_blas_thread
 from linmstmm.topology import build_topology
@@ -55,7 +56,15 @@ class FrequencyResult:
     evaluations: int = 0
 
     def to_dict(self) -> dict:
-        """The ``linmstmm freqs --json`` object (``docs/cli.md``)."""
+        """The ``linmstmm freqs --json`` object (``docs/cli.md``).
+
+        Returns
+        -------
+        dict
+            JSON-ready: ``model``, ``frequencies_hz``, ``rigid_body_modes``, ``ubar_order``,
+            ``seconds``, ``precision``, ``method``, ``indeterminate_released``, ``evaluations``
+            and, when set, ``note``, ``frequencies_hz_text``, ``omega_rad_s_text``.
+        """
         return {
             "model": self.model,
             "frequencies_hz": [float(f) for f in self.frequencies_hz],
@@ -98,52 +107,149 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     return deduction, finder, released
 
 
+@dataclass(frozen=True, eq=False)
+class RootSolution:
+    """The roots of det Ū_all a request asked for, and the system they belong to.
+
+    Attributes
+    ----------
+    deduction : Deduction
+        The deduced system (Ū_all and the states behind it).
+    finder : RootFinder
+        The root finder that found them (rigid-body count, evaluations, notes).
+    released : int
+        Statically indeterminate unknowns released before the search.
+    omegas : numpy.ndarray, shape (n,)
+        Elastic natural frequencies, rad/s, ascending, repeated per multiplicity.
+    precision : str
+        "float64", or "mpmath:<digits>" when roots were refined in mpmath.
+    frequencies_text, omegas_text : list of str or None
+        With mpmath: the frequencies (Hz) and circular frequencies (rad/s) as decimal strings.
+    unseparated : dict
+        Root (rad/s) -> (multiplicity, radius rad/s) of each cluster neither
+        float64 nor mpmath could separate.
+    """
+
+    deduction: Deduction
+    finder: RootFinder
+    released: int
+    omegas: np.ndarray
+    precision: str = "float64"
+    frequencies_text: list | None = None
+    omegas_text: list | None = None
+    unseparated: dict = field(default_factory=dict)
+
+
+def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None, *, digits: int | None = None,
+                root: str | None = None, guess_hz=None, engine: str = "auto") -> RootSolution:
+    """The elastic roots of det Ū_all of ``model``: the one pipeline of frequencies and modes.
+
+    Builds the deduction and its root finder (:func:`frequency_finder`), finds
+    the roots asked for and refines in mpmath what float64 cannot certify.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    count : int or None
+        The lowest ``count`` roots; None: every root up to ``fmax``.
+    fmax : float or None
+        Hz: every root up to fmax; with ``count``, whichever stops first.
+    digits : int or None
+        Significant digits wanted; above FLOAT64_DIGITS every root is refined
+        in mpmath. Without it, roots float64 cannot certify are refined at
+        ESCALATION_DIGITS, and so are clusters float64 could not tell apart
+        (:func:`~linmstmm.precision.separated_cluster`).
+    root : str or None
+        Boundary end (point name) to use as the root of the transfer tree.
+    guess_hz : array_like or None
+        Frequencies of a similar model to start from (with ``count`` only).
+    engine : str
+        How det Ū_all is evaluated: "numpy", "compiled" or "auto".
+
+    Returns
+    -------
+    RootSolution
+
+    Raises
+    ------
+    ModelError
+        For ``fmax`` alone that is not finite, or below which the beams have
+        more modes than a range is searched for (:func:`~linmstmm.mode_bound.check_range_request`).
+    """
+    if fmax is not None and count is None:
+        check_range_request(model, fmax)
+    report("deducing Ubar_all")
+    deduction, finder, released = frequency_finder(model, root, engine=engine)
+    report("finding roots")
+    omega_max = None if fmax is None else 2 * np.pi * fmax
+    if guess_hz is not None and count is not None and fmax is None:
+        omegas = np.array(finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count))
+    else:
+        omegas = np.array(finder.find(count, omega_max))
+    unseparated = finder.unseparated_among(omegas)
+    uncertain = sorted({w for w in omegas if finder.last_step.get(w, 0.0) > CERTIFIED_STEP} - set(unseparated))
+    every = bool(digits and digits > FLOAT64_DIGITS)
+    wanted = digits if every else (ESCALATION_DIGITS if uncertain or unseparated else None)
+    if not wanted:
+        return RootSolution(deduction, finder, released, omegas, unseparated=unseparated)
+    report(f"refining in mpmath to {wanted} digits")
+    omegas, precision, text, omega_text = _refined_in_mpmath(
+        deduction, model, finder, omegas, [w for w in omegas if w not in unseparated and (every or w in uncertain)],
+        unseparated, wanted, cut_by_count=count is not None)
+    return RootSolution(deduction, finder, released, omegas, precision, text, omega_text, unseparated)
+
+
 @single_blas_thread
 def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None = None,
                         digits: int | None = None, root: str | None = None,
                         guess_hz=None, engine: str = "auto") -> FrequencyResult:
     """Elastic natural frequencies of ``model`` by the transfer matrix method.
 
-    count : the lowest N; fmax : Hz, all up to fmax; both: whichever stops first.
-    digits : significant digits wanted; above FLOAT64_DIGITS every root is
-    refined in mpmath. Without it, roots float64 cannot certify are refined
-    at ESCALATION_DIGITS automatically, and so are clusters of roots float64
-    could not tell apart (:attr:`RootFinder.unseparated`, separated by
-    :func:`~linmstmm.precision.separated_cluster`); a cluster mpmath cannot
-    separate either is named in the note.
-    root : boundary end (point name) to use as the root of the transfer tree.
-    guess_hz : frequencies of a similar model (a neighbouring scene) to start
-    from; used with ``count`` only, and checked by a root count either way.
-    engine : how det Ū_all is evaluated: "numpy", "compiled" (numba), or "auto"
-    (compiled where the kernels are already loaded in this process; see
-    :mod:`linmstmm.determinant`). The roots agree to rounding either way.
-    Raises ModelError for ``fmax`` alone that is not finite, or below which the
-    beams have more modes than a range is searched for
-    (:func:`~linmstmm.mode_bound.check_range_request`).
+    Parameters
+    ----------
+    model : Model
+        The model.
+    count : int or None
+        The lowest N; None: every frequency up to ``fmax``.
+    fmax : float or None
+        Hz: all up to fmax; with ``count``, whichever stops first.
+    digits : int or None
+        Significant digits wanted; above FLOAT64_DIGITS every root is
+        refined in mpmath. Without it, roots float64 cannot certify are
+        refined at ESCALATION_DIGITS automatically, and so are clusters of
+        roots float64 could not tell apart (:attr:`RootFinder.unseparated`,
+        separated by :func:`~linmstmm.precision.separated_cluster`); a
+        cluster mpmath cannot separate either is named in the note.
+    root : str or None
+        Boundary end (point name) to use as the root of the transfer tree.
+    guess_hz : array_like or None
+        Frequencies of a similar model (a neighbouring scene) to start from;
+        used with ``count`` only, and checked by a root count either way.
+    engine : str
+        How det Ū_all is evaluated: "numpy", "compiled" (numba), or "auto"
+        (compiled where the kernels are already loaded in this process; see
+        :mod:`linmstmm.determinant`). The roots agree to rounding either way.
+
+    Returns
+    -------
+    FrequencyResult
+
+    Raises
+    ------
+    ModelError
+        For ``fmax`` alone that is not finite, or below which the beams have
+        more modes than a range is searched for
+        (:func:`~linmstmm.mode_bound.check_range_request`).
     """
     start = time.perf_counter()
-    if fmax is not None and count is None:
-        check_range_request(model, fmax)
-    deduction, finder, released = frequency_finder(model, root, engine=engine)
-    rigid = finder.rigid_body_modes()
-    omega_max = None if fmax is None else 2 * np.pi * fmax
-    if guess_hz is not None and count is not None and fmax is None:
-        omegas = np.array(finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count))
-    else:
-        omegas = np.array(finder.find(count, omega_max))
-    precision, text, omega_text = "float64", None, None
-    unseparated = finder.unseparated_among(omegas)
-    uncertain = sorted({w for w in omegas if finder.last_step.get(w, 0.0) > CERTIFIED_STEP} - set(unseparated))
-    every = bool(digits and digits > FLOAT64_DIGITS)
-    wanted = digits if every else (ESCALATION_DIGITS if uncertain or unseparated else None)
-    if wanted:
-        omegas, precision, text, omega_text = _refined_in_mpmath(
-            deduction, model, finder, omegas, [w for w in omegas if w not in unseparated and (every or w in uncertain)],
-            unseparated, wanted, cut_by_count=count is not None)
-    note = search_note(finder, omegas.size, unseparated, count, fmax)
-    return FrequencyResult(model.name, omegas / (2 * np.pi), rigid, deduction.full_order,
-                           time.perf_counter() - start, precision=precision, note=note,
-                           indeterminate_released=released, frequencies_text=text, omegas_text=omega_text,
+    solution = solve_roots(model, count, fmax, digits=digits, root=root, guess_hz=guess_hz, engine=engine)
+    finder, omegas = solution.finder, solution.omegas
+    note = search_note(finder, omegas.size, solution.unseparated, count, fmax)
+    return FrequencyResult(model.name, omegas / (2 * np.pi), finder.rigid_body_modes(),
+                           solution.deduction.full_order, time.perf_counter() - start,
+                           precision=solution.precision, note=note, indeterminate_released=solution.released,
+                           frequencies_text=solution.frequencies_text, omegas_text=solution.omegas_text,
                            evaluations=finder.determinant.evaluations)
 
 
@@ -178,7 +284,8 @@ def _refined_in_mpmath(deduction, model, finder, omegas, chosen, unseparated, di
     top = [omegas[-1]] if cut_by_count and len(chosen) and max(chosen) == omegas[-1] else []
     cut = {w: finder.multiplicity(w, sorted(set(omegas))) for w in top}
     refined = dict(zip(chosen, refine_roots(deduction, model, list(chosen), digits,
-                                            {w: m for w, m in cut.items() if m})))
+                                            {w: m for w, m in cut.items() if m},
+                                            log_det=finder.determinant.log_det)))
     values = [refined.get(w) for w in omegas]
     distinct_refined = len(set(chosen))
     for w, (m, radius) in list(unseparated.items()):

@@ -24,18 +24,17 @@ Block layout of ``U_all Z_all = 0``:
   loop cut written through the supplement equation ``Z_side1 = C Z_side0``;
   ``O`` where no path exists. Several paths sum: ``T_{a-b} + T_{c-b} C``.
 
-The command ``linmstmm check`` (:func:`add_check_command`) prints the report
-and can draw the topology figure (:mod:`linmstmm.plot_topology`).
+The command ``linmstmm check`` prints the report and can draw the topology
+figure (:mod:`linmstmm.plot_topology`).
 """
 from __future__ import annotations
 
 import dataclasses
-import json
 from dataclasses import dataclass
 
 from linmstmm.deduction import Deduction
-from linmstmm.model import COMPONENTS, ModelError, load_model
-from linmstmm.topology import Topology, build_topology
+from linmstmm.model import COMPONENTS
+from linmstmm.topology import Topology
 
 
 @dataclass(frozen=True)
@@ -367,54 +366,3 @@ def _table(rows, columns, blocks):
     widths = [max(len(line[i]) for line in cells) for i in range(len(cells[0]))]
     return ["  ".join(cell.ljust(width) for cell, width in zip(line, widths)).rstrip()
             for line in cells]
-
-
-# --- command line ------------------------------------------------------------------
-
-def add_check_command(subparsers):
-    """Register ``linmstmm check MODEL [--root POINT] [--plot FILE] [--json]``.
-
-    subparsers : the object returned by ``ArgumentParser.add_subparsers``.
-    Returns the new subparser.
-    """
-    check = subparsers.add_parser(
-        "check", help="validate a model and show its deduced transfer structure")
-    check.add_argument("model", help="model file (TOML, see model-format.md)")
-    check.add_argument("--root", default=None, help="boundary point to use as the root")
-    check.add_argument("--plot", default=None, metavar="FILE",
-                       help="write the topology figure to FILE (PNG)")
-    check.add_argument("--json", action="store_true", help="one JSON object on stdout")
-    check.set_defaults(run=run_check)
-    return check
-
-
-def run_check(args) -> int:
-    """Run ``linmstmm check``: print the structure (text or JSON), draw it with ``--plot``.
-
-    Raises ModelError for a bad model file, a bad ``--root`` or a figure
-    that cannot be written. Returns the exit status 0.
-    """
-    model = load_model(args.model)
-    topology = build_topology(model, root=args.root)
-    report = describe(topology)
-    if args.plot is not None:
-        _write_figure(topology, model, args.plot)
-    if args.json:
-        print(json.dumps({"model": model.name, "description": model.description, **report.to_dict()}))
-    else:
-        print(f"{model.name}: deduced transfer structure")
-        if model.description:
-            print(f"  {model.description}")
-        print(report.to_text())
-    return 0
-
-
-def _write_figure(topology, model, path):
-    """plot_topology to ``path``; a file that cannot be written is a ModelError on --plot."""
-    from linmstmm.plot_topology import plot_topology  # matplotlib only when asked for
-
-    try:
-        plot_topology(topology, path, title=model.name)
-    except OSError as error:
-        raise ModelError(model.source or model.name, f"cannot write the figure {str(path)!r}: "
-                         f"{error.strerror or error}", key="--plot") from error

@@ -156,7 +156,7 @@ def _choose_root(model, elements, boundaries, root_point):
                 return b
         names = ", ".join(repr(b.label) for b in boundaries) or "none"
         raise ModelError(model.source or model.name, f"'{root_point}' is not a boundary end "
-                         f"(boundary ends: {names})", key="--root")
+                         f"(boundary ends: {names})", key="root")
     if not boundaries:
         return None
     return max(range(len(boundaries)), key=lambda b: (boundaries[b].fixed.sum(), -b))

@@ -65,7 +65,7 @@ def write_uff(result: ModalResult, model: Model, path) -> dict[str, int]:
 
 def _mode_records(result: ModalResult, model: Model, k: int, labels: dict, ratio: float) -> list[str]:
     """Records 1–10 of dataset 55 for mode ``k``."""
-    frequency = result.natural_freq[k]
+    frequency = result.frequencies_hz[k]
     ids = [model.name,
            f"mode {k + 1}: {frequency:.9g} Hz, {result.normalization} normalisation",
            "linmstmm: MSTMM normal modes at the connection points, SI units (m, rad, kg)",

@@ -20,10 +20,10 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from linmstmm.mode_commands import peak_responses, print_peaks  # noqa: E402
 from linmstmm.model import load_model  # noqa: E402
 from linmstmm.plot import plot_response  # noqa: E402
 from linmstmm.response import load_loads, respond  # noqa: E402
+from linmstmm.studies import peak_responses, peaks_text  # noqa: E402
 
 
 def main(argv=None) -> None:
@@ -43,7 +43,7 @@ def main(argv=None) -> None:
     plot_response(result, args.plot, args.quantity, title=f"{model.name}: firing ({Path(args.loads).name})")
     print(f"{model.name}: {len(case.loads)} loads, {result.elastic_modes} elastic modes, "
           f"{result.times.size} time steps to {result.times[-1]:g} s, solved in {seconds:.2f} s")
-    print_peaks(result.points, *peak_responses(result, args.quantity), args.quantity)
+    print(peaks_text(result.points, *peak_responses(result, args.quantity), args.quantity))
     print(f"wrote {args.plot}")
 
 

@@ -18,8 +18,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from linmstmm.mode_commands import frf_study, print_frf  # noqa: E402
 from linmstmm.model import COMPONENTS, load_model  # noqa: E402
+from linmstmm.plot import plot_frf  # noqa: E402
+from linmstmm.studies import frf_study, frf_text  # noqa: E402
 
 
 def main(argv=None) -> None:
@@ -32,9 +33,12 @@ def main(argv=None) -> None:
     parser.add_argument("--plot", default="frf_sweep.png", help="figure to write (PNG)")
     args = parser.parse_args(argv)
 
-    result, summary = frf_study(load_model(args.model), args.point, args.direction, args.fmax,
-                                response_points=args.response_points, plot=args.plot)
-    print_frf(result, summary)
+    model = load_model(args.model)
+    result, summary = frf_study(model, args.point, args.direction, args.fmax,
+                                response_points=args.response_points)
+    plot_frf(result, args.plot, [f for f in summary["frequencies_hz"] if f <= args.fmax], summary["load_unit"],
+             title=f"{model.name}: unit load {args.direction} at {args.point}")
+    print(frf_text(result, summary))
     print(f"wrote {args.plot}")
 
 

@@ -573,7 +573,7 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
         "\"tube beams\" is the rest).")
     add("")
     for i, (k, path) in enumerate(mode_paths):
-        f = modal.natural_freq[k]
+        f = modal.frequencies_hz[k]
         written, description = MODE_DESCRIPTIONS[i]
         shares, beams_share = energy_shares(modal, model, k)
         energy = ", ".join(f"{name} {comp} {100 * s:.0f} %" for s, name, comp in shares[:4])

@@ -55,7 +55,7 @@ def test_dashpot_chain_roots_match_the_quadratic_eigenproblem(rayleigh):
     assert relative(result.roots, want) < 1e-12
     assert relative(damped_roots(model, 1)[:6], want) < 1e-12
     assert result.damping_ratio[3] > 0.15  # the dashpot works on the masses' relative motion
-    np.testing.assert_allclose(result.damped_freq_hz, want.imag / (2 * np.pi), rtol=1e-12)
+    np.testing.assert_allclose(result.damped_frequencies_hz, want.imag / (2 * np.pi), rtol=1e-12)
     np.testing.assert_allclose(result.damping_ratio, -want.real / np.abs(want), rtol=1e-10)
 
 
@@ -63,7 +63,7 @@ def test_rayleigh_damping_alone_gives_the_modal_ratios():
     model = dataclasses.replace(load_model(ROOT / "models/cantilever_tip_mass.toml"), damping=(0.8, 3e-4))
     undamped = 2 * np.pi * natural_frequencies(model, count=4).frequencies_hz
     result = damped_frequencies(model, count=4)
-    np.testing.assert_allclose(result.natural_freq_hz * 2 * np.pi, undamped, rtol=1e-11)
+    np.testing.assert_allclose(result.frequencies_hz * 2 * np.pi, undamped, rtol=1e-11)
     np.testing.assert_allclose(result.damping_ratio, 0.8 / (2 * undamped) + 3e-4 * undamped / 2, rtol=1e-9)
 
 
@@ -89,11 +89,28 @@ def test_freqs_damped_command(capsys):
     got = np.array([complex(*s) for s in data["roots"]])
     assert relative(got, want) < 1e-12 and data["method"] == "mstmm-damped"
     np.testing.assert_allclose(data["damping_ratio"], -want.real / np.abs(want), rtol=1e-10)
-    assert len(data["undamped_freq_hz"]) == 6 and data["rigid_body_modes"] == 0
+    assert len(data["undamped_frequencies_hz"]) == 6 and data["rigid_body_modes"] == 0
+    np.testing.assert_allclose(data["damped_frequencies_hz"], want.imag / (2 * np.pi), rtol=1e-12)
+    np.testing.assert_allclose(data["frequencies_hz"], np.abs(want) / (2 * np.pi), rtol=1e-12)
     status, out, _ = command(capsys, "freqs", chain, "--damped", "--count", "2")
     assert status == 0 and "damping ratio" in out and out.count("2.397144683") == 3  # the whole eigenspace
     status, out, err = command(capsys, "freqs", chain, "--damped", "--digits", "20")
     assert status == 2 and out == "" and "key '--digits'" in err
+
+
+def test_freqs_damped_csv_and_output_hold_the_json(capsys, tmp_path):
+    chain = ROOT / "models/dashpot_chain.toml"
+    status, table, err = command(capsys, "freqs", chain, "--damped", "--count", "3", "--csv", tmp_path / "d.csv",
+                                 "--output", tmp_path / "d.json")
+    assert status == 0 and "wrote" in table and "damping ratio" in table, err
+    data = json.loads((tmp_path / "d.json").read_text())
+    header, *rows = (tmp_path / "d.csv").read_text().splitlines()
+    assert header == ("mode,damped frequency [Hz],damping ratio,frequency |s|/2pi [Hz],s real [1/s],"
+                      "s imag [1/s]")
+    rows = np.array([row.split(",") for row in rows], dtype=float)
+    assert rows[:, 0].tolist() == [1, 2, 3] and rows[:, 1].tolist() == data["damped_frequencies_hz"]
+    assert rows[:, 2].tolist() == data["damping_ratio"] and rows[:, 3].tolist() == data["frequencies_hz"]
+    assert rows[:, 4:].tolist() == data["roots"]
 
 
 def test_undamped_model_has_real_roots():

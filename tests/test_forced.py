@@ -121,7 +121,7 @@ def test_random_models_with_dashpots_agree_with_fe(kind, seed):
     model = random_model(kind, seed)
     model = with_dashpots(model, {s.name: 1e-4 * np.minimum(s.k, 1e12) for s in model.springs})
     free = [p for p in model.points if p not in model.boundary]
-    first = min(mode_shapes(model, count=1, rigid_body=False).natural_freq)
+    first = min(mode_shapes(model, count=1, rigid_body=False).frequencies_hz)
     frequencies = np.array([0.37, 0.93, 1.6, 2.3]) * first
     rng = np.random.default_rng(seed)
     for point in free[::max(1, len(free) // 4)]:
@@ -184,10 +184,11 @@ def test_frf_command_takes_the_direct_route_for_dashpots(capsys):
     modal = json.loads(command(capsys, "frf", ROOT / "models/spring_mass_chain.toml", "--point", "b2",
                                "--direction", "y", "--fmax", "10", "--frequencies", "20", "--json")[1])
     assert set(data) == set(modal) and (data["route"], modal["route"]) == ("direct", "modal")
-    assert data["modes_in_sum"] == 0 and len(data["natural_freq_hz"]) == 6
+    assert data["modes_in_sum"] == 0 and data["rigid_body_modes"] == 0
+    np.testing.assert_allclose(data["frequencies_hz"], modal["frequencies_hz"], rtol=1e-12)  # the undamped chain's
     got = np.array([[np.array(data["receptance"][p]["real"]) + 1j * np.array(data["receptance"][p]["imag"])]
                     for p in ("b1", "b2")])[:, 0]  # (2, n_f, 6)
-    for f, H in zip(data["frequencies_hz"], np.moveaxis(got, 1, 0)):
+    for f, H in zip(data["excitation_hz"], np.moveaxis(got, 1, 0)):
         W = 2 * np.pi * f
         want = np.linalg.solve(K_HAND + 1j * W * C_HAND - W**2 * M_HAND, np.eye(2)[:, 1])
         assert relative(H[:, 1], want) < 1e-12 and np.abs(H[:, [0, 2, 3, 4, 5]]).max() < 1e-12 * np.abs(want).max()
@@ -196,14 +197,39 @@ def test_frf_command_takes_the_direct_route_for_dashpots(capsys):
     assert status == 0 and "direct transfer-matrix solve" in out and "no Rayleigh damping" in out
 
 
-@pytest.mark.parametrize("option", [("--zeta", "0.02"), ("--modes", "3")])
-def test_modal_options_with_dashpots_exit_2(capsys, option):
+@pytest.mark.parametrize("option, what", [(("--zeta", "0.02"), "modal damping ratios"),
+                                          (("--modes", "3"), "a number of modes in the sum")])
+def test_modal_options_with_dashpots_exit_2(capsys, option, what):
     status, out, err = command(capsys, "frf", DASHPOT_CHAIN_FILE, "--point", "b2", "--direction", "y",
                                "--fmax", "10", *option)
     assert status == 2 and out == ""
     assert err.strip() == (f"linmstmm: error: {DASHPOT_CHAIN_FILE}: key '{option[0]}': the model's spring "
-                           f"dashpots 'c' take the direct route, which sums no modes: {option[0]} belongs to "
+                           f"dashpots 'c' take the direct route, which sums no modes: {what} belong to "
                            f"the modal route; give [damping] for more damping")
+
+
+@pytest.mark.parametrize("parameter, value", [("modes", 3), ("damping_ratio", [0.02])])
+def test_frf_study_names_the_parameter_not_the_option(parameter, value):
+    """The library names its parameter; the command line turns it into the option (above)."""
+    from linmstmm.model import ModelError
+    from linmstmm.studies import frf_study
+
+    with pytest.raises(ModelError) as error:
+        frf_study(load_model(DASHPOT_CHAIN_FILE), "b2", "y", 10.0, frequencies=4, **{parameter: value})
+    assert error.value.key == parameter
+
+
+def test_frf_study_takes_the_direct_route_for_dashpots():
+    """frf_study's summary on the direct route: the undamped frequencies up to fmax, no modes."""
+    from linmstmm.studies import frf_study, frf_text
+
+    model = load_model(DASHPOT_CHAIN_FILE)
+    result, summary = frf_study(model, "b2", "x", 4.0, frequencies=8, response_points=["b1", "b2"])
+    assert summary["route"] == "direct" and summary["modes_in_sum"] == 0
+    assert summary["frequencies_hz"] == pytest.approx([2.391077861106958] * 3, rel=1e-12)
+    want = direct_frf(model, "b2", np.eye(6)[0], result.excitation_hz, ["b1", "b2"]).receptance
+    assert np.array_equal(result.receptance, want)
+    assert "natural frequencies (undamped) [Hz]: 2.39108, 2.39108, 2.39108" in frf_text(result, summary)
 
 
 def test_cantilever_tip_receptance_matches_closed_form_far_above_the_first_modes():

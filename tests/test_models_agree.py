@@ -3,8 +3,7 @@
 Every ``*.toml`` under models/ that loads as a model is a case; other TOML
 files there (the MLRS tube bundle, load files) are data, not models, and are
 left out. The first ten frequencies (all, if there are fewer) must agree to 1e-7 relative and the
-rigid-body mode counts must be equal. Until ``fe`` is wired into the command
-line the FE half is skipped (the ``freqs`` half still runs).
+rigid-body mode counts must be equal.
 
 The second launcher (models/launcher2/launcher2.toml, two closed loops) is also
 checked deeper: its deduced structure is the one its comments describe, and its
@@ -57,10 +56,6 @@ def solve(command: str, path: Path, *options) -> dict:
 
 
 @lru_cache(maxsize=None)
-def fe_is_wired() -> bool:
-    return run("fe", "--help").returncode == 0
-
-
 def test_models_directory_has_models():
     assert len(MODELS) >= 3
 
@@ -69,9 +64,6 @@ def test_models_directory_has_models():
 def test_freqs_and_fe_agree(path):
     freqs = solve("freqs", path)
     assert freqs["frequencies_hz"], "no frequencies"
-    if not fe_is_wired():
-        pytest.skip("`linmstmm fe` is not on the command line yet: linmstmm/cli.py must call "
-                    "linmstmm.fe_command.add_fe_command(sub) in build_parser")
     fe = solve("fe", path)
     assert fe["method"] == "fe" and fe["model"] == freqs["model"]
     assert fe["rigid_body_modes"] == freqs["rigid_body_modes"]
@@ -109,8 +101,6 @@ def test_launcher2_has_two_loops_with_beams_and_a_launcher_size_ubar():
 def test_launcher2_twenty_frequencies_within_fe_estimate():
     """``freqs --count 20`` against ``fe --count 20``: each relative difference within
     the FE route's own error estimate for that frequency, plus float64 rounding."""
-    if not fe_is_wired():
-        pytest.skip("`linmstmm fe` is not on the command line yet")
     freqs = solve("freqs", LAUNCHER2, "--count", "20")
     fe = solve("fe", LAUNCHER2, "--count", "20")
     assert freqs["ubar_order"] == 72

@@ -207,7 +207,7 @@ def test_mac_matrix():
 def test_result_serialises_to_json():
     modes = mode_shapes(cantilever_tip_body(), count=3, stations=5)
     data = json.loads(json.dumps(modes.to_dict()))
-    assert len(data["natural_freq_hz"]) == 3
+    assert len(data["frequencies_hz"]) == 3
     assert np.array(data["beam_fields"]["arm"]["displacements"]).shape == (3, 5, 6)
     assert set(data["point_displacements"]) == {"root", "tip"}
     assert np.array(data["com_displacements"]["payload"]).shape == (3, 6)

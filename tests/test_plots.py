@@ -2,13 +2,10 @@
 
 Every figure command must write its files: PNGs and GIFs are checked by
 their signatures (and the GIF's frame count). The commands run through
-``cli.main`` on a parser with :func:`add_mode_commands` registered, whether
-or not cli.py wires them in yet; one subprocess test runs the real command
-line once it does.
+``cli.main``; one subprocess test runs the real command line.
 """
 from __future__ import annotations
 
-import argparse
 import json
 import subprocess
 import sys
@@ -20,11 +17,20 @@ from builders import fixed, single_beam_model
 from PIL import Image
 
 from linmstmm import cli
-from linmstmm.mode_commands import add_mode_commands, align_eigenspaces
+from linmstmm.compare import align_eigenspaces
 from linmstmm.model import load_model
 from linmstmm.modes import mac_matrix, mode_shapes
-from linmstmm.plot import (AMPLITUDE, _scene, animate_mode, plot_frf, plot_mac, plot_mode,
-                           plot_response, plot_scan, significant_components)
+from linmstmm.plot import (
+    AMPLITUDE,
+    _scene,
+    animate_mode,
+    plot_frf,
+    plot_mac,
+    plot_mode,
+    plot_response,
+    plot_scan,
+    significant_components,
+)
 from linmstmm.response import PointLoad, frf, modal_response, step
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -123,7 +129,7 @@ def test_frf_figure_and_its_significant_components(cantilever, tmp_path):
     model, modes = cantilever
     result = frf(modes, "tip", np.r_[0.0, 0.0, 1.0, 0.0, 0.0, 0.0], np.linspace(1.0, 100.0, 300), ["tip"])
     assert significant_components(result.receptance) == [(0, 2), (0, 4)]  # tip z and its slope ry
-    plot_frf(result, tmp_path / "frf.png", modes.natural_freq)
+    plot_frf(result, tmp_path / "frf.png", modes.frequencies_hz)
     assert is_png(tmp_path / "frf.png")
 
 
@@ -144,25 +150,9 @@ def test_aligned_eigenspace_recovers_the_reference_modes():
 
 # --- the commands ---------------------------------------------------------------------
 
-def _subcommands(parser):
-    return next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
-
-
-_BUILD = cli.build_parser  # before any monkeypatching
-
-
-def _parser_with_mode_commands():
-    """cli's parser with the mode commands registered (whether or not cli.py wires them yet)."""
-    parser = _BUILD()
-    if "modes" not in _subcommands(parser).choices:
-        add_mode_commands(_subcommands(parser))
-    return parser
-
-
 @pytest.fixture
-def run(monkeypatch, capsys):
-    """cli.main on the parser with the mode commands: (status, stdout, stderr)."""
-    monkeypatch.setattr(cli, "build_parser", _parser_with_mode_commands)
+def run(capsys):
+    """cli.main: (status, stdout, stderr)."""
 
     def invoke(*argv):
         status = cli.main([str(a) for a in argv])
@@ -176,11 +166,11 @@ def test_modes_json_plots_animations_uff_and_mac(run, tmp_path):
                          "--animate", "--uff", tmp_path / "modes.uff", "--mac-fe")
     assert status == 0
     data = json.loads(out)
-    for key in ("model", "natural_freq_hz", "rigid_body_modes", "modal_mass", "modal_stiffness",
+    for key in ("model", "frequencies_hz", "rigid_body_modes", "modal_mass", "modal_stiffness",
                 "mass_orthogonality_error", "stiffness_orthogonality_error", "point_displacements",
                 "points", "mac_fe", "files"):
         assert key in data
-    assert len(data["natural_freq_hz"]) == 2 and data["mass_orthogonality_error"] < 1e-9
+    assert len(data["frequencies_hz"]) == 2 and data["mass_orthogonality_error"] < 1e-9
     assert len(data["point_displacements"]["tip"]) == 2 and len(data["point_displacements"]["tip"][0]) == 6
     assert min(np.diag(data["mac_fe"]["matrix"])) > 0.9999
     pngs, gifs = sorted((tmp_path / "figs").glob("*.png")), sorted((tmp_path / "figs").glob("*.gif"))
@@ -228,9 +218,9 @@ def test_frf_json_and_figure(run, tmp_path):
                          "--plot", tmp_path / "frf.png")
     assert status == 0
     data = json.loads(out)
-    for key in ("load", "natural_freq_hz", "modes_in_sum", "frequencies_hz", "points", "receptance"):
+    for key in ("load", "frequencies_hz", "modes_in_sum", "excitation_hz", "points", "receptance"):
         assert key in data
-    assert data["points"] == ["tip", "root"] and len(data["frequencies_hz"]) == 200
+    assert data["points"] == ["tip", "root"] and len(data["excitation_hz"]) == 200
     static = 2.0**3 / (3 * 2.1e11 * 2e-7)  # tip flexibility, m/N; the sum has only two z modes
     assert data["receptance"]["tip"]["real"][0][2] == pytest.approx(static, rel=3e-3)
     assert is_png(tmp_path / "frf.png")
@@ -265,14 +255,12 @@ def test_bad_input_exits_2_with_one_line(run, tmp_path, argv, key):
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err and key in err
 
 
-@pytest.mark.skipif("modes" not in _subcommands(_BUILD()).choices,
-                    reason="the mode commands are not wired into cli.py yet")
 def test_modes_subcommand_end_to_end(tmp_path):
     result = subprocess.run([sys.executable, "-m", "linmstmm", "modes", CANTILEVER, "--count", "1",
                              "--json", "--plot", str(tmp_path)], cwd=ROOT, capture_output=True,
                             text=True, timeout=120)
     assert result.returncode == 0, result.stderr
-    assert json.loads(result.stdout)["natural_freq_hz"][0] == pytest.approx(6.7535653, rel=1e-7)
+    assert json.loads(result.stdout)["frequencies_hz"][0] == pytest.approx(6.7535653, rel=1e-7)
     assert is_png(tmp_path / "mode_1.png")
 
 

@@ -303,7 +303,8 @@ def test_load_file_round_trip(tmp_path):
     result = respond(model, case)
     assert result.displacement.shape == (501, 2, 6)
     assert set(result.to_dict()) == {"times", "points", "displacement", "velocity", "acceleration",
-                                     "units", "elastic_modes", "static_correction"}
+                                     "units", "elastic_modes", "rigid_body_modes", "frequencies_hz",
+                                     "static_correction"}
 
 
 @pytest.mark.parametrize("edit, key, words", [

@@ -19,7 +19,7 @@ from linmstmm import cli
 from linmstmm.deduction import Deduction
 from linmstmm.model import Model
 from linmstmm.plot_topology import plot_topology
-from linmstmm.structure import add_check_command, describe
+from linmstmm.structure import describe
 from linmstmm.topology import build_topology
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -214,25 +214,9 @@ def test_figure_is_a_png(tmp_path, make):
     assert path.read_bytes()[:8] == PNG_SIGNATURE and path.stat().st_size > 5000
 
 
-def _subcommands(parser):
-    """The subparsers action of ``parser``."""
-    return next(action for action in parser._actions if action.dest == "command")
-
-
-_CLI_PARSER = cli.build_parser
-
-
-def _parser_with_check():
-    """cli's parser with ``check`` registered (whether or not cli.py wires it yet)."""
-    parser = _CLI_PARSER()
-    if "check" not in _subcommands(parser).choices:
-        add_check_command(_subcommands(parser))
-    return parser
-
-
 def test_check_command_prints_json_and_writes_the_figure(tmp_path, capsys):
     figure = tmp_path / "fig.png"
-    args = _parser_with_check().parse_args(
+    args = cli.build_parser().parse_args(
         ["check", CHAIN, "--json", "--plot", str(figure)])
     assert args.run(args) == 0
     data = json.loads(capsys.readouterr().out)
@@ -243,15 +227,12 @@ def test_check_command_prints_json_and_writes_the_figure(tmp_path, capsys):
 
 @pytest.mark.parametrize("options", [("--root", "nowhere"), ("--plot", "missing/fig.png")])
 def test_check_command_errors_are_one_line_exit_2(monkeypatch, capsys, tmp_path, options):
-    monkeypatch.setattr(cli, "build_parser", _parser_with_check)
     monkeypatch.chdir(tmp_path)
     assert cli.main(["check", CHAIN, *options]) == 2
     error = capsys.readouterr().err
     assert len(error.strip().splitlines()) == 1 and options[0] in error
 
 
-@pytest.mark.skipif("check" not in _subcommands(cli.build_parser()).choices,
-                    reason="the check subcommand is not wired into cli.py yet")
 def test_check_subcommand_end_to_end(tmp_path):
     result = subprocess.run([sys.executable, "-m", "linmstmm", "check",
                              "models/cantilever_tip_mass.toml", "--plot", str(tmp_path / "f.png")],

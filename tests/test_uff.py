@@ -105,7 +105,7 @@ def test_modes_round_trip(written):
         assert mode["definition"] == [1, 2, 3, 8, 2, 6]  # structural, normal mode, 6 DOF, displacement, real
         assert mode["integers"] == [2, 4, 1, k + 1]
         frequency, modal_mass, viscous, hysteretic = mode["reals"]
-        assert frequency == pytest.approx(modes.natural_freq[k], rel=RTOL)
+        assert frequency == pytest.approx(modes.frequencies_hz[k], rel=RTOL)
         assert modal_mass == pytest.approx(modes.modal_mass[k], rel=RTOL)
         assert viscous == 0 and hysteretic == 0  # the model has no [damping]
         assert sorted(mode["values"]) == sorted(labels.values())
@@ -150,7 +150,7 @@ def test_pyuff_reads_it(written, tmp_path):
     np.testing.assert_allclose(sets[0]["x"], [xyz[0] for xyz in model.points.values()], rtol=RTOL, atol=1e-12)
     for k, mode in enumerate(sets[1:]):
         assert mode["mode_n"] == k + 1 and mode["n_data_per_node"] == 6
-        assert mode["freq"] == pytest.approx(modes.natural_freq[k], rel=RTOL)
+        assert mode["freq"] == pytest.approx(modes.frequencies_hz[k], rel=RTOL)
         got = np.column_stack([mode[f"r{i}"] for i in range(1, 7)])
         np.testing.assert_allclose(got, modes.shape_matrix(labels).reshape(modes.omega.size, -1, 6)[k],
                                    rtol=RTOL, atol=1e-99)

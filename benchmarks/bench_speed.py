@@ -39,6 +39,7 @@ import scipy.sparse.linalg as sla
 
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
+sys.path.insert(0, str(REPO / "benchmarks"))
 
 from linmstmm.deduction import Deduction  # noqa: E402
 from linmstmm.determinant import CompiledDeterminant, NumpyDeterminant, load_kernels  # noqa: E402
@@ -48,6 +49,7 @@ from linmstmm.nullspace import release_indeterminate  # noqa: E402
 from linmstmm.solve import natural_frequencies  # noqa: E402
 from linmstmm.threads import one_blas_thread  # noqa: E402
 from linmstmm.topology import build_topology  # noqa: E402
+from time_budget import time_budget  # noqa: E402
 
 #: Degrees of freedom above which the dense eigensolver is not timed (sparse eigsh wins there).
 DENSE_LIMIT = 2000
@@ -116,6 +118,24 @@ def fe_eigensolves(model, count: int, target: np.ndarray, tolerance: float, roun
     return {"per_beam": per_beam, "dof": K.shape[0], "error": error, "eigh": eigh_time, "eigsh": eigsh_time}
 
 
+def budget_table(model, counts) -> list[str]:
+    """Markdown lines: where one warm solve of each count spends its time and evaluations."""
+    budgets = {count: time_budget(lambda: natural_frequencies(model, count, engine="compiled"))[1]
+               for count in counts}
+    stages = [name for name in budgets[counts[0]] if any(b[name][0] > 1e-4 or b[name][1] for b in budgets.values())]
+    lines = ["Where one warm solve spends its time (`benchmarks/time_budget.py`: stages timed exclusively, "
+             "each evaluation of det Ū_all charged to the stage that asked for it):", "",
+             "| stage | " + " | ".join(f"first {count}: ms (evaluations)" for count in counts) + " |",
+             "|---|" + "---:|" * len(counts)]
+    for name in stages:
+        lines.append(f"| {name} | " + " | ".join(
+            f"{budgets[c][name][0] * 1e3:.1f} ({budgets[c][name][1]})" for c in counts) + " |")
+    lines.append("| **total** | " + " | ".join(
+        f"**{sum(v[0] for v in budgets[c].values()) * 1e3:.1f}** ({sum(v[1] for v in budgets[c].values())})"
+        for c in counts) + " |")
+    return lines
+
+
 def startup(command: list[str], rounds: int) -> float:
     """Median wall time of a new process running ``command`` (s)."""
     times = []
@@ -175,7 +195,7 @@ def main() -> None:
                     f"{fe_time * 1e3:.0f} ms | **{fastest / mstmm_time:.2f}** | {fe_time / mstmm_time:.1f} |")
                 curves.setdefault(label, []).append((count, mstmm_time, solves.get("eigh", np.nan),
                                                      solves.get("eigsh", np.nan), fe_time))
-            lines.append("")
+            lines += ["", *budget_table(model, counts), ""]
     lines += ["**Reading the FE columns.** The FE mesh is the coarsest of 1, 2, 4, … 128 elements per "
               "beam whose first N frequencies by eigsh are within 1e-9 of the transfer-matrix ones (1e-6 "
               "from N = 60), or, where none is, the mesh that came closest (column *its diff. from "

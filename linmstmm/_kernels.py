@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numba import njit
 
-from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, ORTHO, STATE_BLOCK, TIP
+from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, STATE_BLOCK, TIP
 
 #: See linmstmm.deduction: beam pieces, growth between orthonormalisations, far scale.
 BEAM_PIECE_BETA_L = 4.0
@@ -134,6 +134,18 @@ def _multiply_add(matrix, source, target, place, rows):
             if a != 0.0:
                 for c in range(source.shape[1]):
                     target[i, place[c]] += a * source[j, c]
+
+
+@njit(cache=True)
+def _multiply_rows(matrix, source, target):
+    """target = matrix[:rows] @ source, target (rows, k), matrix (12, 12) float, source (12, k)."""
+    target[:, :] = 0.0
+    for i in range(target.shape[0]):
+        for j in range(12):
+            a = matrix[i, j]
+            if a != 0.0:
+                for c in range(source.shape[1]):
+                    target[i, c] += a * source[j, c]
 
 
 @njit(cache=True)
@@ -261,8 +273,9 @@ def _orthonormalise(program, index, work, reference, log_scale, group):
                 for i in range(rows):
                     for c in range(source.shape[1]):
                         stacked[m, row + i, place[c]] = source[i, c]
+            forces = blocks[b, 5]  # a joint's row: force rows, then moment rows
             for i in range(rows):
-                kinds[row + i] = i // 3
+                kinds[row + i] = i // 3 if forces < 0 else (3 if i < forces else 2)
             row += rows
     factors = np.zeros((group, total, width), dtype=work.dtype)
     diagonals = np.zeros((group, width))
@@ -337,6 +350,9 @@ def _run(program, omegas, work, reference, log_scale):
                                 for k in range(source.shape[1]):
                                     target[i, k] += w2 * coefficient * source[j, k]
                 reference[m, a] = reference[m, b]
+            elif code == JOINT:
+                target = _view(work[m], slot_offset[a], slot_rows[a], slot_width[a])
+                _multiply_rows(matrices[c], _view(work[m], slot_offset[b], 12, slot_width[b]), target)
             elif code == GEOMETRIC:
                 target = _view(work[m], slot_offset[a], 6, slot_width[a])
                 first = _view(work[m], slot_offset[b], 12, slot_width[b])
@@ -380,7 +396,7 @@ def _run(program, omegas, work, reference, log_scale):
 
 @njit(cache=True)
 def _assembled(root, root_row, rows, order, kept_rows, kept_columns, work_m, slot_offset, slot_width,
-               slot_columns, slot_columns_start):
+               slot_columns, slot_columns_start, slot_rows):
     """Ū_all (N, N) of one frequency from its workspace."""
     full = np.zeros((order, order), dtype=work_m.dtype)
     for slot in (root, root_row):
@@ -392,12 +408,12 @@ def _assembled(root, root_row, rows, order, kept_rows, kept_columns, work_m, slo
     start = 12
     for g in range(rows.size):
         slot = rows[g]
-        block = _view(work_m, slot_offset[slot], 6, slot_width[slot])
+        block = _view(work_m, slot_offset[slot], slot_rows[slot], slot_width[slot])
         columns = slot_columns[slot_columns_start[slot]:slot_columns_start[slot + 1]]
-        for i in range(6):
+        for i in range(slot_rows[slot]):
             for c in range(columns.size):
                 full[start + i, columns[c]] = block[i, c]
-        start += 6
+        start += slot_rows[slot]
     out = np.empty((kept_rows.size, kept_columns.size), dtype=work_m.dtype)
     for i in range(kept_rows.size):
         for j in range(kept_columns.size):
@@ -414,7 +430,7 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
     log_scale_out : (n,) the log-scale alone (det Ū_all = det(matrix) e^log_scale).
     """
     (slot_offset, slot_width, slot_columns, slot_columns_start, workspace, n_slots, root, root_row,
-     rows, order, kept_rows, kept_columns) = layout
+     rows, order, kept_rows, kept_columns, slot_rows) = layout
     n = omegas.size
     # every operation writes the whole of its target: the workspace needs no clearing
     whole = np.empty((min(group, n), workspace), dtype=omegas.dtype)
@@ -427,7 +443,7 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
         _run(program, omegas[start:stop], work, reference, log_scale)
         for m in range(size):
             ubar = _assembled(root, root_row, rows, order, kept_rows, kept_columns, work[m], slot_offset,
-                              slot_width, slot_columns, slot_columns_start)
+                              slot_width, slot_columns, slot_columns_start, slot_rows)
             if matrices_out.shape[0]:
                 matrices_out[start + m] = ubar
             sign, log_abs = np.linalg.slogdet(ubar)

@@ -119,7 +119,7 @@ def make_rigid(name, ports, mass, com, inertia=(0.0, 0.0, 0.0)) -> Rigid:
                  np.diag(inertia) if inertia.ndim == 1 else inertia)
 
 
-def make_spring(name, a, b, k, axes=None) -> Spring:
+def make_spring(name, a, b, k, axes=None, release=()) -> Spring:
     """An elastic hinge (massless, zero length) between two coinciding points.
 
     Parameters
@@ -130,15 +130,20 @@ def make_spring(name, a, b, k, axes=None) -> Spring:
         End point names (the points must coincide).
     k : array_like, shape (6,)
         [kx, ky, kz, krx, kry, krz] in the spring's axes: N/m and N m/rad,
-        each > 0; ``numpy.inf`` = rigid in that direction.
+        each > 0 (exactly 0 where released); ``numpy.inf`` = rigid in that direction.
     axes : array_like, shape (3, 3), optional
         Rows: the spring's local x, y, z unit vectors; default the inertial axes.
+    release : sequence of str, optional
+        Released directions drawn from "x", "y", "z", "rx", "ry", "rz" (in the
+        spring's axes): a joint, no force or moment there.
 
     Returns
     -------
     linmstmm.model.Spring
     """
-    return Spring(name, (a, b), np.asarray(k, float), np.eye(3) if axes is None else np.asarray(axes))
+    mask = np.array([c in release for c in COMPONENTS])
+    return Spring(name, (a, b), np.asarray(k, float), np.eye(3) if axes is None else np.asarray(axes),
+                  release=mask if mask.any() else None)
 
 
 def fixed(*components) -> np.ndarray:

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from linmstmm.counting import count_inside
-from linmstmm.forced import rayleigh_equivalent, released_deduction
+from linmstmm.forced import rayleigh_equivalent, refuse_released_dashpots, released_deduction
 from linmstmm.model import Model
 from linmstmm.modes import SAME_FREQUENCY, _group
 from linmstmm.solve import natural_frequencies
@@ -152,6 +152,7 @@ def damped_frequencies(model: Model, count: int | None = 10, fmax: float | None 
         When a root cannot be found or the certifying count finds roots the
         search did not.
     """
+    refuse_released_dashpots(model)
     started = time.perf_counter()
     asked = natural_frequencies(model, count=count, fmax=fmax, root=root)
     if not asked.frequencies_hz.size:

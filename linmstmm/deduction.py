@@ -4,7 +4,8 @@ The unknowns ``z̄`` are the non-zero entries of the boundary state vectors:
 six per boundary end (the free displacements and the forces of the fixed
 components), twelve per loop cut (the state on side 0; side 1 is
 ``C Z_0`` with ``C = diag(I, −I)``, or ``C = I`` for the closing cut of a
-boundary-less model, whose side 0 is the root).
+boundary-less model, whose side 0 is the root), and one per released
+direction of a joint (the jump Δ across it, m or rad).
 
 The state at every port is carried as a matrix ``Z_port = S_port z̄``, built
 from the tips towards the root: an element with inputs I_1..I_L and output O
@@ -15,7 +16,10 @@ boundary conditions already applied:
 
 * main transfer equation (12 rows): ``S_root − Z_root = 0``;
 * geometric equation of input k ≥ 2 of a body (6 rows each):
-  ``−H_j S_I1 + H_{j,Ik} S_Ik = 0``.
+  ``−H_j S_I1 + H_{j,Ik} S_Ik = 0``;
+* released direction of a joint (1 row each): no force along it,
+  ``F S_I = 0``, while its output state gains the jump: ``S_O = U S_I + E Δ``
+  (:func:`~linmstmm.elements.spring.joint_jump`).
 
 Only the columns of the tips upstream of a port are stored with it, so the
 cost of one evaluation is linear in the number of elements (a run of
@@ -31,9 +35,17 @@ import numpy as np
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.elements.frames import FORCE_INDEX
 from linmstmm.elements.rigid import force_extraction, position_incidence, rigid_transfer_parts
-from linmstmm.elements.spring import spring_transfer
-from linmstmm.numeric import (constant_times, frequencies, is_mp, numbers, power_of_two_scale, size_estimate,
-                              zeros_like_stack)
+from linmstmm.elements.spring import joint_force, joint_jump, spring_transfer
+from linmstmm.model import COMPONENTS
+from linmstmm.numeric import (
+    constant_times,
+    frequencies,
+    is_mp,
+    numbers,
+    power_of_two_scale,
+    size_estimate,
+    zeros_like_stack,
+)
 from linmstmm.periodic import carry_run, find_runs
 from linmstmm.topology import Topology
 
@@ -42,6 +54,9 @@ from linmstmm.topology import Topology
 #: orthonormalisations costs under two digits of the decaying solutions.
 _BEAM_PIECE_BETA_L = 4.0
 _CUT_SIGN = np.diag(np.r_[np.ones(6), -np.ones(6)])
+#: Kind of the row a released direction adds, for the orthonormaliser's row
+#: scales (:meth:`_Orthonormaliser._unit_scale`): a force (3) or a moment (2).
+_RELEASE_ROW_KIND = np.array([3, 3, 3, 2, 2, 2])
 
 
 @dataclass
@@ -97,12 +112,20 @@ class Deduction:
         for c, cut in enumerate(topology.cuts):
             self._cut_columns[c] = np.arange(len(labels), len(labels) + 12)
             labels += [f"cut {cut.point}.{name}" for name in names]
+        #: element -> columns of the jumps across its released directions
+        self.jump_columns: dict[int, np.ndarray] = {}
+        for e, element in enumerate(topology.elements):
+            if element.kind == "spring" and element.record.released.size:
+                released = element.record.released
+                self.jump_columns[e] = np.arange(len(labels), len(labels) + released.size)
+                labels += [f"{element.name}.Δ{COMPONENTS[d]}" for d in released]
         self.columns = labels
         self.full_order = self.order = len(labels)
         self.released_columns = self.released_rows = np.zeros(0, dtype=int)
         n_geometric = sum(max(len(el.inputs) - 1, 0) for el in topology.elements)
-        if 12 + 6 * n_geometric != self.full_order:
-            raise AssertionError(f"U_all is not square: {12 + 6 * n_geometric} rows, "
+        n_jumps = sum(columns.size for columns in self.jump_columns.values())
+        if 12 + 6 * n_geometric + n_jumps != self.full_order:
+            raise AssertionError(f"U_all is not square: {12 + 6 * n_geometric + n_jumps} rows, "
                                  f"{self.order} unknowns")
 
     # -- element transfer matrices ------------------------------------------------
@@ -134,7 +157,8 @@ class Deduction:
                     record.mass, record.com, record.inertia,
                     element.ports[element.inputs[0]].position, element.ports[element.output].position)))
             elif element.kind == "spring":
-                parts = (spring_transfer(numbers(record.k, exact), record.axes, np.zeros(1))[0], None)
+                parts = (spring_transfer(numbers(record.k, exact), record.axes, np.zeros(1), record.release)[0],
+                         None)
             else:  # junction: a massless rigid body whose ports coincide
                 parts = (np.eye(12), None)
             self._parts[e, exact] = parts
@@ -189,6 +213,25 @@ class Deduction:
             self._tips[link] = (columns[kept], selection[:, kept])
         columns, selection = self._tips[link]
         return PortState(columns, np.broadcast_to(selection, (n,) + selection.shape), np.ones(n))
+
+    def jump_state(self, e, n) -> PortState:
+        """The jumps across the released directions of joint ``e`` as a state:
+        ``E Δ`` on their columns (less released ones)."""
+        if ("jump", e) not in self._tips:
+            columns, record = self.jump_columns[e], self.topology.elements[e].record
+            kept = ~np.isin(columns, self.released_columns)
+            jump = joint_jump(record.axes, record.released)
+            self._tips["jump", e] = (columns[kept], jump[:, kept])
+        columns, jump = self._tips["jump", e]
+        return PortState(columns, np.broadcast_to(jump, (n,) + jump.shape), np.ones(n))
+
+    def _joint_row(self, e, state: PortState) -> list:
+        """[label, columns, (n, r, k) F S_I, kinds]: no force along the released
+        directions of joint ``e`` whose input state is ``state``."""
+        record = self.topology.elements[e].record
+        force = joint_force(record.axes, record.released)
+        return [f"{record.name} released", state.columns, constant_times(force, state.matrix),
+                _RELEASE_ROW_KIND[record.released]]
 
     def release(self, columns, rows) -> None:
         """Drop statically indeterminate unknowns and the as many dependent rows.
@@ -304,6 +347,10 @@ class Deduction:
                 terms = [(inputs[0].columns, inputs[0].matrix)]
             else:
                 terms = [(inputs[0].columns, self.carried(e, omega, inputs[0].matrix))]
+            if e in self.jump_columns:
+                rows.append(self._joint_row(e, inputs[0]))
+                jump = self.jump_state(e, n)
+                terms.append((jump.columns, jump.matrix))
             for k, ((label, forces, incidence), state) in enumerate(zip(self._other_inputs(e, is_mp(omega)),
                                                                        inputs[1:])):
                 terms.append((state.columns, constant_times(forces, state.matrix)))
@@ -383,7 +430,8 @@ class Deduction:
         ubar[:, :12, _index(root.columns)] = root.matrix
         ubar[:, :12, _index(rows[0][1])] += rows[0][2]  # −Z_root: a ring's shares the root state's columns
         start = 12
-        for _, columns, block in rows[1:]:  # each geometric row alone in its rows: assigned, not added
+        for row in rows[1:]:  # each geometric or joint row alone in its rows: assigned, not added
+            columns, block = row[1], row[2]
             ubar[:, start:start + block.shape[1], _index(columns)] = block
             start += block.shape[1]
         if self.released_columns.size:
@@ -578,8 +626,8 @@ class _Orthonormaliser:
         stacked = np.concatenate(parts, axis=1)
         if stacked.shape[1] < stacked.shape[2]:
             return state
-        row_scale = self._unit_scale(stacked, np.concatenate([_row_kinds(block) for block in blocks]
-                                                             + [np.arange(state.matrix.shape[1]) // 3]))
+        kinds = [_row_kinds(block) for block in blocks] + [np.arange(state.matrix.shape[1]) // 3]
+        row_scale = self._unit_scale(stacked, np.concatenate(kinds))
         q, r = np.linalg.qr(stacked * row_scale[:, :, None])
         diagonal = np.diagonal(r, axis1=1, axis2=2)
         if not np.all(np.abs(diagonal) > 0):  # dependent columns (exactly at a root): keep as is
@@ -609,12 +657,16 @@ class _Orthonormaliser:
 
 
 def _row_kinds(block) -> np.ndarray:
-    """The kind of each row of a block of :meth:`_Orthonormaliser.apply` (0 displacement,
-    1 rotation, 2 moment, 3 force, by threes). A point load's row (it pins the
-    load's unknown to 1, :class:`_Loads`) is weighed with the forces its unknown
-    brings in: weighed as a displacement, the QR lost up to 5 digits of a
-    cantilever's receptance (closed form, βL from 1 to 50)."""
+    """Kind of each row of an orthonormaliser block (:meth:`_Orthonormaliser._unit_scale`):
+    0 displacement, 1 rotation, 2 moment, 3 force. A joint row says its own; a
+    point load's row (it pins the load's unknown to 1, :class:`_Loads`) is weighed
+    with the forces its unknown brings in: weighed as a displacement, the QR lost
+    up to 5 digits of a cantilever's receptance (closed form, βL from 1 to 50). A
+    state, a cut side and the other rows are displacement, rotation, moment,
+    force, three rows each, as far as they go."""
     kind, key, _, matrix = block
+    if kind == "row" and len(key) > 3:
+        return key[3]
     if kind == "row" and isinstance(key[0], tuple):
         return np.full(matrix.shape[1], 3)
     return np.arange(matrix.shape[1]) // 3

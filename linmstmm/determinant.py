@@ -89,7 +89,7 @@ class CompiledDeterminant:
                             p.places_start, p.matrices, p.orthos, p.ortho_blocks, p.beams, p.beam_rotation)
         self._layout = (p.slot_offset, p.slot_width, p.slot_columns, p.slot_columns_start, p.workspace,
                         p.slot_rows.size, p.root, p.root_row, p.geometric_rows, p.order, p.kept_rows,
-                        p.kept_columns)
+                        p.kept_columns, p.slot_rows)
         #: evaluations of det Ū_all so far (one per frequency)
         self.evaluations = 0
 

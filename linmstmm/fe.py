@@ -11,6 +11,8 @@ beam, which is cut into ``n`` equal 3-D frame elements: cubic Hermite bending
 in both principal planes with consistent mass ρA (no rotary inertia), linear
 axial (EA, ρA) and torsion (GJ, ρ·Ip) with consistent mass. Springs are
 massless and of zero length; rigid bodies carry m and J_c at their mass centre.
+A spring's released directions (a joint) have no stiffness at all: neither
+a strain nor a constraint joins its two end nodes there.
 
 Constraints are exact, never penalties: ports of rigid bodies, ``inf`` spring
 directions, ``axial=False`` / ``torsion=False`` and boundary conditions are
@@ -44,10 +46,11 @@ even at thousands of elements per beam.
 Rigid-body modes and massless DOFs
 ----------------------------------
 Zero-frequency modes are counted structurally, not by a threshold on computed
-eigenvalues: every connected part of the model has the six rigid motions, of
-which those compatible with its boundary conditions and carrying mass (a
-positive kinetic energy, 1e-13 relative to the largest) are the rigid-body
-modes. They are deflated exactly: K is made invertible by temporary
+eigenvalues: every segment of the model (nodes joined by elements other than
+joints) has the six rigid motions, of which those compatible with the
+boundary conditions and with the directions each joint keeps, and carrying
+mass (a positive kinetic energy, 1e-13 relative to the largest), are the
+rigid-body and mechanism modes. They are deflated exactly: K is made invertible by temporary
 statically determinate supports on as many DOFs as there are rigid motions,
 and the solve is projected M-orthogonally off the rigid-body modes.
 
@@ -371,21 +374,10 @@ def _add_beams(model, layout, n, strains, stiffness, mass, constraints):
             constraints.add(rows[:, :, None], dofs[:, None, :], c @ to_local)
 
 
-def _spring_directions(spring, index: DofIndex):
-    """Per component of ``spring`` (its six local directions): (component,
-    full-vector columns (6,), values (6,)) of the elongation b − a along it."""
-    a, b = (index.point(end) for end in spring.ends)
-    axes = np.asarray(spring.axes, float)
-    for component in range(6):
-        block = slice(0, 3) if component < 3 else slice(3, 6)
-        direction = axes[component % 3]
-        yield component, np.concatenate([a[block], b[block]]), np.concatenate([-direction, direction])
-
-
 def _add_springs(model, layout, strains, stiffness, constraints):
-    """Finite spring directions become strains, ``inf`` ones constraints."""
+    """Finite spring directions become strains, ``inf`` ones constraints, released ones nothing."""
     for spring in model.springs:
-        for component, cols, values in _spring_directions(spring, layout.index):
+        for component, cols, values in _spring_directions(spring, layout.index, kept_only=True):
             k = float(spring.k[component])
             if np.isinf(k):
                 constraints.add(constraints.new_rows(1), cols, values)
@@ -403,7 +395,7 @@ def dashpot_matrix(model: Model, fe: FEModel) -> sp.csr_matrix:
     """
     rows, damping = _Triplets(), []
     for spring in model.springs:
-        for component, cols, values in _spring_directions(spring, fe.dof_index):
+        for component, cols, values in _spring_directions(spring, fe.dof_index, kept_only=False):
             if spring.c is not None and spring.c[component] > 0:
                 rows.add(rows.new_rows(1), cols, values)
                 damping.append(float(spring.c[component]))
@@ -465,6 +457,20 @@ def damped_roots(model: Model, elements_per_beam: int = 8) -> np.ndarray:
                       np.block([[identity, zero], [zero, fe.M.toarray()]]))
     roots = roots[np.isfinite(roots) & (roots.imag > 0)]
     return roots[np.argsort(roots.imag)]
+
+
+def _spring_directions(spring, index: DofIndex, kept_only: bool):
+    """(component, cols (6,), values (6,)) per direction of ``spring``: the elongation
+    (end b − end a along the spring's axis, m or rad) as a row on the full DOFs of ``index``.
+    kept_only : leave out the released directions."""
+    a, b = (_node_dofs(index.points[end]) for end in spring.ends)
+    axes = np.asarray(spring.axes, float)
+    for component in range(6):
+        if kept_only and component in spring.released:
+            continue
+        block = slice(0, 3) if component < 3 else slice(3, 6)
+        direction = axes[component % 3]
+        yield component, np.concatenate([a[block], b[block]]), np.concatenate([-direction, direction])
 
 
 def _negligible_mass_removed(model: Model) -> Model:
@@ -634,14 +640,19 @@ def _substitute(terms, owner, slave, solved, users):
 # --------------------------------------------------------------------------
 # Rigid motions
 
-def _components(model, layout) -> np.ndarray:
-    """(n_nodes,) label of the connected part of the model each node is in."""
+def _components(model, layout, through_joints: bool = True) -> np.ndarray:
+    """(n_nodes,) label of the connected part of the model each node is in.
+
+    through_joints : False to leave out springs with a released direction (the
+    parts are then the segments that move rigidly in a zero-energy motion).
+    """
     edges = []
     for body in model.rigids:
         centre = layout.index.rigids[body.name]
         edges.extend((centre, layout.index.points[p]) for p in body.ports)
     for spring in model.springs:
-        edges.append(tuple(layout.index.points[e] for e in spring.ends))
+        if through_joints or not spring.released.size:
+            edges.append(tuple(layout.index.points[e] for e in spring.ends))
     for nodes in layout.index.beam_nodes.values():
         edges.extend(zip(nodes[:-1], nodes[1:]))
     edges = np.array(edges, dtype=int).reshape(-1, 2)
@@ -650,8 +661,9 @@ def _components(model, layout) -> np.ndarray:
     return connected_components(graph, directed=False)[1]
 
 
-def _rigid_field(positions, frames) -> np.ndarray:
-    """(6 n, 6) DOFs of n nodes under the three unit translations and rotations.
+def _rigid_field(positions, frames, segments) -> tuple[np.ndarray, float]:
+    """(6 n, 6 s) DOFs of n nodes under the unit translations and rotations of each of
+    their s segments (``segments`` (n,) numbers them 0..s−1), and the scale of the rotations.
 
     Rotations are about the nodes' centroid and scaled by their extent, so
     translations and rotations weigh alike; each node's DOFs are in its frame.
@@ -668,28 +680,48 @@ def _rigid_field(positions, frames) -> np.ndarray:
         field[:, :3, k] = frames @ unit
         field[:, :3, 3 + k] = (frames @ np.cross(unit, arm)[:, :, None])[:, :, 0] / size
         field[:, 3:, 3 + k] = frames @ unit / size
-    return field.reshape(-1, 6)
+    placed = np.zeros((len(positions), 6, 6 * (segments.max() + 1)))
+    for node, segment in enumerate(segments):
+        placed[node, :, 6 * segment:6 * segment + 6] = field[node]
+    return placed.reshape(6 * len(positions), -1), float(size)
+
+
+def _across_segments(spring, layout, segments) -> bool:
+    """Whether ``spring`` joins two segments (joined within one, its ends move alike
+    under every rigid motion of it, to the tolerance within which they coincide)."""
+    a, b = (layout.index.points[end] for end in spring.ends)
+    return segments[a] != segments[b]
 
 
 def _rigid_motions(model, layout) -> np.ndarray:
-    """(n_full, r) rigid motions of each connected part allowed by its boundaries.
+    """(n_full, r) zero-energy motions of each connected part: every segment
+    (:func:`_components` without joints) moves rigidly, as far as the boundaries and
+    the directions each joint keeps allow.
 
-    Only boundary conditions can stop a rigid motion of a whole part: ports,
-    ``inf`` springs and rigid axial/torsion all hold under it. Columns are
-    orthonormal.
+    Ports, springs and rigid axial/torsion all hold under a segment's rigid
+    motion; across a joint the two segments must move alike in each direction
+    it keeps. Columns are orthonormal.
     """
     labels = _components(model, layout)
-    fixed = np.zeros(6 * layout.n_nodes, bool)
-    for point, components in model.boundary.items():
-        fixed[layout.index.point(point)] = np.asarray(components, bool)
+    segments = _components(model, layout, through_joints=False)
+    held = [sp.csr_matrix((np.ones(1), ([0], [dof])), shape=(1, 6 * layout.n_nodes))
+            for point, components in model.boundary.items()
+            for dof in layout.index.point(point)[np.asarray(components, bool)]]
+    held += [sp.csr_matrix((values, (np.zeros(6, int), cols)), shape=(1, 6 * layout.n_nodes))
+             for spring in model.springs if spring.released.size and _across_segments(spring, layout, segments)
+             for _, cols, values in _spring_directions(spring, layout.index, kept_only=True)]
+    held = sp.vstack(held).tocsc() if held else sp.csc_matrix((0, 6 * layout.n_nodes))
     motions = []
     for label in np.unique(labels):
         nodes = np.flatnonzero(labels == label)
         dofs = (6 * nodes[:, None] + np.arange(6)).ravel()
-        field = _rigid_field(layout.positions[nodes], layout.frames[nodes])
-        held = fixed[dofs]
-        allowed = (la.null_space(field[held], rcond=REDUNDANT_CONSTRAINT) if held.any()
-                   else np.eye(6))
+        field, size = _rigid_field(layout.positions[nodes], layout.frames[nodes],
+                                   np.unique(segments[nodes], return_inverse=True)[1])
+        weight = np.tile(np.r_[np.ones(3), np.full(3, size)], len(nodes))  # rotation rows of order one
+        rows = held[:, dofs]
+        rows = rows[np.flatnonzero(np.diff(rows.tocsr().indptr))]  # the rows on this part
+        allowed = (la.null_space(rows @ (weight[:, None] * field), rcond=REDUNDANT_CONSTRAINT)
+                   if rows.shape[0] else np.eye(field.shape[1]))
         if allowed.shape[1]:
             motion = np.zeros((6 * layout.n_nodes, allowed.shape[1]))
             motion[dofs] = la.orth(field @ allowed)
@@ -824,7 +856,9 @@ def _rigid_basis(motions, M):
         return np.zeros((n, 0)), np.zeros(0, dtype=int)
     basis = la.orth(motions)
     kinetic, directions = la.eigh(basis.T @ (M @ basis))
-    massive = kinetic > MASSLESS * np.abs(kinetic).max()
+    # against the model's own mass scale too: a joint can leave a motion of massless
+    # points alone, whose kinetic energy is the rounding of the others' DOFs
+    massive = kinetic > MASSLESS * max(np.abs(kinetic).max(), M.diagonal().max())
     modes = basis @ (directions[:, massive] / np.sqrt(kinetic[massive]))
     pivots = la.qr(basis.T, pivoting=True, mode="r")[1]
     return modes, np.sort(pivots[:basis.shape[1]])

@@ -35,7 +35,7 @@ import numpy as np
 from linmstmm.deduction import Deduction
 from linmstmm.elements.frames import FORCE_INDEX
 from linmstmm.elements.spring import damped_spring_transfer
-from linmstmm.model import Model
+from linmstmm.model import COMPONENTS, Model, ModelError
 from linmstmm.nullspace import equilibration, release_indeterminate
 from linmstmm.response import FRFResult
 from linmstmm.threads import single_blas_thread
@@ -67,6 +67,30 @@ def has_dashpots(model: Model) -> bool:
     return any(spring.c is not None and np.any(spring.c > 0) for spring in model.springs)
 
 
+def refuse_released_dashpots(model: Model) -> None:
+    """ModelError (the spring, key ``c``) for a dashpot in a released direction of a joint.
+
+    A released direction's jump is an unknown of its own whose force is zero
+    (:func:`~linmstmm.elements.spring.joint_force`); a dashpot there would make
+    that force iΩcΔ, which the direct route and the damped roots do not carry
+    (the FE route's :func:`~linmstmm.fe.dashpot_matrix` would).
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    """
+    for spring in model.springs:
+        if spring.c is None:
+            continue
+        damped = [COMPONENTS[d] for d in spring.released if spring.c[d] > 0]
+        if damped:
+            raise ModelError(model.source or model.name,
+                             f"a dashpot in a released direction ({', '.join(damped)}) is not supported by "
+                             f"the direct route and the damped roots: give c = 0 there", element=f"spring "
+                             f"{spring.name!r}", key="c")
+
+
 class DampedDeduction(Deduction):
     """The deduction of a topology whose springs with dashpots have complex stiffness.
 
@@ -85,7 +109,7 @@ class DampedDeduction(Deduction):
         """U_j @ matrix as :meth:`Deduction.carried`; a spring with dashpots complex."""
         record = self.topology.elements[e].record
         if getattr(record, "kind", None) == "spring" and record.c is not None:
-            return damped_spring_transfer(record.k, record.c, record.axes, self.rate) @ matrix
+            return damped_spring_transfer(record.k, record.c, record.axes, self.rate, record.release) @ matrix
         return super().carried(e, omega, matrix)
 
     def periodic_runs(self) -> list:
@@ -189,6 +213,7 @@ def direct_frf(model: Model, point: str, vector, frequencies_hz, points=None, *,
         Exact for springs and rigid bodies, and for beams (continuous, no
         discretisation) to rounding.
     """
+    refuse_released_dashpots(model)
     frequencies_hz = np.asarray(frequencies_hz, dtype=float)
     points = tuple(model.points) if points is None else tuple(points)
     topology = build_topology(model, root=root)

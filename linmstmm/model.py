@@ -18,8 +18,10 @@ docs/model-format.md. The keys of a file, in brief:
   projected normal to the beam; default e_Z x local x, e_Y for a vertical
   beam), ``axial`` and ``torsion`` (false = rigid in that deformation);
 * ``[[spring]]``: ``name``, ``ends`` (two coinciding points), ``k`` (6
-  stiffnesses, N/m and N m/rad, ``inf`` = rigid); optional ``axes`` (3x3,
-  rows = local x, y, z) and ``c`` (6 dashpots, N s/m and N m s/rad);
+  stiffnesses, N/m and N m/rad, ``inf`` = rigid, 0 exactly where released);
+  optional ``axes`` (3x3, rows = local x, y, z), ``c`` (6 dashpots, N s/m
+  and N m s/rad) and ``release`` (a list drawn from x, y, z, rx, ry, rz: the
+  directions the joint leaves free, no force or moment there);
 * ``[boundary]``: ``point = "free" | "fixed" | "pinned"`` or a list drawn
   from x, y, z, rx, ry, rz (the fixed components);
 * ``[damping]``: ``alpha`` 1/s, ``beta`` s of C = alpha M + beta K (each
@@ -82,9 +84,13 @@ class Spring:
     """Elastic hinge: massless, zero length, between coinciding points.
 
     k : (6,) stiffnesses [kx, ky, kz, krx, kry, krz] in the spring's local axes,
-        N/m and N m/rad; ``inf`` = rigid in that direction.
+        N/m and N m/rad; ``inf`` = rigid in that direction, 0 where released.
     axes : (3, 3) rows = local x, y, z unit vectors in the inertial frame.
     c : (6,) viscous damping in the same layout, N s/m and N m s/rad, or None.
+    release : (6,) bool, the released directions (x, y, z, rx, ry, rz in the
+        spring's axes): no force or moment passes there and the two ends move
+        apart freely (a pin releases one rotation, a universal joint two, a
+        ball joint three, a slider one translation). None: nothing released.
     """
 
     name: str
@@ -92,7 +98,13 @@ class Spring:
     k: np.ndarray
     axes: np.ndarray
     c: np.ndarray | None = None
+    release: np.ndarray | None = None
     kind: str = field(default="spring", init=False)
+
+    @property
+    def released(self) -> np.ndarray:
+        """Indices (0..5: x, y, z, rx, ry, rz) of the released directions, ascending."""
+        return np.flatnonzero(np.zeros(6, bool) if self.release is None else self.release)
 
 
 @dataclass(frozen=True, eq=False)
@@ -526,17 +538,57 @@ def _check_ends(t, points):
 
 def _check_spring(t, points, tol):
     """Fields of a Spring."""
-    t.check_keys(("name", "ends", "k"), ("axes", "c"))
+    t.check_keys(("name", "ends", "k"), ("axes", "c", "release"))
     name = t.string("name", nonempty=True)
     ends, a, b = _check_ends(t, points)
     gap = np.linalg.norm(b - a)
     if gap > tol:
         raise t.error("ends", f"points {ends[0]!r} and {ends[1]!r} do not coincide "
                               f"(distance {gap:g} m); a spring has no length")
-    k = t.vector("k", 6, "> 0", allow_inf=True)
+    release = _check_release(t)
+    k = _check_joint_stiffness(t, release)
     axes = _check_rotation(t, "axes") if "axes" in t else np.eye(3)
     c = t.vector("c", 6, ">= 0") if "c" in t else None
-    return {"name": name, "ends": ends, "k": k, "axes": axes, "c": c}
+    return {"name": name, "ends": ends, "k": k, "axes": axes, "c": c,
+            "release": release if release.any() else None}
+
+
+def _check_release(t):
+    """(6,) bool mask of the directions listed in ``release`` (distinct, not all six)."""
+    value = t.table.get("release", [])
+    if not isinstance(value, list):
+        raise t.error("release", f"must be a list drawn from {', '.join(COMPONENTS)}, "
+                                 f"got {_describe(value)}")
+    for i, component in enumerate(value):
+        if component not in COMPONENTS:
+            raise t.error("release", f"release[{i}] = {_describe(component)} is not one of "
+                                     f"{', '.join(COMPONENTS)}")
+        if component in value[:i]:
+            raise t.error("release", f"component {component!r} is listed twice")
+    if len(value) == 6:
+        raise t.error("release", "all six directions are released: the spring joins nothing; "
+                                 "remove it")
+    return np.array([c in value for c in COMPONENTS])
+
+
+def _check_joint_stiffness(t, release):
+    """``k``: > 0 (``inf`` allowed) in every direction kept, exactly 0 in every released one.
+
+    A zero stiffness outside ``release`` is refused rather than read as a
+    release: it may as well be a slip of the pen, and the file should say
+    which it means.
+    """
+    k = t.vector("k", 6, allow_inf=True)
+    for i, (value, free) in enumerate(zip(k, release)):
+        if free and value != 0:
+            raise t.error("k", f"k[{i}] = {value:g} but {COMPONENTS[i]!r} is released: a released "
+                               f"direction has no stiffness, give 0 (or leave it out of 'release')")
+        if not free and value == 0:
+            raise t.error("k", f"k[{i}] must be > 0, got 0; to leave direction {COMPONENTS[i]!r} "
+                               f"free (a joint), list it in 'release' as well")
+        if not free and value < 0:
+            raise t.error("k", f"k[{i}] must be > 0, got {value:g}")
+    return k
 
 
 def _check_rotation(t, key):
@@ -667,12 +719,25 @@ def _record_table(record, file):
                          element=f"rigid {record.name!r}", key="inertia")
     if isinstance(record, Spring) and record.c is None:
         del table["c"]
+    if isinstance(record, Spring):
+        table["release"] = _release_names(table.pop("release"), file, record.name)
     if isinstance(record, Beam):
         del table["length"]
         axes = table.pop("axes")
         if np.shape(axes) == (3, 3):
             table["y_axis"] = np.asarray(axes)[1]
     return table
+
+
+def _release_names(mask, file, name):
+    """A spring record's ``release`` (None or a (6,) bool mask) as the file's list of names."""
+    if mask is None:
+        return []
+    mask = np.asarray(mask)
+    if mask.shape != (6,) or mask.dtype != bool:
+        raise ModelError(file, f"must be None or a (6,) bool mask of released directions "
+                               f"({', '.join(COMPONENTS)})", element=f"spring {name!r}", key="release")
+    return [c for c, free in zip(COMPONENTS, mask) if free]
 
 
 def _boundary_table(boundary, file):

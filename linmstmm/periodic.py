@@ -51,7 +51,8 @@ class Run:
 
 
 def find_runs(topology, parts) -> list[Run]:
-    """Runs of a repeated cell of single-input rigid bodies, springs and junctions.
+    """Runs of a repeated cell of single-input rigid bodies, springs and junctions
+    (not joints: a released direction adds an unknown and a row of its own).
 
     parts : callable element id -> (kinematic, inertial or None), the element's
     U = kinematic + ω² inertial. Inside a run every element's only input is the
@@ -60,7 +61,9 @@ def find_runs(topology, parts) -> list[Run]:
     order = topology.order
     elements = topology.elements
     size = len(order)
-    chained = np.array([elements[e].kind != "beam" and len(elements[e].inputs) == 1 for e in order])
+    chained = np.array([elements[e].kind != "beam" and len(elements[e].inputs) == 1
+                        and not (elements[e].kind == "spring" and elements[e].record.released.size)
+                        for e in order])
     follows = np.array([i > 0 and elements[order[i]].ports[elements[order[i]].inputs[0]].link[:2]
                         == ("element", order[i - 1]) for i in range(size)])
     stacked = [parts(e) if ok else (np.full((12, 12), np.nan), None) for e, ok in zip(order, chained)]

@@ -41,6 +41,9 @@ WAVE_PER_ELEMENT = 1.0
 #: scan-based search runs): its dense eigenproblem grows as their cube, and a chain
 #: of 1000 bodies took 3.5 s to predict what the search finds in 0.1 s.
 MAX_UNKNOWNS = 1500
+#: A direction of the coarse (K, M) whose images are both below this fraction of
+#: their largest entries moves neither stiffness nor mass (:func:`_regular_pencil`).
+SINGULAR_PENCIL = 1e-12
 #: Elements per beam the predicting mesh may take.
 MAX_ELEMENTS = 64
 #: Predictions closer than this (relative) are a cluster: a member's secant result
@@ -54,6 +57,11 @@ REPAIR_DEPTH = 8
 SECANT_STEPS = 12
 #: Rounds of the secant on det with the known roots divided out (:func:`_deflated_polished`).
 DEFLATION_ROUNDS = 3
+#: A root the deflated secant finds this close (relative) to a known one is not taken:
+#: beside a multiple root, dividing out one inexact member leaves a zero a little off
+#: (a tip-mass cantilever's double root at 42.4339020 rad/s came back with a second
+#: member at 42.4339063); the pencil and the segment search decide there.
+NEAR_KNOWN = 1e-5
 #: Predictions above the count-th are polished only within this (relative) of it;
 #: the others only place the certifying count's upper end in the gap above it
 #: (the coarse model is within about 1e-2 of every root it predicts).
@@ -84,10 +92,28 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2) -> 
     try:  # Cholesky of M: every unknown carries mass
         lam = scipy.linalg.eigh(K, M, eigvals_only=True, subset_by_index=[0, wanted])
     except np.linalg.LinAlgError:  # massless unknowns: QZ, their eigenvalues infinite
+        K, M = _regular_pencil(K, M)
         lam = scipy.linalg.eigvals(K, M)
         lam = np.sort(lam[np.isfinite(lam)].real)
     lam = np.sort(lam)[fe.rigid_modes.shape[1]:]  # the rigid-body modes' zeros first
     return np.sqrt(np.maximum(lam[:count], 0.0))
+
+
+def _regular_pencil(K: np.ndarray, M: np.ndarray):
+    """(K, M) less one unknown per motion with neither stiffness nor mass (a massless
+    point free to turn between two joints), which makes the pencil singular and QZ's
+    eigenvalues arbitrary. Each such motion v (K v = M v = 0, both scaled to their
+    largest entry) is removed exactly by holding the unknown it moves most (pivoted
+    QR): every vector is one that holds it plus a multiple of v.
+    """
+    stacked = np.vstack([K / max(np.abs(K).max(), np.finfo(float).tiny),
+                         M / max(np.abs(M).max(), np.finfo(float).tiny)])
+    motions = scipy.linalg.null_space(stacked, rcond=SINGULAR_PENCIL)
+    if not motions.shape[1]:
+        return K, M
+    held = scipy.linalg.qr(motions.T, pivoting=True, mode="r")[1][:motions.shape[1]]
+    kept = np.setdiff1d(np.arange(K.shape[0]), held)
+    return K[np.ix_(kept, kept)], M[np.ix_(kept, kept)]
 
 
 def predict_frequencies(model: Model, count: int) -> np.ndarray:
@@ -297,7 +323,7 @@ def _deflated_polished(finder, roots: list[float], starts: list[float],
         left, this_round = [], []
         for start, root, step in zip(starts, found, steps):
             if (np.isnan(root) or step > finder.xtol or abs(root - start) > _cluster_reach(predictions, start)
-                    or _known(root, roots + this_round, finder.SAME_ROOT)):
+                    or _known(root, roots, NEAR_KNOWN) or _known(root, this_round, finder.SAME_ROOT)):
                 left.append(start)
             else:
                 this_round.append(float(root))

@@ -26,6 +26,7 @@ import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import _state_rotation
+from linmstmm.elements.spring import joint_force
 
 # Operation codes (first entry of each record in Program.operations).
 #: TIP dst constant: the slot holds a constant (12, k) selection, reference 1.
@@ -42,6 +43,9 @@ COMBINE = 3
 GEOMETRIC = 4
 #: ORTHO index: orthonormalisation record ``index`` (Program.orthos).
 ORTHO = 5
+#: JOINT dst src F: dst (its r rows) = F[:r] src, the forces along a joint's released
+#: directions (:func:`linmstmm.elements.spring.joint_force`), on src's columns.
+JOINT = 6
 
 #: Block kinds in an orthonormalisation: a formed row (no growth reference), or a state.
 ROW_BLOCK, STATE_BLOCK = 0, 1
@@ -78,12 +82,14 @@ class Program:
     matrices : (K, 12, 12) float64 constants (selections padded, U0, U2, U_{j,Ik}, H).
     orthos : (O, 5) int64 ``(first block, number of blocks, state block, columns, layout only)``;
         ``layout only`` = 1: the blocks are laid out on the columns, never orthonormalised.
-    ortho_blocks : (B, 5) int64 ``(src, dst, rows, kind, place)``: ``place``
-        indexes ``places`` (src's columns in dst), −1 where dst is src.
+    ortho_blocks : (B, 6) int64 ``(src, dst, rows, kind, place, forces)``: ``place``
+        indexes ``places`` (src's columns in dst), −1 where dst is src; ``forces``:
+        a joint's row block has that many force rows first, moment rows after (their
+        kinds in the row scales), −1 for any other block (three rows per kind).
     beams : (nb, 10) float64 ``(E, G, rho, A, Iy, Iz, J, Ip, length, flags)``,
         flags = axial + 2 torsion; beam_rotation : (nb, 12, 12) its state rotation.
     root, root_row : slots of the carried root state and of −Z_root.
-    geometric_rows : (g,) slots of the geometric rows, in Ū_all's row order.
+    geometric_rows : (g,) slots of the geometric and joint rows, in Ū_all's row order.
     order, kept_rows, kept_columns : order of Ū_all before release, and the rows and
         columns that remain after it.
     """
@@ -169,12 +175,14 @@ class _Planner:
 
 
 def compile_program(deduction: Deduction) -> Program:
-    """The straight-line program of ``deduction`` (after any release of unknowns)."""
+    """The straight-line program of ``deduction`` (after any release of unknowns).
+
+    """
     plan = _Planner(deduction)
     topology = deduction.topology
     elements = topology.elements
     root_given = topology.root if topology.root[0] == "boundary" else ("cut", topology.root[1], 0)
-    rows: list[list] = [["root", plan.tip(root_given, negate=True), 12]]  # [label, slot, rows]
+    rows: list[list] = [["root", plan.tip(root_given, negate=True), 12, -1]]  # [label, slot, rows, forces]
     open_states: dict[int, int] = {}
     waiting: dict[tuple, int] = {}
 
@@ -199,15 +207,17 @@ def compile_program(deduction: Deduction) -> Program:
         blocks = [others[i] for i in sorted(chosen)] + [("self", None, state)]
         union = np.array(sorted(columns), dtype=np.int64)
         block_rows = [rows[key][2] if kind == "row" else 12 for kind, key, _ in blocks]
+        block_forces = [rows[key][3] if kind == "row" else -1 for kind, key, _ in blocks]
         if sum(block_rows) < union.size:  # fewer rows than columns: never orthonormalised
             return state
         first = len(plan.ortho_blocks)
         new_slots = []
-        for (kind, key, src), count in zip(blocks, block_rows):
+        for (kind, key, src), count, forces in zip(blocks, block_rows, block_forces):
             same = np.array_equal(plan.columns(src), union)
             dst = src if same else plan.slot(count, union)
             place = -1 if same else plan.place(plan.columns(src), union)
-            plan.ortho_blocks.append((src, dst, count, ROW_BLOCK if kind == "row" else STATE_BLOCK, place))
+            plan.ortho_blocks.append((src, dst, count, ROW_BLOCK if kind == "row" else STATE_BLOCK, place,
+                                      forces))
             new_slots.append((kind, key, dst))
         plan.orthos.append((first, len(blocks), len(blocks) - 1, union.size, 0))
         if emit:
@@ -258,6 +268,8 @@ def compile_program(deduction: Deduction) -> Program:
             plan.emit(CARRY, carried, inputs[0], plan.matrix(kinematic),
                       -1 if inertial is None else plan.matrix(inertial))
             terms = [(carried, -1)]
+            if e in deduction.jump_columns:
+                terms.append((_joint(plan, deduction, e, inputs[0], rows), -1))
         for (label, forces, incidence), other in zip(deduction._other_inputs(e), inputs[1:]):
             terms.append((other, plan.matrix(forces)))
             first = inputs[0]
@@ -267,7 +279,7 @@ def compile_program(deduction: Deduction) -> Program:
                       len(plan.places))
             plan.place(plan.columns(first), union)
             plan.place(plan.columns(other), union)
-            rows.append([label, row, 6])
+            rows.append([label, row, 6, -1])
         state = terms[0][0] if len(terms) == 1 else plan.combined(terms)
         open_states[e] = orthonormalise(state)
     root = open_states[topology.order[-1]]
@@ -291,7 +303,7 @@ def compile_program(deduction: Deduction) -> Program:
         places_start=places_start.astype(np.int64),
         matrices=np.array(plan.matrices).reshape(-1, 12, 12),
         orthos=np.array(plan.orthos, dtype=np.int64).reshape(-1, 5),
-        ortho_blocks=np.array(plan.ortho_blocks, dtype=np.int64).reshape(-1, 5),
+        ortho_blocks=np.array(plan.ortho_blocks, dtype=np.int64).reshape(-1, 6),
         beams=np.array(plan.beams, dtype=float).reshape(-1, 10),
         beam_rotation=np.array(plan.rotations).reshape(-1, 12, 12),
         root=root,
@@ -301,6 +313,20 @@ def compile_program(deduction: Deduction) -> Program:
         kept_rows=np.setdiff1d(np.arange(order), deduction.released_rows).astype(np.int64),
         kept_columns=np.setdiff1d(np.arange(order), deduction.released_columns).astype(np.int64),
     )
+
+
+def _joint(plan: _Planner, deduction: Deduction, e: int, state: int, rows: list) -> int:
+    """Record joint e's row (no force along its released directions, on its input
+    ``state``) as :meth:`Deduction._carry` does, and return the slot of its jumps' state
+    (a constant, ``E Δ``) to add to its output."""
+    record = deduction.topology.elements[e].record
+    row = plan.slot(record.released.size, plan.columns(state))
+    plan.emit(JOINT, row, state, plan.matrix(joint_force(record.axes, record.released)))
+    rows.append([f"{record.name} released", row, record.released.size, int(np.sum(record.released < 3))])
+    jump = deduction.jump_state(e, 1)
+    slot = plan.slot(12, jump.columns)
+    plan.emit(TIP, slot, plan.matrix(jump.matrix[0]))
+    return slot
 
 
 def _leave_final_orthos_to_the_lu(plan: _Planner) -> None:

@@ -37,7 +37,8 @@ correction (mode acceleration) adds, for each load f g(t),
 (and g', g'' to velocity and acceleration), with K⁻¹f from the FE route's
 static solve (:func:`linmstmm.fe.static_displacements`), so a slowly applied
 or lasting load gives the static solution exactly. :func:`respond` adds it
-for held models; a free-floating model gets the modal sum alone and a note.
+for held models; a free-floating model, or one with a mechanism (a joint
+free to move), gets the modal sum alone and a note.
 
 The frequency response (receptance) between a load and the points is the
 modal sum H(Ω) = Σ_k φ^k (d · φ^k_load) / (M_k (ω_k² − Ω² + i Ω c_k)).
@@ -559,7 +560,7 @@ def respond(model: Model, case: LoadCase, damping_ratio=None,
         they replace the model's ``[damping]``; None: the model's damping.
     static_correction : add the static correction (mode acceleration), the
         static solution from :func:`linmstmm.fe.static_displacements`. Not
-        for a model with rigid-body modes (the result's ``note`` says so):
+        for a model with rigid-body or mechanism modes (the result's ``note`` says so):
         there the elastic part of a beam's static solution depends on the
         mesh (its rigid-body motion is removed with the mesh's mass), so
         it would not be exact.
@@ -588,7 +589,8 @@ def respond(model: Model, case: LoadCase, damping_ratio=None,
                             damping_ratio=damping_ratio, static=static)
     if static_correction and not held:
         return replace(result, note=f"no static correction: the model has {modes.rigid_body_modes} "
-                                    f"rigid-body modes (free-floating); the modal sum alone")
+                                    f"rigid-body modes (free-floating, or a joint's mechanism); the "
+                                    f"modal sum alone")
     return result
 
 

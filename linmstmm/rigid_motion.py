@@ -1,16 +1,21 @@
 """Rigid-body (zero-frequency) modes from the model's kinematics.
 
 A zero-frequency mode stores no strain energy. Every spring is stiff in all
-six directions (k > 0, or ``inf``) and every beam has E, G > 0, so zero strain
-means that each connected part of the model moves as one rigid body: only
-boundary conditions can stop such a motion. The rigid motions of a part are
-its six unit motions (translations, and rotations about its centroid scaled
-by its extent so that both weigh alike), less those its fixed boundary
-components hold. That is the null space of a small matrix of pure geometry:
-direction cosines and lengths relative to the part's own extent, so its rank
-is decided at a relative tolerance that no choice of units or overall size
-changes (Ū_all(0), by contrast, mixes the stiffness and length scales of the
-model, and its small singular values say little about its null space).
+six directions (k > 0, or ``inf``) except those a joint releases, and every
+beam has E, G > 0, so zero strain means that each *segment* of the model
+(points joined by rigid bodies, beams and springs without a released
+direction) moves as one rigid body, and that across every joint the two
+segments it joins move alike in each direction it keeps. The zero-energy
+motions of a connected part are therefore the six unit motions of each of
+its segments (translations, and rotations about the part's centroid scaled by
+its extent so that both weigh alike), less those its fixed boundary
+components and its joints' kept directions hold: rigid-body modes and
+mechanism modes (a four-bar linkage's one) alike. That is the null space of
+a small matrix of pure geometry: direction cosines and lengths relative to
+the part's own extent, so its rank is decided at a relative tolerance that no
+choice of units or overall size changes (Ū_all(0), by contrast, mixes the
+stiffness and length scales of the model, and its small singular values say
+little about its null space).
 
 A motion counts as a mode only if it moves mass: a free point mass without
 rotary inertia has three rigid-body modes, not six.
@@ -32,11 +37,13 @@ GEOMETRIC_RANK = 1e-10
 MASSLESS_MOTION = 1e-13
 
 
-def connected_parts(model: Model) -> list[list[str]]:
+def connected_parts(model: Model, through_joints: bool = True) -> list[list[str]]:
     """Point names of each connected part of ``model``, in order of first appearance.
 
     Two points are connected when an element joins them (a rigid body's ports,
-    a beam's or a spring's ends).
+    a beam's or a spring's ends). through_joints : False to leave out springs
+    with a released direction (the parts are then the segments that move as
+    one rigid body in a zero-energy motion).
     """
     parent = {name: name for name in model.points}
 
@@ -47,6 +54,8 @@ def connected_parts(model: Model) -> list[list[str]]:
         return name
 
     for element in model.elements:
+        if not through_joints and element.kind == "spring" and element.released.size:
+            continue
         ends = element.ports if element.kind == "rigid" else element.ends
         for other in ends[1:]:
             parent[root(other)] = root(ends[0])
@@ -108,15 +117,17 @@ def _body_kinetic(mass, com, inertia, centre, size) -> np.ndarray:
 
 
 def rigid_body_motions(model: Model) -> dict[str, np.ndarray]:
-    """Point motions of every rigid-body mode of ``model``.
+    """Point motions of every zero-frequency (rigid-body or mechanism) mode of ``model``.
 
     Returns point name -> (6, r): the (u, θ) of that point (m, rad, up to a
     common scale per mode) in each of the r zero-frequency modes. The modes of
-    each connected part are orthonormal in the part's unit motions and move
+    each connected part are orthonormal in its segments' unit motions and move
     mass (see :data:`MASSLESS_MOTION`).
     """
     columns = []
     names = list(model.points)
+    segment_of = {p: s for s, segment in enumerate(connected_parts(model, through_joints=False))
+                  for p in segment}
     for part in connected_parts(model):
         members = set(part)
         positions = np.array([model.points[p] for p in part])
@@ -124,12 +135,16 @@ def rigid_body_motions(model: Model) -> dict[str, np.ndarray]:
         extent = np.vstack([positions] + [np.asarray(c, float)[None] for c in coms])
         centre = extent.mean(axis=0)
         size = float(np.abs(extent - centre).max()) or 1.0
-        field = unit_motions(positions, centre, size)
-        held = np.concatenate([field[i][model.fixed_mask(p)] for i, p in enumerate(part)])
-        allowed = la.null_space(held, rcond=GEOMETRIC_RANK) if held.size else np.eye(6)
+        segments = list(dict.fromkeys(segment_of[p] for p in part))  # this part's, in order
+        field = _segment_field(unit_motions(positions, centre, size), [segments.index(segment_of[p]) for p in part],
+                               len(segments))
+        index = {p: i for i, p in enumerate(part)}
+        held = _held_motions(model, part, index, field, size, segment_of)
+        allowed = la.null_space(held, rcond=GEOMETRIC_RANK) if held.size else np.eye(field.shape[2])
         if not allowed.shape[1]:
             continue
-        kinetic = _kinetic_matrix(model, members, centre, size)
+        kinetic = la.block_diag(*[_kinetic_matrix(model, {p for p in part if segment_of[p] == segment},
+                                                  centre, size) for segment in segments])
         energy, directions = la.eigh(allowed.T @ kinetic @ allowed)
         moving = allowed @ directions[:, energy > MASSLESS_MOTION * max(np.abs(kinetic).max(), 0.0)]
         if not moving.shape[1]:
@@ -140,6 +155,34 @@ def rigid_body_motions(model: Model) -> dict[str, np.ndarray]:
         columns.append(motion)
     stacked = np.concatenate(columns, axis=2) if columns else np.zeros((len(names), 6, 0))
     return {name: stacked[i] for i, name in enumerate(names)}
+
+
+def _segment_field(field: np.ndarray, segment: list, count: int) -> np.ndarray:
+    """(n, 6, 6 count): the unit motions ``field`` (n, 6, 6) of n points, each
+    point's placed in the columns of its segment (``segment[i]`` of ``count``)."""
+    placed = np.zeros(field.shape[:2] + (6 * count,))
+    for i, s in enumerate(segment):
+        placed[i, :, 6 * s:6 * s + 6] = field[i]
+    return placed
+
+
+def _held_motions(model: Model, part: list, index: dict, field: np.ndarray, size: float,
+                  segment_of: dict) -> np.ndarray:
+    """(h, 6 segments) rows that vanish under an allowed motion of the part: its fixed
+    boundary components, and the relative motion across each of its joints in the
+    directions the joint keeps (in the joint's axes). Rotation rows are scaled by
+    ``size`` so that every row is of order one. A joint whose ends are in one segment
+    (``segment_of``: point -> segment) holds nothing: its ends move alike (to the
+    tolerance within which they coincide, which is no row of the matrix)."""
+    weight = np.r_[np.ones(3), np.full(3, size)]
+    rows = [(weight[:, None] * field[index[p]])[model.fixed_mask(p)] for p in part]
+    for spring in model.springs:
+        a, b = spring.ends
+        if spring.released.size and a in index and segment_of[a] != segment_of[b]:
+            relative = weight[:, None] * (field[index[b]] - field[index[a]])
+            local = np.kron(np.eye(2), np.asarray(spring.axes, float)) @ relative
+            rows.append(np.delete(local, spring.released, axis=0))
+    return np.concatenate(rows) if rows else np.zeros((0, field.shape[2]))
 
 
 def rigid_body_mode_count(model: Model) -> int:

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg
 
-from linmstmm.counting import count_in_disc, count_zeros, count_zeros_many, deflated, divided_out
+from linmstmm.counting import DEFLATED_ASPECT, count_in_disc, count_zeros, count_zeros_many, deflated, divided_out
 from linmstmm.nullspace import equilibration
 from linmstmm.predicted import predicted_roots
 
@@ -801,7 +801,8 @@ class RootFinder:
         one is not a zero); lo None: OMEGA_FLOOR. None where the count cannot be made."""
         try:
             return count_zeros(deflated(self.log_det, known), OMEGA_FLOOR if lo is None else lo, hi,
-                               max_points=DEFLATED_MAX_POINTS, initial_points=DEFLATED_POINTS)
+                               max_points=DEFLATED_MAX_POINTS, initial_points=DEFLATED_POINTS,
+                               aspect=DEFLATED_ASPECT)
         except RuntimeError:
             return None
 

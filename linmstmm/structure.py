@@ -11,16 +11,21 @@ deduction with a derivation by hand.
 Block layout of ``U_all Z_all = 0``:
 
 * block rows: the main transfer equation, then one geometric equation per
-  non-first input k of every multi-input body j (in ``topology.order``, as
-  :class:`~linmstmm.deduction.Deduction` stacks them);
-* block columns: the root state, then every tip and loop-cut state in the
-  order of ``Deduction.columns``;
+  non-first input k of every multi-input body j and one equation per joint j
+  (a spring with released directions: no force along them), in
+  ``topology.order``, as :class:`~linmstmm.deduction.Deduction` stacks them;
+* block columns: the root state, then every tip and loop-cut state, then the
+  jumps ``Δ[j]`` across every joint's released directions, in the order of
+  ``Deduction.columns``;
 * entries: ``-I`` (the root in the main row); ``T_{a-b}`` the product of the
   transfer matrices along the path from tip element a to root element b
   (``U_{j,Ik}`` where the path enters body j by input k ≥ 2); ``G_{a-j}`` the
   product along the path from tip element a up to, not including, body j,
   premultiplied by −H_j if the path enters j by its first input or by
-  +H_{j,Ik} if it enters by input k; a trailing ``C`` marks the side of a
+  +H_{j,Ik} if it enters by input k; ``F_{a-j}`` the product from a up to
+  joint j premultiplied by F_j (the forces along its released directions);
+  a trailing ``E_j`` marks a path that starts at joint j's output with its
+  jumps (``E_j Δ[j]``), and a trailing ``C`` the side of a
   loop cut written through the supplement equation ``Z_side1 = C Z_side0``;
   ``O`` where no path exists. Several paths sum: ``T_{a-b} + T_{c-b} C``.
 
@@ -94,6 +99,17 @@ class LoopCut:
 
 
 @dataclass(frozen=True)
+class Joint:
+    """A spring with released directions: one jump unknown and one row of U_all each.
+
+    name : the spring. released : its released directions (``"x"`` … ``"rz"``, its axes).
+    """
+
+    name: str
+    released: tuple[str, ...]
+
+
+@dataclass(frozen=True)
 class Path:
     """The elements from the tip of ``column`` to the root element.
 
@@ -119,6 +135,7 @@ class StructureReport:
     junctions: tuple[str, ...]
     multi_input_bodies: tuple[MultiInputBody, ...]
     cuts: tuple[LoopCut, ...]
+    joints: tuple[Joint, ...]
     paths: tuple[Path, ...]
     ubar_order: int
     block_rows: tuple[str, ...]
@@ -146,9 +163,14 @@ class StructureReport:
         lines.append(f"loop cuts ({len(self.cuts)}):")
         lines += [f"  Z[cut {cut.point}] between {cut.elements[0]} and {cut.elements[1]}: "
                   f"{cut.supplement}" for cut in self.cuts]
-        geometric = len(self.block_rows) - 1
+        if self.joints:
+            lines.append(f"joints ({len(self.joints)}):")
+            lines += [f"  {joint.name}: released {' '.join(joint.released)}" for joint in self.joints]
+        geometric = len(self.block_rows) - 1 - len(self.joints)
+        released = sum(len(joint.released) for joint in self.joints)
         lines.append(f"order of Ubar_all: {self.ubar_order} "
-                     f"(12 main rows + 6 x {geometric} geometric rows)")
+                     f"(12 main rows + 6 x {geometric} geometric rows"
+                     + (f" + {released} joint rows)" if released else ")"))
         lines.append("paths, tip -> root:")
         width = max((len(path.column) for path in self.paths), default=0)
         lines += [f"  {path.column:<{width}} : {' -> '.join(path.elements)}" for path in self.paths]
@@ -164,6 +186,7 @@ class StructureReport:
         """The unknowns of every block column, in column order."""
         ends = {_column(end.label): end.unknowns for end in (self.root, *self.tips)}
         ends |= {_column(f"cut {cut.point}"): cut.unknowns for cut in self.cuts}
+        ends |= {_jump_column(joint.name): tuple(f"Δ{c}" for c in joint.released) for joint in self.joints}
         return [ends[column] for column in self.block_columns]
 
 
@@ -172,6 +195,8 @@ _LEGEND = (
     "  element b (U_{j,Ik} where the path enters body j by input k >= 2); G_{a-j} product from a",
     "  up to body j, premultiplied by -H_j (path into j's first input) or +H_{j,Ik} (into input k);",
     "  C = diag(I6, -I6) of a cut's supplement equation; O no path.",
+    "  Joints: F_{a-j} product from a up to joint j, premultiplied by F_j (its released forces);",
+    "  E_j the jumps of joint j entering at its output (a path from there, column Δ[j]).",
 )
 
 
@@ -182,9 +207,12 @@ def describe(topology: Topology) -> StructureReport:
     elements = topology.elements
     states = [("boundary", b) for b in range(len(topology.boundaries))]
     states += [("cut", c) for c in range(len(topology.cuts))]
+    joints = sorted(deduction.jump_columns)
     columns = [topology.root] + [state for state in states if state != topology.root]
+    columns += [("jump", j) for j in joints]
     bodies = [e for e in topology.order if len(elements[e].inputs) >= 2]
-    rows = [None] + [(j, k) for j in bodies for k in range(1, len(elements[j].inputs))]
+    rows = [None] + [row for j in topology.order for row in (
+        [(j, "joint")] if j in deduction.jump_columns else [(j, k) for k in range(1, len(elements[j].inputs))])]
     blocks, paths = _blocks(topology, rows, columns)
     return StructureReport(
         root=_root_end(topology, unknowns),
@@ -193,11 +221,13 @@ def describe(topology: Topology) -> StructureReport:
         junctions=tuple(el.name for el in elements if el.kind == "junction"),
         multi_input_bodies=tuple(_multi_input_body(topology, j) for j in bodies),
         cuts=tuple(_loop_cut(topology, c, unknowns) for c in range(len(topology.cuts))),
+        joints=tuple(Joint(elements[j].name, tuple(COMPONENTS[d] for d in elements[j].record.released))
+                     for j in joints),
         paths=paths,
         ubar_order=deduction.order,
-        block_rows=tuple("main" if row is None else f"{elements[row[0]].name} I{row[1] + 1}"
-                         for row in rows),
-        block_columns=tuple(_column(_state_label(topology, state)) for state in columns),
+        block_rows=tuple(_row_label(topology, row) for row in rows),
+        block_columns=tuple(_jump_column(elements[state[1]].name) if state[0] == "jump"
+                            else _column(_state_label(topology, state)) for state in columns),
         blocks=blocks,
     )
 
@@ -205,28 +235,43 @@ def describe(topology: Topology) -> StructureReport:
 def _blocks(topology, rows, columns):
     """The block entries of U_all and the tip-to-root paths they come from.
 
-    rows : None (main equation) or (body, input index k ≥ 1); columns : states.
-    Walks from every tip port to the root and writes a T term in the main row
-    and a G term in every geometric row of each multi-input body passed.
+    rows : None (main equation), (body, input index k ≥ 1) or (joint, "joint");
+    columns : states, and ("jump", joint). Walks from every tip port (and every
+    joint's output) to the root and writes a T term in the main row, a G term
+    in every geometric row of each multi-input body passed and an F term in
+    the row of each joint passed.
     """
     elements = topology.elements
-    root = elements[topology.order[-1]].name
     terms = {(r, c): [] for r in range(len(rows)) for c in range(len(columns))}
     terms[0, 0].append("-I")
     paths = []
     for state, factor, (e, p) in _tip_ports(topology):
         steps = _walk(topology, e, p)
-        c = columns.index(state)
         paths.append(Path(_column(_state_label(topology, state)) + factor,
                           tuple(_step_name(topology, step) for step in steps)))
-        tip = elements[e].name
-        terms[0, c].append(f"T_{{{tip}-{root}}}{factor}")
-        for j, k in steps:
-            for r in _geometric_rows(rows, j, k):
-                terms[r, c].append(f"G_{{{tip}-{elements[j].name}}}{factor}")
+        _write_path(topology, rows, terms, columns.index(state), elements[e].name, steps, factor)
+    for c, (kind, j) in enumerate(columns):
+        if kind == "jump":
+            link = elements[j].ports[elements[j].output].link
+            if link[0] == "element":
+                _write_path(topology, rows, terms, c, elements[link[1]].name, _walk(topology, *link[1:]),
+                            f" E_{{{elements[j].name}}}")
+            else:  # the joint is the root element: its jumps enter the main row alone
+                terms[0, c].append(f"E_{{{elements[j].name}}}")
     blocks = tuple(tuple(" + ".join(terms[r, c]) or "O" for c in range(len(columns)))
                    for r in range(len(rows)))
     return blocks, tuple(paths)
+
+
+def _write_path(topology, rows, terms, c, tip, steps, factor):
+    """The terms of one path from element ``tip`` along ``steps`` to the root, in column c."""
+    elements = topology.elements
+    terms[0, c].append(f"T_{{{tip}-{elements[topology.order[-1]].name}}}{factor}")
+    for j, k in steps:
+        for r in _geometric_rows(rows, j, k):
+            terms[r, c].append(f"G_{{{tip}-{elements[j].name}}}{factor}")
+        if (j, "joint") in rows:
+            terms[rows.index((j, "joint")), c].append(f"F_{{{tip}-{elements[j].name}}}{factor}")
 
 
 # --- walking the transfer tree ------------------------------------------------
@@ -267,7 +312,7 @@ def _geometric_rows(rows, j, k):
     Input 1 (k = 0) appears in every geometric equation of j (−H_j), input
     k ≥ 2 only in its own (+H_{j,Ik}).
     """
-    return [r for r, row in enumerate(rows) if row is not None and row[0] == j
+    return [r for r, row in enumerate(rows) if row is not None and row[0] == j and row[1] != "joint"
             and (k == 0 or row[1] == k)]
 
 
@@ -285,6 +330,19 @@ def _column(label):
     return f"Z[{label}]"
 
 
+def _jump_column(joint):
+    """Block column heading of the jumps across joint ``joint``'s released directions."""
+    return f"Δ[{joint}]"
+
+
+def _row_label(topology, row):
+    """Block row label: "main", "<body> I<k>" (geometric) or "<joint> free" (joint)."""
+    if row is None:
+        return "main"
+    name = topology.elements[row[0]].name
+    return f"{name} free" if row[1] == "joint" else f"{name} I{row[1] + 1}"
+
+
 def _state_label(topology, state):
     """Label of a boundary end or loop cut state: its boundary label or ``cut <point>``."""
     kind, index = state
@@ -296,12 +354,13 @@ def _state_label(topology, state):
 def _unknowns_by_state(topology, deduction):
     """state -> names of its unknowns, read from ``deduction.columns``.
 
-    Deduction lists six unknowns per boundary end, then twelve per cut, each
-    labelled ``"<label>.<entry>"``.
+    Deduction lists six unknowns per boundary end, then twelve per cut, then
+    the jumps of each joint, each labelled ``"<label>.<entry>"``.
     """
     labels = iter(deduction.columns)
     sizes = [(("boundary", b), 6) for b in range(len(topology.boundaries))]
     sizes += [(("cut", c), 12) for c in range(len(topology.cuts))]
+    sizes += [(("jump", j), columns.size) for j, columns in sorted(deduction.jump_columns.items())]
     return {state: tuple(next(labels).rsplit(".", 1)[1] for _ in range(size))
             for state, size in sizes}
 

@@ -7,8 +7,10 @@
   command line's entry point with exit status 0, unless it is marked
   ``# slow``; the top-level keys of each ``--json`` output are documented there;
 * every ```toml block of docs/model-format.md is valid TOML, and each complete
-  model (one with ``name`` and ``[points]``) loads; the load-file example of
-  docs/cli.md loads for the model it was written for;
+  model (one with ``name`` and ``[points]``) loads; each complete model with a
+  joint (``release``) gives the FE route's frequencies and zero-frequency
+  count; the load-file example of docs/cli.md loads for the model it was
+  written for;
 * relative links between the guides lead to existing files and headings, and
   no tracked text points at a folder outside the repository.
 """
@@ -23,11 +25,14 @@ import subprocess
 import tomllib
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from linmstmm.cli import main
+from linmstmm.fe import fe_frequencies
 from linmstmm.model import ModelError, load_model
 from linmstmm.response import load_loads
+from linmstmm.solve import natural_frequencies
 
 REPO = Path(__file__).resolve().parents[1]
 GUIDES = sorted((REPO / "docs").glob("*.md"))
@@ -95,6 +100,27 @@ def test_model_format_toml_examples_are_valid(path, index, text, tmp_path):
         file = tmp_path / "example.toml"
         file.write_text(text)
         load_model(file)
+
+
+def joint_examples():
+    """The complete models of docs/model-format.md that have a joint, named by their ``name``."""
+    models = [tomllib.loads(text) | {"text": text} for text in blocks(REPO / "docs" / "model-format.md", "toml")]
+    return [pytest.param(model["text"], id=model["name"]) for model in models
+            if "points" in model and any("release" in spring for spring in model.get("spring", []))]
+
+
+def test_the_guide_shows_every_joint_kind():
+    assert len(joint_examples()) == 4
+
+
+@pytest.mark.parametrize("text", joint_examples())
+def test_joint_examples_agree_with_the_fe_route(text, tmp_path):
+    file = tmp_path / "joint.toml"
+    file.write_text(text)
+    model = load_model(file)
+    result, check = natural_frequencies(model, count=3), fe_frequencies(model, count=3)
+    assert result.rigid_body_modes == check.rigid_body_modes
+    np.testing.assert_allclose(result.frequencies_hz, check.frequencies_hz, rtol=1e-8)
 
 
 def test_model_format_example_is_the_test_data_file():

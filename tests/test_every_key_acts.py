@@ -132,6 +132,7 @@ CASES = [
     Case("spring", "axes", *after(MOUNT, "axes = [[0.0, 0.6, 0.8], [0.0, 0.8, -0.6], [-1.0, 0.0, 0.0]]"),
          "frequencies"),
     Case("spring", "c", *after(LINK, "c = [50.0, 50.0, 50.0, 1.0, 1.0, 1.0]"), "response"),
+    Case("spring", "release", LINK, 'k = [3e6, 4e6, 5e6, 6e4, 7e4, 0.0]\nrelease = ["rz"]', "frequencies"),
     Case("boundary", "free", 'root = "fixed"', 'root = "free"', "frequencies"),
     Case("boundary", "pinned", 'root = "fixed"', 'root = "pinned"', "frequencies"),
     Case("boundary", "fixed", 'root = "fixed"', 'root = "fixed"\ncap = "fixed"', "frequencies"),

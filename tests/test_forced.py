@@ -247,3 +247,42 @@ def test_cantilever_tip_receptance_matches_closed_form_far_above_the_first_modes
     got = direct_frf(model, "b", np.eye(6)[2], frequencies, ["b"]).receptance
     np.testing.assert_allclose(got[:, 0, 2], want, rtol=1e-12)
     assert np.all(np.abs(got[:, 0, [0, 1, 3, 5]]).max(axis=1) < 1e-12 * np.abs(want))
+
+
+# --- joints ----------------------------------------------------------------------
+
+def damped_hinged_chain(ct=4.0, released=False):
+    """tests/test_joints.py's two hinged rods, a rotary dashpot ct (N m s/rad) beside each
+    torsion spring (its kept direction rz); ``released``: one on a pin's released rz instead."""
+    from test_joints import hinged_chain
+
+    model = hinged_chain()
+    name, c = ("pin", [0.0] * 5 + [ct]) if released else ("torsion", [0.0] * 5 + [ct])
+    return with_dashpots(model, {f"{name}{i}": c for i in (1, 2)})
+
+
+def test_joints_with_rotary_dashpots_agree_with_fe_and_the_quadratic_eigenproblem():
+    """Rods and springs only: the FE route is exact, so the direct FRF and the damped
+    roots agree with it to rounding, the joints' released jumps carried alongside."""
+    from linmstmm.damped import damped_frequencies
+    from linmstmm.fe import damped_roots
+
+    model = damped_hinged_chain()
+    frequencies = np.array([0.5, 1.3, 2.9, 7.0, 15.0])
+    vector = np.eye(6)[1]  # y at the free end
+    got = direct_frf(model, "b2", vector, frequencies, ["b1", "b2"], damping=(0.2, 1e-4)).receptance
+    want = harmonic_receptance(model, "b2", vector, frequencies, ["b1", "b2"], damping=(0.2, 1e-4))
+    assert relative(got, want) < 1e-10
+    roots = damped_frequencies(model, count=2).roots
+    assert relative(roots, damped_roots(model, 1)[:2]) < 1e-10 and np.all(roots.real < 0)
+
+
+def test_a_dashpot_in_a_released_direction_is_refused():
+    from linmstmm.damped import damped_frequencies
+    from linmstmm.model import ModelError
+
+    model = damped_hinged_chain(released=True)
+    for solve in (lambda: direct_frf(model, "b2", np.eye(6)[1], [1.0]), lambda: damped_frequencies(model, 2)):
+        with pytest.raises(ModelError, match="released direction") as error:
+            solve()
+        assert error.value.key == "c" and error.value.element == "spring 'pin1'"

@@ -5,41 +5,56 @@ the internal force (the spring pulls its downstream end back):
 ``u_O = u_I - C_t q``, ``θ_O = θ_I - C_r m``. ``inf`` stiffness = zero
 compliance = rigid direction. The matrix does not depend on which end is
 the input (the spring is symmetric).
+
+A released direction (a joint: pin, universal, ball, slider) transmits no
+force and its jump Δ is free: the transfer becomes
+``Z_O = U Z_I + E Δ`` with U rigid in that direction, and the condition
+``F Z_I = 0`` (the force along it vanishes) holds on the input side, as a
+hinge element does in the transfer matrix method for multibody systems: one
+more unknown and one more equation per released direction
+(:func:`joint_jump`, :func:`joint_force`).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.elements.frames import M, Q, R, U
+from linmstmm.elements.frames import FORCE_INDEX, M, Q, R, U
 from linmstmm.numeric import number_type
 
 
-def spring_compliance(k, axes) -> tuple[np.ndarray, np.ndarray]:
+def spring_compliance(k, axes, release=None) -> tuple[np.ndarray, np.ndarray]:
     """Translational and rotational compliance in the inertial frame.
 
     k : (6,) N/m and N m/rad, ``inf`` allowed; floats, or mpmath numbers
     (:func:`~linmstmm.numeric.numbers`: the compliances are then formed at the
-    working precision). axes : (3, 3) rows = local axes.
+    working precision). axes : (3, 3) rows = local axes. release : (6,) bool or
+    None: released directions get zero compliance (their jump is an unknown of
+    its own, :func:`joint_jump`).
     Returns (C_t, C_r), each (3, 3), m/N and rad/(N m).
     """
     k = np.asarray(k, dtype=number_type(k))
     axes = np.asarray(axes, dtype=float)
-    compliance = 1.0 / k  # inf -> 0: rigid direction
+    free = np.zeros(6, bool) if release is None else np.asarray(release, bool)
+    compliance = np.array([0 * value if loose else 1 / value for value, loose in zip(k, free)],
+                          dtype=k.dtype)  # inf -> 0: rigid direction
     C_t = axes.T @ np.diag(compliance[:3]) @ axes
     C_r = axes.T @ np.diag(compliance[3:]) @ axes
     return C_t, C_r
 
 
-def spring_transfer(k, axes, omega) -> np.ndarray:
-    """Transfer matrix stack (n, 12, 12) of a spring; constant in omega."""
-    C_t, C_r = spring_compliance(k, axes)
+def spring_transfer(k, axes, omega, release=None) -> np.ndarray:
+    """Transfer matrix stack (n, 12, 12) of a spring; constant in omega.
+
+    k, axes, release : as :func:`spring_compliance`. omega : (n,) rad/s.
+    """
+    C_t, C_r = spring_compliance(k, axes, release)
     U_single = np.eye(12, dtype=C_t.dtype)
     U_single[U, Q] = -C_t
     U_single[R, M] = -C_r
     return np.broadcast_to(U_single, (np.size(omega), 12, 12)).copy()
 
 
-def damped_spring_transfer(k, c, axes, rate) -> np.ndarray:
+def damped_spring_transfer(k, c, axes, rate, release=None) -> np.ndarray:
     """Transfer matrix stack (n, 12, 12), complex, of a spring with dashpots.
 
     Each direction has the complex stiffness ``k + rate c``: at circular
@@ -52,6 +67,9 @@ def damped_spring_transfer(k, c, axes, rate) -> np.ndarray:
     c : (6,) viscous damping, N s/m and N m s/rad, same layout.
     axes : (3, 3) rows = the spring's local axes.
     rate : (n,) complex, 1/s.
+    release : (6,) bool or None: released directions get zero compliance (their
+    jump is an unknown of its own, :func:`joint_jump`); a dashpot there is
+    refused before (:func:`linmstmm.forced.refuse_released_dashpots`).
 
     Returns
     -------
@@ -60,8 +78,38 @@ def damped_spring_transfer(k, c, axes, rate) -> np.ndarray:
     """
     axes = np.asarray(axes, dtype=float)
     rate = np.reshape(np.asarray(rate, dtype=complex), (-1, 1))
-    compliance = 1.0 / (np.asarray(k, dtype=float) + rate * np.asarray(c, dtype=float))  # (n, 6)
+    with np.errstate(divide="ignore"):  # k = 0, c = 0: a released direction, zeroed below
+        compliance = 1.0 / (np.asarray(k, dtype=float) + rate * np.asarray(c, dtype=float))  # (n, 6)
+    if release is not None:
+        compliance[:, np.asarray(release, bool)] = 0.0
     stack = np.broadcast_to(np.eye(12, dtype=complex), (rate.shape[0], 12, 12)).copy()
     stack[:, U, Q] = -np.einsum("ji,nj,jk->nik", axes, compliance[:, :3], axes)
     stack[:, R, M] = -np.einsum("ji,nj,jk->nik", axes, compliance[:, 3:], axes)
     return stack
+
+
+def joint_jump(axes, released) -> np.ndarray:
+    """(12, r) E: the state jump across the spring from its released jumps Δ (r,).
+
+    axes : (3, 3) rows = local axes. released : (r,) direction indices 0..5
+    (x, y, z, rx, ry, rz in the spring's axes). Δ_j is m for a translation,
+    rad for a rotation, along local axis ``released[j] % 3``.
+    """
+    axes = np.asarray(axes, dtype=float)
+    jump = np.zeros((12, len(released)))
+    for j, direction in enumerate(released):
+        block = U if direction < 3 else R
+        jump[block, j] = axes[direction % 3]
+    return jump
+
+
+def joint_force(axes, released) -> np.ndarray:
+    """(r, 12) F: the force (N) or moment (N m) of the state along each released direction.
+
+    ``F Z = 0`` is the condition a released direction adds; F pairs with
+    :func:`joint_jump` by work (``F[j]`` reads the force that does work on Δ_j).
+    """
+    jump = joint_jump(axes, released)
+    force = np.zeros((len(released), 12))
+    force[:, FORCE_INDEX] = jump[:6].T
+    return force

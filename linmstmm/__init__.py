@@ -22,7 +22,10 @@ Public names (each documented where it is defined):
   :func:`frf` -> :class:`FRFResult` (receptance), :class:`PointLoad`;
 * dashpots: :func:`direct_frf` -> :class:`FRFResult` (the direct solve,
   spring dashpots acting), :func:`damped_frequencies` -> :class:`DampedResult`
-  (complex roots of det Ū_all).
+  (complex roots of det Ū_all);
+* parameter studies: the modules :mod:`linmstmm.parameters` (keys naming
+  model values), :mod:`linmstmm.sweep` (sweeps with modes tracked by MAC)
+  and :mod:`linmstmm.sensitivity` (∂f/∂p from the mode shapes).
 
 The names are imported on first use, so ``import linmstmm`` stays light
 (in particular, matplotlib is only imported by the plotting functions).
@@ -59,7 +62,13 @@ _SOURCES = {
     "ResponseResult": "linmstmm.response",
     "FRFResult": "linmstmm.response",
     "builders": "linmstmm.builders",
+    "parameters": "linmstmm.parameters",
+    "sweep": "linmstmm.sweep",
+    "sensitivity": "linmstmm.sensitivity",
 }
+
+#: Public names that are modules (the rest are defined in their module).
+_MODULES = {"builders", "parameters", "sweep", "sensitivity"}
 
 __all__ = list(_SOURCES)
 
@@ -69,7 +78,7 @@ def __getattr__(name: str):
     if name not in _SOURCES:
         raise AttributeError(f"module 'linmstmm' has no attribute {name!r}")
     module = importlib.import_module(_SOURCES[name])
-    value = module if name == "builders" else getattr(module, name)
+    value = module if name in _MODULES else getattr(module, name)
     globals()[name] = value
     return value
 

@@ -234,7 +234,7 @@ def _orthonormalise(program, index, work, reference, log_scale, group):
     skip = True
     for m in range(group if orthos[index, 4] == 0 else 0):
         ref = reference[m, state_src]
-        if math.isnan(ref):
+        if math.isnan(ref) or ref == 0.0:  # no reference, or grown from nothing (numpy: inf)
             skip = False
             break
         growth = _size(_view(work[m], slot_offset[state_src], slot_rows[state_src],

@@ -4,51 +4,34 @@ Every function draws on matplotlib's Agg canvas straight into a file (PNG,
 or GIF for :func:`animate_mode`); no window is opened and pyplot's global
 state is not touched.
 
-Mode figures (:func:`plot_mode`, :func:`animate_mode`) show the undeformed
-structure in grey and the deformed one coloured by the size of the local
-translation: beams as their deflected curves (the stations of
-:class:`linmstmm.modes.BeamField`), rigid bodies as lines from each
-port to the mass centre (a square marks the mass centre), springs as small
-diamonds between their two ends. The mode is scaled so that its largest
-translation is ``AMPLITUDE`` × the size of the model.
+The mode figures (:func:`plot_mode`, :func:`animate_mode`: three
+orthographic views and an isometric one) are drawn by
+:mod:`linmstmm.mode_figure` and re-exported here.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import matplotlib
 import numpy as np
-from matplotlib.animation import PillowWriter
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.cm import ScalarMappable
 from matplotlib.collections import LineCollection
-from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
-from mpl_toolkits.mplot3d.art3d import Line3DCollection
 
-from linmstmm.model import COMPONENTS, Model
-from linmstmm.modes import ModalResult
+from linmstmm.mode_figure import AMPLITUDE, animate_mode, plot_mode
+from linmstmm.model import COMPONENTS
 from linmstmm.response import QUANTITY_UNITS
 
-#: Largest drawn modal translation, as a fraction of the model's size.
-AMPLITUDE = 0.1
-#: A mode whose largest translation is below this fraction of (model size ×
-#: largest rotation) is drawn undeformed and called "rotation only".
-NO_TRANSLATION = 1e-9
+__all__ = ["AMPLITUDE", "animate_mode", "frf_figure", "plot_frf", "plot_mac", "plot_mode", "plot_response",
+           "plot_scan", "significant_components"]
+
 #: FRF components below this fraction of the largest of their kind are not drawn.
 SIGNIFICANT = 1e-6
-#: Frames per period of an animated mode, and frames per second.
-FRAMES, FPS = 24, 12
-#: Half the shortest side of the box of a mode figure, as a fraction of the model size.
-_THINNEST = 0.25
+#: An FRF axis with more lines than this has a legend by point (colour) and direction (dashes).
+LEGEND_LINES = 12
 #: MAC values are written into the cells of matrices up to this size.
 ANNOTATED_MAC = 16
 
-_COLORMAP = "plasma"
-_UNDEFORMED = "0.72"
-_WIDTHS = {"beam": 3.0, "rigid": 2.5, "spring": 0.8}
 _DPI = 130
 _AXIS_COLORS = ("tab:red", "tab:green", "tab:blue")
 _SIGN_COLORS = {1.0: "tab:red", -1.0: "tab:blue"}
@@ -59,171 +42,6 @@ def _canvas(figsize, rows=1, columns=1, **options):
     figure = Figure(figsize=figsize, layout="constrained")
     FigureCanvasAgg(figure)
     return figure, figure.subplots(rows, columns, squeeze=False, **options)
-
-
-# --- mode shapes ------------------------------------------------------------------
-
-@dataclass(frozen=True, eq=False)
-class _Scene:
-    """One mode ready to draw: every piece of the structure as straight segments and markers.
-
-    segments : (N, 2, 3) undeformed segments, m (beam stations, rigid port to
-    mass centre, spring ends); segment_motion : (N, 2, 3) the mode's
-    translation at their ends; widths : (N,) line widths. markers : (M, 3)
-    mass centres and spring middles; marker_motion : (M, 3); marker_shapes :
-    (M,) "s" (mass centre) or "D" (spring). scale : modal to drawn
-    translation (0: drawn undeformed). largest : largest modal translation
-    (0 for a rotation-only mode). limits : (3, 2) axes limits, m.
-    """
-
-    segments: np.ndarray
-    segment_motion: np.ndarray
-    widths: np.ndarray
-    markers: np.ndarray
-    marker_motion: np.ndarray
-    marker_shapes: np.ndarray
-    scale: float
-    largest: float
-    limits: np.ndarray
-    title: str
-
-    def colors(self, motion) -> np.ndarray:
-        """(n, 4) colours of |motion| (n, m, 3) averaged over its m places, relative to ``largest``."""
-        size = np.linalg.norm(motion, axis=-1).mean(axis=1)
-        return matplotlib.colormaps[_COLORMAP](size / self.largest if self.largest else 0 * size)
-
-
-def plot_mode(result: ModalResult, model: Model, k: int, path) -> None:
-    """Write mode ``k`` (0-based index into ``result``) of ``model`` as a 3-D PNG figure.
-
-    Undeformed structure grey, deformed structure coloured by |translation|;
-    the title gives the mode number (from 1), the frequency and the modal mass.
-    """
-    scene = _scene(result, model, k)
-    figure, axes = _mode_canvas(scene)
-    _Deformed(axes, scene).pose(1.0)
-    figure.savefig(path, format="png", dpi=_DPI)
-
-
-def animate_mode(result: ModalResult, model: Model, k: int, path,
-                 frames: int = FRAMES, fps: int = FPS) -> None:
-    """Write mode ``k`` of ``model`` as an animated GIF: one period of sin ωt in ``frames`` frames."""
-    scene = _scene(result, model, k)
-    figure, axes = _mode_canvas(scene)
-    deformed = _Deformed(axes, scene)
-    writer = PillowWriter(fps=fps)
-    with writer.saving(figure, path, dpi=_DPI // 2):
-        for phase in np.arange(frames) / frames:
-            deformed.pose(np.sin(2 * np.pi * phase))
-            writer.grab_frame()
-
-
-def _scene(result: ModalResult, model: Model, k: int) -> _Scene:
-    """Segments, markers, scale, limits and title of mode ``k``."""
-    if not 0 <= k < result.omega.size:
-        raise IndexError(f"mode index {k} out of range: the result has {result.omega.size} modes")
-    segments, widths, markers, shapes = _pieces(result, model, k)
-    positions = np.concatenate([segments[:, :, 0].reshape(-1, 3), markers[:, 0],
-                                np.array(list(model.points.values()), dtype=float)])
-    size = max(float(np.ptp(positions, axis=0).max()), 1e-3)
-    largest = float(np.linalg.norm(segments[:, :, 1], axis=-1).max(initial=0.0))
-    rotation = np.abs(result.shape_matrix().reshape(result.omega.size, -1, 6)[k, :, 3:]).max()
-    moves = largest > NO_TRANSLATION * size * rotation
-    reach = AMPLITUDE * size
-    low, high = positions.min(axis=0) - reach, positions.max(axis=0) + reach
-    middle, half = (low + high) / 2, np.maximum((high - low) / 2, _THINNEST * size)
-    return _Scene(segments[:, :, 0], segments[:, :, 1], widths, markers[:, 0], markers[:, 1], shapes,
-                  reach / largest if moves else 0.0, largest if moves else 0.0,
-                  np.stack([middle - half, middle + half], axis=1), _mode_title(result, model, k, moves))
-
-
-def _pieces(result: ModalResult, model: Model, k: int):
-    """The structure of mode ``k`` as segments and markers, each with (position, motion).
-
-    Returns segments (N, 2 ends, 2, 3), widths (N,), markers (M, 2, 3) and
-    marker shapes (M,); the axis of length 2 is (position, modal translation).
-    """
-    def at(point):
-        return model.points[point], result.point_displacements[point][k, :3]
-
-    segments, widths, markers, shapes = [], [], [], []
-    for field in result.beam_fields.values():
-        ends = np.stack([field.positions, field.displacements[k, :, :3]], axis=1)
-        segments += list(np.stack([ends[:-1], ends[1:]], axis=1))
-        widths += [_WIDTHS["beam"]] * (len(ends) - 1)
-    for rigid in model.rigids:
-        centre = (rigid.com, result.com_displacements[rigid.name][k, :3])
-        segments += [np.array([at(port), centre], dtype=float) for port in rigid.ports]
-        widths += [_WIDTHS["rigid"]] * len(rigid.ports)
-        markers.append(centre)
-        shapes.append("s")
-    for spring in model.springs:
-        ends = np.array([at(end) for end in spring.ends], dtype=float)
-        segments.append(ends)
-        widths.append(_WIDTHS["spring"])
-        markers.append(ends.mean(axis=0))
-        shapes.append("D")
-    return (np.array(segments, dtype=float).reshape(-1, 2, 2, 3), np.array(widths),
-            np.array(markers, dtype=float).reshape(-1, 2, 3), np.array(shapes))
-
-
-def _mode_title(result: ModalResult, model: Model, k: int, moves: bool) -> str:
-    kind = "rigid-body mode" if result.omega[k] == 0 else f"f = {result.frequencies_hz[k]:.6g} Hz"
-    mass = f"modal mass {result.modal_mass[k]:.4g} kg ({result.normalization} normalisation)"
-    note = "" if moves else "; rotation only, drawn undeformed"
-    return f"{model.name}\nmode {k + 1}: {kind}, {mass}{note}"
-
-
-def _mode_canvas(scene: _Scene):
-    """An Agg figure with 3-D axes, the undeformed structure, a colour bar and a legend."""
-    figure = Figure(figsize=(8.0, 6.5))
-    FigureCanvasAgg(figure)
-    axes = figure.add_subplot(projection="3d")
-    axes.add_collection3d(Line3DCollection(scene.segments, colors=_UNDEFORMED, linewidths=scene.widths))
-    for shape in ("s", "D"):
-        chosen = scene.markers[scene.marker_shapes == shape]
-        axes.plot(*chosen.T, marker=shape, ls="", markersize=4, color=_UNDEFORMED)
-    for (low, high), setter in zip(scene.limits, (axes.set_xlim, axes.set_ylim, axes.set_zlim)):
-        setter(low, high)
-    axes.set_box_aspect(np.ptp(scene.limits, axis=1))
-    for name, axis in zip("xyz", (axes.xaxis, axes.yaxis, axes.zaxis)):
-        axis.set_major_locator(MaxNLocator(4))
-        axis.set_label_text(f"{name} [m]")
-    label = (f"|translation| / largest ({scene.largest:.3g}); largest drawn as {AMPLITUDE:g} × model size"
-             if scene.largest else "no translation")
-    figure.colorbar(ScalarMappable(Normalize(0.0, 1.0), _COLORMAP), ax=axes, shrink=0.6, pad=0.12,
-                    label=label)
-    figure.suptitle(scene.title, fontsize=10)
-    handles = [Line2D([], [], color=_UNDEFORMED, lw=2, label="undeformed"),
-               Line2D([], [], color="tab:purple", lw=_WIDTHS["beam"], label="beam (deformed)"),
-               Line2D([], [], color="tab:purple", lw=_WIDTHS["rigid"], marker="s",
-                      label="rigid body: ports to mass centre"),
-               Line2D([], [], color="tab:purple", marker="D", ls="", markersize=4, label="spring")]
-    figure.legend(handles=handles, loc="lower left", fontsize=8, frameon=False)
-    return figure, axes
-
-
-class _Deformed:
-    """The deformed structure on ``axes``; :meth:`pose` moves it to ``factor`` × the scaled mode."""
-
-    def __init__(self, axes, scene: _Scene):
-        self.axes, self.scene = axes, scene
-        self.lines = Line3DCollection(scene.segments, colors=scene.colors(scene.segment_motion),
-                                      linewidths=scene.widths)
-        axes.add_collection3d(self.lines)
-        self.markers = []
-
-    def pose(self, factor: float) -> None:
-        """Move the deformed structure to ``factor`` (−1 … 1) × the scaled mode."""
-        scene = self.scene
-        self.lines.set_segments(scene.segments + factor * scene.scale * scene.segment_motion)
-        for markers in self.markers:
-            markers.remove()
-        moved = scene.markers + factor * scene.scale * scene.marker_motion
-        colors = scene.colors(scene.marker_motion[:, None])
-        self.markers = [self.axes.scatter(*moved[chosen].T, c=colors[chosen], marker=shape, s=20,
-                                          depthshade=False)
-                        for shape in ("s", "D") if (chosen := scene.marker_shapes == shape).any()]
 
 
 # --- determinant scan ---------------------------------------------------------------
@@ -297,29 +115,81 @@ def plot_frf(result, path, natural_hz=(), load_unit: str = "N", title: str = "")
     """Write magnitude and phase of a :class:`linmstmm.response.FRFResult`.
 
     Every (point, component) whose largest |H| is at least SIGNIFICANT × the
-    largest of its kind (translation or rotation) is drawn. natural_hz :
-    natural frequencies to mark. load_unit : unit of the load, "N" or "N m".
+    largest of its kind (translation or rotation) is drawn: translations
+    (m per load unit) and rotations (rad per load unit) on separate magnitude
+    axes, the phases of all on one axis below. Each line has its own colour
+    and line style and is labelled by point and direction. natural_hz :
+    natural frequencies to mark, Hz. load_unit : unit of the load, "N" or "N m".
     """
-    figure, axes = _canvas((9.0, 6.5), 2, 1, sharex=True, height_ratios=(2, 1))
-    top, bottom = axes[:, 0]
-    for p, c in significant_components(result.receptance):
-        unit = "m" if c < 3 else "rad"
-        line, = top.semilogy(result.excitation_hz, np.abs(result.receptance[:, p, c]), lw=1.0,
-                             label=f"{result.points[p]} {COMPONENTS[c]} [{unit}/{load_unit}]")
-        bottom.plot(result.excitation_hz, np.degrees(np.angle(result.receptance[:, p, c])),
-                    lw=1.0, color=line.get_color())
+    frf_figure(result, natural_hz, load_unit, title).savefig(path, format="png", dpi=_DPI)
+
+
+def frf_figure(result, natural_hz=(), load_unit: str = "N", title: str = "") -> Figure:
+    """The figure :func:`plot_frf` writes (same arguments but the path), not yet saved.
+
+    Its axes are the magnitude axes, translations first (those present), then
+    the phase axis.
+    """
+    lines = significant_components(result.receptance)
+    kinds = [(name, unit, [(p, c) for p, c in lines if (c < 3) == (name == "translation")])
+             for name, unit in (("translation", "m"), ("rotation", "rad"))]
+    kinds = [kind for kind in kinds if kind[2]]
+    figure, axes = _canvas((9.0, 2.6 + 2.6 * len(kinds)), len(kinds) + 1, 1, sharex=True,
+                           height_ratios=(2,) * len(kinds) + (1.2,))
+    phase = axes[-1, 0]
+    styles = _line_styles(lines)
+    for axis, (name, unit, chosen) in zip(axes[:, 0], kinds):
+        for p, c in chosen:
+            label = f"{result.points[p]} {COMPONENTS[c]}"
+            axis.semilogy(result.excitation_hz, np.abs(result.receptance[:, p, c]), lw=1.2,
+                          label=label, **styles[p, c])
+            phase.plot(result.excitation_hz, np.degrees(np.angle(result.receptance[:, p, c])),
+                       lw=1.0, **styles[p, c])
+        axis.set_ylabel(f"|H|, {name}\n[{unit}/{load_unit}]")
+        _frf_legend(axis, result.points, chosen, styles)
+        axis.grid(alpha=0.3)
     for frequency in natural_hz:
-        for axis in (top, bottom):
+        for axis in axes[:, 0]:
             axis.axvline(frequency, color="0.5", ls=":", lw=0.8)
-    top.set_ylabel("|receptance|")
-    top.legend(fontsize=7, loc="best")
-    top.grid(alpha=0.3, which="both")
-    top.set_title(title or "frequency response (receptance)")
-    bottom.set_ylabel("phase [deg]")
-    bottom.set_yticks([-180, -90, 0, 90, 180])
-    bottom.set_xlabel("frequency [Hz]")
-    bottom.grid(alpha=0.3)
-    figure.savefig(path, format="png", dpi=_DPI)
+    axes[0, 0].set_title(title or "frequency response (receptance)")
+    phase.set_ylabel("phase [deg]")
+    phase.set_yticks([-180, -90, 0, 90, 180])
+    phase.set_xlabel("frequency [Hz]")
+    phase.grid(alpha=0.3)
+    return figure
+
+
+def _frf_legend(axis, points, chosen, styles) -> None:
+    """Legend right of ``axis``: one entry per line, or colours by point and dashes by direction
+    when there are more than LEGEND_LINES lines."""
+    options = dict(fontsize=7, title_fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    if len(chosen) <= LEGEND_LINES:
+        axis.legend(title="point, direction", **options)
+        return
+    component = dict(chosen)  # point index -> one of its components
+    handles = [Line2D([], [], label=points[p], **(styles[p, c] | dict(ls="-"))) for p, c in component.items()]
+    handles += [Line2D([], [], color="k", ls=_DIRECTION_DASHES[c % 3], label=f"{COMPONENTS[c]}")
+                for c in sorted({c for _, c in chosen})]
+    axis.legend(handles=handles, title="colour: point\ndashes: direction",
+                ncols=1 + len(handles) // 20, **options)
+
+
+#: Line colours of the FRF figure (by point) and line styles (by direction, x/rx … z/rz).
+_POINT_COLORS = matplotlib.colormaps["tab10"].colors
+_DIRECTION_DASHES = ("-", "--", "-.")
+_MARKERS = (None, "o", "s", "^", "v", "D")
+
+
+def _line_styles(lines) -> dict:
+    """(point, component) -> plot options: colour by point, dashes by direction.
+
+    Points beyond the ten colours also get a marker, so that no two lines
+    share colour, dashes and marker (up to 60 points).
+    """
+    order = {p: i for i, p in enumerate(dict.fromkeys(p for p, _ in lines))}
+    return {(p, c): dict(color=_POINT_COLORS[order[p] % 10], ls=_DIRECTION_DASHES[c % 3],
+                         marker=_MARKERS[order[p] // 10 % len(_MARKERS)], markevery=0.1, markersize=4)
+            for p, c in lines}
 
 
 def significant_components(receptance) -> list[tuple[int, int]]:

@@ -566,8 +566,11 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
     # ---- modes
     add("## 3. The first six mode shapes")
     add("")
-    add(f"`mode_shapes(model, {MODES})` ({seconds_text(modal_seconds)}), drawn by `plot.plot_mode`: "
-        "grey undeformed, coloured deformed (colour = size of the local translation). Each line "
+    add(f"`mode_shapes(model, {MODES})` ({seconds_text(modal_seconds)}), drawn by `plot.plot_mode` "
+        "in three orthographic views (x–z, y–z, x–y) and an isometric one: undeformed light grey, "
+        "deformed coloured by its displacement as a fraction of the largest; beams as curves, rigid "
+        "bodies as the filled outline of their ports and mass centre, springs as diamonds; each "
+        "title gives the drawing scale. Each line "
         "gives what moves (written from the figure) and the springs holding the largest shares of "
         "the mode's strain energy (computed from the relative motion of the spring ends; "
         "\"tube beams\" is the rest).")

@@ -58,6 +58,7 @@ from benchmarks.common import (beam_chain, beam_chain_reference_hz, best_of, bla
 from linmstmm import deduction as deduction_module  # noqa: E402
 from linmstmm.deduction import Deduction  # noqa: E402
 from linmstmm.fe import fe_frequencies  # noqa: E402
+from linmstmm.label_layout import line_samples, place_label  # noqa: E402
 from linmstmm.model import load_model  # noqa: E402
 from linmstmm.roots import DEFLATED_POINTS, MIN_POINTS_PER_OCTAVE  # noqa: E402
 from linmstmm.solve import CERTIFIED_STEP, frequency_finder, natural_frequencies  # noqa: E402
@@ -207,23 +208,23 @@ def merged_labels(x, y, labels, spans, near: float = 0.02) -> list:
     return [(xi, yi, ", ".join(members)) for xi, yi, members in runs]
 
 
+def plotted_error(point) -> float:
+    """Where a point's error is drawn: on the floor band if below it, at 1 for an incomplete solve."""
+    return max(point["error"], ERROR_FLOOR) if np.isfinite(point["error"]) else 1.0
+
+
 def plot_trade(points, title: str, path: Path, time_target: float | None = None) -> None:
     fig, ax = plt.subplots(figsize=(12.5, 6.5))
     drawn = [p for p in points if np.isfinite(p["seconds"])]
-    y_of = lambda p: max(p["error"], ERROR_FLOOR) if np.isfinite(p["error"]) else 1.0  # noqa: E731
-    spans = tuple(np.log10(max(v) / min(v)) or 1.0 for v in ([p["seconds"] for p in drawn], [y_of(p) for p in drawn]))
+    spans = tuple(np.log10(max(v) / min(v)) or 1.0
+                  for v in ([p["seconds"] for p in drawn], [plotted_error(p) for p in drawn]))
     for family, style in STYLES.items():
         chosen = [p for p in drawn if p["family"] == family]
         if not chosen:
             continue
         x = [p["seconds"] for p in chosen]
-        y = [y_of(p) for p in chosen]
+        y = [plotted_error(p) for p in chosen]
         ax.plot(x, y, label=family, alpha=0.85, **style)
-        if family in LABELLED:
-            below = family == "FE automatic"  # apart from the FE fixed-mesh labels, which sit above
-            for xi, yi, text in merged_labels(x, y, [short_label(p) for p in chosen], spans):
-                ax.annotate(text, (xi, yi), textcoords="offset points", xytext=(5, -11 if below else 4),
-                            fontsize=7, color=style["color"])
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.axhline(TARGET_ERROR, color="grey", ls=":", lw=1)
@@ -243,8 +244,28 @@ def plot_trade(points, title: str, path: Path, time_target: float | None = None)
              "the MSTMM settings of each point are in the report's table"
              + (f"; raised an error (not drawn): {', '.join(failed)}" if failed else ""), fontsize=7, color="0.4")
     fig.tight_layout(rect=(0, 0.04, 1, 1))
+    label_settings(ax, drawn, spans)
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+#: Places tried for a setting's label around its point, in order (offset in points, alignment).
+LABEL_PLACES = (((5, 4), "left", "bottom"), ((5, -4), "left", "top"), ((-5, 4), "right", "bottom"),
+                ((-5, -4), "right", "top"), ((0, 8), "center", "bottom"), ((0, -8), "center", "top"))
+
+
+def label_settings(ax, drawn, spans) -> None:
+    """Label the points of the LABELLED families with their settings, where no line, marker or label is."""
+    ax.figure.canvas.draw()
+    samples = line_samples(ax, [line.get_xydata() for line in ax.get_lines()])
+    renderer = ax.figure.canvas.get_renderer()
+    taken = [text.get_window_extent(renderer) for text in ax.texts]
+    for family in LABELLED:
+        chosen = [p for p in drawn if p["family"] == family]
+        x, y = [p["seconds"] for p in chosen], [plotted_error(p) for p in chosen]
+        for xi, yi, text in merged_labels(x, y, [short_label(p) for p in chosen], spans):
+            place_label(ax, text, (xi, yi), samples, taken, places=LABEL_PLACES, pad=4.0, fontsize=7,
+                        color=STYLES[family]["color"])
 
 
 # --------------------------------------------------------------------------

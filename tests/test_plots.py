@@ -14,23 +14,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 from builders import fixed, single_beam_model
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 from PIL import Image
 
 from linmstmm import cli
 from linmstmm.compare import align_eigenspaces
+from linmstmm.label_layout import AROUND, line_samples, place_label
+from linmstmm.mode_figure import _GIF_COLORS, _mode_canvas, _scene, convex_hull
 from linmstmm.model import load_model
 from linmstmm.modes import mac_matrix, mode_shapes
-from linmstmm.plot import (
-    AMPLITUDE,
-    _scene,
-    animate_mode,
-    plot_frf,
-    plot_mac,
-    plot_mode,
-    plot_response,
-    plot_scan,
-    significant_components,
-)
+from linmstmm.plot import (AMPLITUDE, _line_styles, animate_mode, frf_figure, plot_frf, plot_mac, plot_mode,
+                           plot_response, plot_scan, significant_components)
 from linmstmm.response import PointLoad, frf, modal_response, step
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -69,9 +64,43 @@ def test_mode_figure_is_a_png(tmp_path, request, which):
 def test_largest_drawn_translation_is_a_tenth_of_the_model(cantilever):
     model, modes = cantilever
     scene = _scene(modes, model, 2)
-    drawn = np.linalg.norm(scene.scale * scene.segment_motion, axis=-1).max()
+    motion = np.concatenate([scene.segment_motion.reshape(-1, 3), *scene.body_motion, scene.marker_motion])
+    drawn = np.linalg.norm(scene.scale * motion, axis=-1).max()
     assert drawn == pytest.approx(AMPLITUDE * 2.0)  # the arm is 2 m long
     assert "mode 3" in scene.title and "50.899" in scene.title
+    assert f"drawn × {scene.scale:.3g}" in scene.title and "model's size (2 m)" in scene.title
+
+
+def test_mode_figure_has_three_orthographic_views_and_an_isometric_one(chain):
+    """Each view shows the two coordinates it names, at one scale; rigid bodies are filled outlines."""
+    model, modes = chain
+    scene = _scene(modes, model, 0)
+    figure, views = _mode_canvas(scene)
+    assert [v.view.labels for v in views[:3]] == [("x [m]", "z [m]"), ("y [m]", "z [m]"), ("x [m]", "y [m]")]
+    assert views[3].view.labels is None and "isometric" in views[3].view.title
+    point = np.array([1.0, 2.0, 3.0])
+    assert [tuple(v.view.project(point)) for v in views[:3]] == [(1.0, 3.0), (2.0, 3.0), (1.0, 2.0)]
+    iso = views[3].view.project(np.eye(3))  # the unit axes on screen: a projection along (1, -1, 1)
+    towards_viewer = np.array([1.0, -1.0, 1.0]) / np.sqrt(3)
+    np.testing.assert_allclose(iso @ iso.T, np.eye(3) - np.outer(towards_viewer, towards_viewer), atol=1e-15)
+    assert views[3].view.depth(towards_viewer) == pytest.approx(1.0)
+    figure.canvas.draw()
+    for view in views:  # true shapes: one metre is as long across as up
+        across, up = np.diff(view.axes.transData.transform([[0, 0], [1, 1]]), axis=0)[0]
+        assert across == pytest.approx(up, rel=1e-6)
+    assert len(views[0].hulls.get_paths()) == len(model.rigids) == 2
+    assert figure.axes[-1].get_xlabel() == "displacement, fraction of largest"  # the colour bar
+
+
+def test_convex_hull():
+    square = [[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0.5], [0.5, 0]]
+    hull = convex_hull(square)
+    assert sorted(map(tuple, hull)) == [(0, 0), (0, 1), (1, 0), (1, 1)]
+    following = np.roll(hull, -1, axis=0)
+    area = 0.5 * (hull[:, 0] * following[:, 1] - hull[:, 1] * following[:, 0]).sum()
+    assert area == pytest.approx(1.0)  # counter-clockwise
+    assert sorted(map(tuple, convex_hull([[2, 2], [0, 0], [1, 1], [1, 1]]))) == [(0, 0), (2, 2)]
+    assert convex_hull([[1, 1]]).tolist() == [[1, 1]]
 
 
 def test_rotation_only_mode_is_drawn_undeformed(tmp_path):
@@ -90,12 +119,18 @@ def test_mode_index_out_of_range(cantilever, tmp_path):
         plot_mode(modes, model, modes.omega.size, tmp_path / "none.png")
 
 
-def test_animation_is_a_gif_with_every_frame(chain, tmp_path):
+def test_animation_is_a_wide_small_gif_with_every_frame(chain, tmp_path):
     model, modes = chain
     animate_mode(modes, model, 1, tmp_path / "mode.gif", frames=5)
     assert (tmp_path / "mode.gif").read_bytes()[:6] in GIF
     with Image.open(tmp_path / "mode.gif") as image:
-        assert image.n_frames == 5
+        assert image.n_frames == 5 and image.width >= 900 and image.mode == "P"
+        colours = set()
+        for frame in range(image.n_frames):
+            image.seek(frame)
+            colours |= {colour for _, colour in image.convert("RGB").getcolors(maxcolors=1 << 16)}
+    assert len(colours) <= _GIF_COLORS  # one small palette for every frame
+    assert (tmp_path / "mode.gif").stat().st_size < 150_000
 
 
 def test_scan_figure(tmp_path):
@@ -131,6 +166,34 @@ def test_frf_figure_and_its_significant_components(cantilever, tmp_path):
     assert significant_components(result.receptance) == [(0, 2), (0, 4)]  # tip z and its slope ry
     plot_frf(result, tmp_path / "frf.png", modes.frequencies_hz)
     assert is_png(tmp_path / "frf.png")
+
+
+def _curves(axis):
+    return [line for line in axis.get_lines() if not line.get_label().startswith("_")]
+
+
+def test_frf_figure_has_one_magnitude_axis_per_unit(cantilever):
+    """Translations (m/N) and rotations (rad/N) never share an axis; each line names point and direction."""
+    _, modes = cantilever
+    result = frf(modes, "tip", np.r_[0.0, 1.0, 1.0, 0.0, 0.0, 0.0], np.linspace(1.0, 100.0, 100), ["tip"])
+    translation, rotation, phase = frf_figure(result).axes
+    assert translation.get_ylabel().endswith("[m/N]") and rotation.get_ylabel().endswith("[rad/N]")
+    assert phase.get_ylabel() == "phase [deg]" and len(phase.get_lines()) == 4
+    for axis, directions in ((translation, "xyz"), (rotation, ("rx", "ry", "rz"))):
+        labels = [line.get_label().split() for line in _curves(axis)]
+        assert labels and all(point in result.points and direction in directions for point, direction in labels)
+    assert [line.get_label() for line in _curves(translation)] == ["tip y", "tip z"]
+    only_forces = frf(modes, "tip", np.r_[0.0, 0.0, 1.0, 0.0, 0.0, 0.0], np.linspace(1.0, 100.0, 50), ["tip"])
+    only_forces.receptance[:, :, 3:] = 0  # translations alone: one magnitude axis and the phase
+    assert len(frf_figure(only_forces, load_unit="N").axes) == 2
+
+
+def test_frf_lines_differ_in_colour_or_style():
+    """Up to 60 points × 6 directions, no two lines look alike."""
+    lines = [(p, c) for p in range(60) for c in range(6)]
+    styles = _line_styles(lines)
+    looks = {(c < 3, s["color"], s["ls"], s["marker"]) for (p, c), s in styles.items()}  # c < 3: its axis
+    assert len(looks) == len(lines)
 
 
 def test_mac_figure(tmp_path):
@@ -277,3 +340,21 @@ def test_script_writes_its_figure(tmp_path, script, words):
     assert result.returncode == 0, result.stderr
     assert all(word in result.stdout for word in words)
     assert is_png(figure)
+
+
+def test_a_label_takes_the_first_clear_place():
+    """A line across the place above the anchor sends the label to the next place; a box taken, further."""
+    figure = Figure(figsize=(4, 3))
+    FigureCanvasAgg(figure)
+    axes = figure.add_subplot(xlim=(0, 10), ylim=(0, 10))
+    line = [[0, 5.3], [10, 5.3]]  # a few points above the anchor (5, 5)
+    samples = line_samples(axes, [line])
+    assert np.diff(np.sort(samples[:, 0])).max() <= 2.0 + 1e-9  # at most 2 px apart
+    taken = []
+    first = place_label(axes, "name", (5, 5), samples, taken)
+    assert first.get_anncoords() == "offset points" and first.xyann[1] < 0  # below the line
+    assert not taken[0].count_contains(samples)
+    second = place_label(axes, "name", (5, 5), samples, taken)
+    assert not second.get_window_extent().overlaps(taken[0])
+    everywhere = place_label(axes, "name", (5, 5), samples, taken, places=AROUND[:1])
+    assert everywhere.xyann == AROUND[0][0]  # nothing clear: the first place

@@ -17,8 +17,8 @@ from builders import fixed, make_rigid, make_spring
 
 from linmstmm import cli
 from linmstmm.deduction import Deduction
-from linmstmm.model import Model
-from linmstmm.plot_topology import plot_topology
+from linmstmm.model import Model, load_model
+from linmstmm.plot_topology import plot_topology, topology_figure
 from linmstmm.structure import describe
 from linmstmm.topology import build_topology
 
@@ -212,6 +212,31 @@ def test_figure_is_a_png(tmp_path, make):
     path = tmp_path / "topology.png"
     plot_topology(build_topology(make()), path, title=make.__name__)
     assert path.read_bytes()[:8] == PNG_SIGNATURE and path.stat().st_size > 5000
+
+
+@pytest.mark.parametrize("make", [book_figure_11_1, loop_model, ring_model, junction_model, "mlrs"])
+def test_figure_labels_do_not_overlap_and_a_legend_keys_the_symbols(make):
+    if make == "mlrs":
+        topology = build_topology(load_model(ROOT / "models" / "mlrs" / "mlrs.toml"), root="muzzle")
+    else:
+        topology = build_topology(make())
+    figure = topology_figure(topology, title="topology")
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    texts = [text for text in figure.axes[0].texts if text.get_text()]
+    boxes = [(text.get_bbox_patch() or text).get_window_extent(renderer) for text in texts]
+    for i, box in enumerate(boxes):
+        overlapping = [texts[j].get_text() for j in range(i + 1, len(boxes)) if box.overlaps(boxes[j])]
+        assert not overlapping, f"{texts[i].get_text()!r} overlaps {overlapping}"
+    arrows = [text.arrow_patch.get_path().interpolated(40).vertices for text in figure.axes[0].texts
+              if getattr(text, "arrow_patch", None) is not None]
+    for text, box in zip(texts, boxes):
+        if text.get_bbox_patch() is None:  # names and end labels, not the boxed or circled ones
+            assert not any(box.count_contains(arrow) for arrow in arrows), f"an arrow crosses {text.get_text()!r}"
+    keys = [text.get_text() for text in figure.legends[0].get_texts()]
+    assert "rigid body" in keys and any("boundary end" in key for key in keys)
+    assert any("loop cut" in key for key in keys) == bool(topology.cuts)
+    assert any("spring" in key for key in keys) == any(e.kind == "spring" for e in topology.elements)
 
 
 def test_check_command_prints_json_and_writes_the_figure(tmp_path, capsys):

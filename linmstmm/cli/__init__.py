@@ -25,6 +25,7 @@ from linmstmm.cli.frf import add_frf_command
 from linmstmm.cli.modes import add_modes_command
 from linmstmm.cli.response import add_response_command
 from linmstmm.cli.scan import add_scan_command
+from linmstmm.cli.sweep import add_sweep_command
 
 #: The commands, each registered by its ``add_..._command(subparsers)``.
 COMMANDS = [
@@ -35,6 +36,7 @@ COMMANDS = [
     add_scan_command,
     add_response_command,
     add_frf_command,
+    add_sweep_command,
 ]
 
 #: Every command with one example on the bundled models (shown by ``linmstmm -h``).
@@ -46,6 +48,7 @@ COMMAND_EXAMPLES = {
     "scan": "linmstmm scan models/cantilever_tip_mass.toml --fmax 200 --plot scan.png",
     "response": "linmstmm response models/cantilever_tip_mass.toml models/loads/cantilever_step.toml",
     "frf": "linmstmm frf models/cantilever_tip_mass.toml --point tip --direction z --fmax 100",
+    "sweep": "linmstmm sweep models/spring_mass_chain.toml --vary spring.k2.k[0]=500:2000:4:log --count 3",
 }
 
 class _Parser(argparse.ArgumentParser):

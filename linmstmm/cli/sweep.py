@@ -1,0 +1,162 @@
+"""``linmstmm sweep MODEL --vary KEY=START:STOP:N[:log] ...``: a parameter study.
+
+The study is :func:`linmstmm.sweep.sweep`; the JSON is
+:meth:`linmstmm.sweep.SweepResult.to_dict` (keys in ``docs/cli.md``). A
+malformed ``--vary``, an unknown key or a step that breaks the model contract
+exits with status 2 (one line naming the file and the key).
+"""
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from linmstmm import load_model
+from linmstmm.cli.common import (
+    UsageError,
+    add_model_argument,
+    add_output_options,
+    emit,
+    positive_int,
+    writing,
+)
+from linmstmm.parameters import parse_key, unit
+from linmstmm.sweep import Vary, grid, sweep
+
+#: Elastic frequencies per step unless --count says otherwise.
+DEFAULT_COUNT = 5
+
+
+def add_sweep_command(subparsers) -> None:
+    """Register ``sweep`` on ``subparsers`` (from ``ArgumentParser.add_subparsers``)."""
+    command = subparsers.add_parser("sweep", help="natural frequencies over a grid of model values, "
+                                                  "modes tracked by shape")
+    add_model_argument(command)
+    command.add_argument("--vary", type=_vary, action="append", required=True, metavar="KEY=START:STOP:N[:log]",
+                         help="a value of the model (e.g. spring.k1.k[2], beam.arm.E, rigid.m2.mass, "
+                              "points.tip[0]) from START to STOP in N steps (:log geometric); several form a grid")
+    command.add_argument("--zip", action="store_true", help="pair the --vary ranges (same N) instead of a grid")
+    command.add_argument("--count", type=positive_int, default=DEFAULT_COUNT, metavar="K",
+                         help=f"elastic frequencies per step (default {DEFAULT_COUNT})")
+    command.add_argument("--plot", metavar="FILE", help="PNG: tracked frequencies against the first key")
+    command.add_argument("--sensitivity", action="store_true",
+                         help="df/dp of every varied key at every step, from the mode shapes")
+    command.add_argument("--workers", type=positive_int, default=1, metavar="N",
+                         help="local processes running the steps (default 1)")
+    command.add_argument("--dask", metavar="ADDRESS",
+                         help="run the steps on a dask.distributed scheduler; 'local' starts a LocalCluster")
+    add_output_options(command, csv_layout="one row per step (values, tracked frequencies, ranks, sensitivities)")
+    command.set_defaults(run=run_sweep)
+
+
+def _vary(text):
+    """argparse type of --vary: a :class:`linmstmm.sweep.Vary`."""
+    try:
+        return Vary.parse(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
+def run_sweep(args) -> int:
+    """Run ``linmstmm sweep``; returns the exit status 0."""
+    model = load_model(args.model)
+    try:
+        steps, shape = grid(args.vary, zipped=args.zip)
+    except ValueError as error:
+        raise UsageError(f"linmstmm sweep: --vary: {error}") from None
+    try:
+        result = sweep(model, steps, count=args.count, shape=shape, sensitivity=args.sensitivity,
+                       workers=args.workers, dask=args.dask, progress=not args.quiet)
+    except OSError as error:  # a scheduler that cannot be reached
+        raise UsageError(f"linmstmm sweep: --dask {args.dask}: {error}") from None
+    data = result.to_dict()
+    if args.plot:
+        with writing(model, "--plot", args.plot):
+            plot_sweep(result, args.plot, log_x=args.vary[0].log)
+        data["plot"] = str(args.plot)
+
+    def table(_):
+        print_table(result)
+        if args.plot:
+            print(f"  wrote {args.plot}")
+
+    emit(args, model, data, table, lambda: csv_table(model, result))
+    return 0
+
+
+def print_table(result) -> None:
+    """Print the sweep as a text table: values, then the tracked frequencies, per step."""
+    count = result.order.shape[1]
+    print(f"{result.model}: natural frequencies over {len(result.values)} steps "
+          f"({result.workers}, {result.seconds:.2f} s); columns follow mode shapes (MAC)")
+    head = [f"{key:>14}" for key in result.keys] + [f"{'mode ' + str(c + 1) + ' [Hz]':>14}" for c in range(count)]
+    print("  " + "  ".join(head))
+    for values, row in zip(result.values, result.frequencies_hz):
+        cells = [f"{v:>14.6g}" for v in values] + [f"{f:>14.8g}" for f in row]
+        print("  " + "  ".join(cells))
+    for step, note in result.notes.items():
+        print(f"  note (step {step + 1}): {note}")
+
+
+def csv_table(model, result) -> tuple[list[str], list[list[str]]]:
+    """The ``--csv`` table: (header, rows), one row per step.
+
+    Columns: every varied key ``KEY [unit]``, the tracked frequencies
+    ``mode c [Hz]``, the rank of each column's mode ``mode c rank`` (1 = lowest)
+    and, with sensitivities, ``dmode c/dKEY [Hz/unit]``; empty cells where a
+    step has fewer modes.
+    """
+    count = result.order.shape[1]
+    units = {key: unit(parse_key(model, key)) for key in result.keys}
+    header = [f"{key} [{units[key]}]" for key in result.keys] + [f"mode {c + 1} [Hz]" for c in range(count)] + \
+        [f"mode {c + 1} rank" for c in range(count)]
+    blocks = [result.values, result.frequencies_hz, result.order + 1.0]
+    for key, values in result.sensitivities.items():
+        header += [f"dmode {c + 1}/d{key} [{_per(units[key])}]" for c in range(count)]
+        blocks.append(values)
+    return header, [[_cell(v) for v in row] for row in np.hstack(blocks)]
+
+
+def _per(key_unit: str) -> str:
+    """The unit of Hz per ``key_unit``."""
+    if key_unit == "1":
+        return "Hz"
+    return f"Hz/{key_unit}" if " " not in key_unit and "/" not in key_unit else f"Hz/({key_unit})"
+
+
+def _cell(value: float) -> str:
+    """A CSV cell: "" for nan, whole numbers without a decimal point, else the shortest repr."""
+    if np.isnan(value):
+        return ""
+    return str(int(value)) if float(value).is_integer() and abs(value) < 2**53 else repr(float(value))
+
+
+def plot_sweep(result, path, log_x: bool = False) -> None:
+    """Write a PNG of the tracked frequencies (Hz) against the first varied key.
+
+    One colour per tracked column; with a grid of several keys, one line per
+    combination of the other keys' values. log_x : logarithmic value axis.
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(7.5, 4.8), layout="constrained")
+    FigureCanvasAgg(figure)
+    axes = figure.subplots()
+    lines = result.values.shape[0] // result.shape[0]
+    x = result.values[:, 0].reshape(result.shape[0], lines)
+    frequencies = result.frequencies_hz.reshape(result.shape[0], lines, -1)
+    for column in range(frequencies.shape[2]):
+        colour = f"C{column % 10}"
+        for line in range(lines):
+            axes.plot(x[:, line], frequencies[:, line, column], "-o", color=colour, markersize=2.5,
+                      lw=1.2, label=f"mode {column + 1}" if line == 0 else None)
+    if log_x:
+        axes.set_xscale("log")
+    axes.set_xlabel(result.keys[0])
+    axes.set_ylabel("natural frequency [Hz]")
+    others = f"; one line per value of {', '.join(result.keys[1:])}" if len(result.shape) > 1 else ""
+    axes.set_title(f"{result.model}: modes followed by shape (MAC){others}", fontsize=9)
+    axes.legend(fontsize=8)
+    axes.grid(alpha=0.3)
+    figure.savefig(path, format="png", dpi=130)

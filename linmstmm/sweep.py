@@ -1,0 +1,473 @@
+"""Parameter studies: natural frequencies over a grid of model values, modes tracked by MAC.
+
+A sweep is a list of steps, each a dict key -> value (keys:
+:mod:`linmstmm.parameters`). :func:`grid` builds it from :class:`Vary`
+ranges, as their outer product or (``zipped``) side by side. Each step is an
+edited copy of the model, solved afresh by
+:func:`~linmstmm.solve.natural_frequencies` with the numpy engine (:data:`ENGINE`;
+so every row is exactly what ``linmstmm freqs`` gives on the edited model,
+whatever runs the steps and whatever this process has loaded) and
+:func:`~linmstmm.modes.mode_shapes` (for tracking; and for the sensitivities
+of :mod:`linmstmm.sensitivity`).
+
+Tracking: frequencies by rank swap places where two modes veer or cross. Each
+step is compared with its neighbour in the grid (the step one before it along
+the last range that is not at its start) by the MAC of the mode shapes at the
+model's points, translations in m and rotations times the model's size in m
+(so the MAC does not depend on the units of length); the assignment that
+maximises the sum of the MACs gives each column the mode nearest in shape to
+the column's mode at the neighbour. Column c at step s is rank
+``order[s, c]`` there; repeated frequencies keep one column per multiplicity.
+
+Steps run serially, in local processes (``workers``) or on a dask.distributed
+cluster (``dask``); the results are the same.
+"""
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from linmstmm.model import Model, ModelError
+from linmstmm.parameters import get_value, parse_key, with_values
+
+#: How every step evaluates det Ū_all: the engine ``linmstmm freqs`` uses in a new process.
+#: Fixed, not "auto" (which follows what this process has loaded), so that a step gives
+#: the same bits in this process, in a fresh worker process and on a cluster.
+ENGINE = "numpy"
+#: Seconds to wait for a dask scheduler given by address before giving up.
+SCHEDULER_TIMEOUT = 10
+
+
+@dataclass(frozen=True)
+class Vary:
+    """One swept key: ``n`` values from ``start`` to ``stop`` (both included),
+    equally spaced, or in geometric progression if ``log``."""
+
+    key: str
+    start: float
+    stop: float
+    n: int
+    log: bool = False
+
+    @classmethod
+    def parse(cls, text: str) -> Vary:
+        """``KEY=START:STOP:N`` or ``KEY=START:STOP:N:log`` (ValueError if malformed)."""
+        key, equals, spec = text.partition("=")
+        parts = spec.split(":")
+        log = parts[-1] == "log"
+        if log:
+            parts = parts[:-1]
+        if not (equals and key and len(parts) == 3):
+            raise ValueError(f"{text!r} is not KEY=START:STOP:N or KEY=START:STOP:N:log")
+        try:
+            start, stop, n = float(parts[0]), float(parts[1]), int(parts[2])
+        except ValueError:
+            raise ValueError(f"{text!r}: START and STOP must be numbers and N an integer") from None
+        return cls(key, start, stop, n, log)
+
+    def __post_init__(self):
+        if not (math.isfinite(self.start) and math.isfinite(self.stop)):
+            raise ValueError(f"{self.key}: START and STOP must be finite")
+        if self.n < 1:
+            raise ValueError(f"{self.key}: N must be at least 1, got {self.n}")
+        if self.log and not (self.start > 0 and self.stop > 0):
+            raise ValueError(f"{self.key}: logarithmic steps need START and STOP > 0")
+
+    def values(self) -> np.ndarray:
+        """(n,) the values, in the key's SI unit."""
+        if self.log:
+            return np.geomspace(self.start, self.stop, self.n)
+        return np.linspace(self.start, self.stop, self.n)
+
+
+def grid(varies, zipped: bool = False) -> tuple[list[dict], tuple[int, ...]]:
+    """The steps of ``varies`` and the grid's shape.
+
+    Parameters
+    ----------
+    varies : iterable of Vary
+        The ranges, each with its own key.
+    zipped : bool
+        Pair the ranges (all must have the same N; shape (N,)) instead of
+        their outer product (shape (n1, n2, ...), last range fastest).
+
+    Returns
+    -------
+    steps : list of dict
+        Each step's {key: value}.
+    shape : tuple of int
+
+    Raises
+    ------
+    ValueError
+        For no range, a key varied twice, or zipped ranges of different N.
+    """
+    varies = list(varies)
+    if not varies:
+        raise ValueError("nothing to vary: give at least one range")
+    keys = [v.key for v in varies]
+    if len(set(keys)) < len(keys):
+        raise ValueError(f"a key is varied twice: {', '.join(keys)}")
+    columns = [v.values() for v in varies]
+    if zipped:
+        counts = {v.n for v in varies}
+        if len(counts) > 1:
+            raise ValueError("zipped ranges need the same N, got "
+                             + ", ".join(f"{v.key}: {v.n}" for v in varies))
+        rows, shape = zip(*columns), (varies[0].n,)
+    else:
+        rows, shape = itertools.product(*columns), tuple(v.n for v in varies)
+    return [dict(zip(keys, map(float, row))) for row in rows], shape
+
+
+def neighbours(shape: tuple[int, ...]) -> list[int | None]:
+    """For each step of a grid, the step it is tracked from.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        The grid's shape (last index fastest).
+
+    Returns
+    -------
+    list of int or None
+        Per step, the step one back along the last index that is not 0
+        (None for the first step).
+    """
+    out = []
+    for index in np.ndindex(*shape):
+        moving = [axis for axis, i in enumerate(index) if i > 0]
+        if not moving:
+            out.append(None)
+            continue
+        back = list(index)
+        back[moving[-1]] -= 1
+        out.append(int(np.ravel_multi_index(back, shape)))
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class StepSolution:
+    """One step solved.
+
+    frequencies_hz : (m,) elastic natural frequencies, Hz, ascending (m = count
+    unless fewer exist). rigid_body_modes : zero-frequency modes.
+    shapes : (m, p, 6) mass-normalised mode shapes at the model's p points
+    (m/√kg, rad/√kg). sensitivities : key -> (m,) ∂f/∂value, Hz per SI unit.
+    note : what the solve had to say ("" if nothing).
+    """
+
+    frequencies_hz: np.ndarray
+    rigid_body_modes: int
+    shapes: np.ndarray
+    sensitivities: dict = field(default_factory=dict)
+    note: str = ""
+
+
+def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGINE) -> StepSolution:
+    """Frequencies, mode shapes and sensitivities of one step.
+
+    Parameters
+    ----------
+    model : Model
+        The step's (edited) model.
+    count : int
+        Elastic frequencies wanted.
+    sensitivity_keys : sequence of str
+        Keys whose ∂f/∂value is wanted (none: no mode-shape derivatives).
+    engine : str
+        How det Ū_all is evaluated, as for :func:`~linmstmm.solve.natural_frequencies`.
+
+    Returns
+    -------
+    StepSolution
+        The frequencies as :func:`~linmstmm.solve.natural_frequencies` with
+        ``engine`` gives them, the mass-normalised shapes at the points and
+        the sensitivities.
+    """
+    from linmstmm.modes import mode_shapes
+    from linmstmm.solve import natural_frequencies
+
+    result = natural_frequencies(model, count=count, engine=engine)
+    modes = mode_shapes(model, count=count, rigid_body=False, engine=engine)
+    found = min(result.frequencies_hz.size, modes.omega.size)
+    shapes = np.stack([modes.point_displacements[p][:found] for p in model.points], axis=1)
+    sensitivities = {}
+    if sensitivity_keys:
+        from linmstmm.sensitivity import frequency_sensitivities
+
+        sensitivities = {key: values[:found] for key, values in
+                         frequency_sensitivities(model, modes, sensitivity_keys).items()}
+    return StepSolution(result.frequencies_hz[:found], result.rigid_body_modes, shapes,
+                        sensitivities, result.note)
+
+
+@dataclass(frozen=True, eq=False)
+class SweepResult:
+    """A parameter study.
+
+    keys : the varied keys. values : (steps, keys) their values, SI.
+    shape : the grid's shape (steps = its product).
+    frequencies_hz_by_rank : (steps, count) Hz, ascending per step (nan where
+    fewer exist). order : (steps, count) int, the rank at each step of the mode
+    each column follows (-1 where none). tracking_mac : (steps, count) MAC of
+    each column's shape against its shape at the neighbouring step (1 at the first).
+    sensitivities : key -> (steps, count) ∂f/∂value, Hz per SI unit of the key,
+    in tracked order (empty without sensitivities).
+    rigid_body_modes : (steps,) int. notes : step index -> note of its solve.
+    seconds : wall time. workers : what ran the steps ("serial", "2 processes", ...).
+    """
+
+    model: str
+    keys: tuple[str, ...]
+    values: np.ndarray
+    shape: tuple[int, ...]
+    frequencies_hz_by_rank: np.ndarray
+    order: np.ndarray
+    tracking_mac: np.ndarray
+    sensitivities: dict
+    rigid_body_modes: np.ndarray
+    notes: dict
+    seconds: float
+    workers: str
+
+    @property
+    def frequencies_hz(self) -> np.ndarray:
+        """(steps, count) Hz in tracked order: column c follows one mode shape."""
+        return _tracked(self.frequencies_hz_by_rank, self.order)
+
+    def to_dict(self) -> dict:
+        """The ``linmstmm sweep --json`` object (``docs/cli.md``); nan is null."""
+        return {
+            "model": self.model, "keys": list(self.keys), "shape": list(self.shape),
+            "values": self.values.tolist(),
+            "frequencies_hz": _json_rows(self.frequencies_hz),
+            "frequencies_hz_by_rank": _json_rows(self.frequencies_hz_by_rank),
+            "order": self.order.tolist(), "tracking_mac": _json_rows(self.tracking_mac),
+            "rigid_body_modes": self.rigid_body_modes.tolist(),
+            **({"sensitivity_hz_per_unit": {k: _json_rows(v) for k, v in self.sensitivities.items()}}
+               if self.sensitivities else {}),
+            "notes": {str(step): note for step, note in self.notes.items()},
+            "solves": len(self.values), "seconds": self.seconds, "workers": self.workers,
+        }
+
+
+def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = False,
+          workers: int = 1, dask=None, progress: bool = False) -> SweepResult:
+    """Natural frequencies of ``model`` at every step, modes tracked by MAC.
+
+    Parameters
+    ----------
+    model : Model
+        The model the steps edit.
+    steps : list of dict
+        Each step's {key: value} (every step sets the same keys), e.g. from :func:`grid`.
+    count : int
+        Elastic frequencies per step.
+    shape : tuple of int or None
+        The grid's shape (tracking follows its neighbours, :func:`neighbours`);
+        default a line of the steps.
+    sensitivity : bool
+        Also ∂f/∂value of every varied key at every step
+        (:func:`linmstmm.sensitivity.frequency_sensitivities`).
+    workers : int
+        Local processes running the steps (1: in this process).
+    dask : str, distributed.Client or None
+        Run the steps on a dask.distributed cluster instead: a scheduler
+        address, "local" (a LocalCluster of ``max(workers, 2)`` single-threaded
+        worker processes, closed at the end) or a ``distributed.Client``.
+    progress : bool
+        A tqdm bar on stderr (only when stderr is a terminal).
+
+    Returns
+    -------
+    SweepResult
+
+    Raises
+    ------
+    ModelError
+        For an unknown key or a step that breaks the model contract.
+    """
+    start = time.perf_counter()
+    steps = list(steps)
+    shape = tuple(shape) if shape is not None else (len(steps),)
+    _check_steps(steps, shape)
+    keys = [parse_key(model, text) for text in steps[0]]
+    models = [_edited(model, keys, step) for step in steps]
+    names = tuple(key.text for key in keys)
+    solutions, label = _run(models, count, names if sensitivity else (), workers, dask, progress)
+    order, mac = track([s.shapes for s in solutions], neighbours(shape), count, _length_scale(model))
+    return SweepResult(
+        model.name, names, np.array([[get_value(m, key) for key in keys] for m in models]).reshape(-1, len(keys)),
+        shape, _padded([s.frequencies_hz for s in solutions], count), order, mac,
+        {name: _tracked(_padded([s.sensitivities[name] for s in solutions], count), order)
+         for name in (names if sensitivity else ())},
+        np.array([s.rigid_body_modes for s in solutions], dtype=int),
+        {i: s.note for i, s in enumerate(solutions) if s.note}, time.perf_counter() - start, label)
+
+
+def track(shapes, previous, count: int, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """Columns that follow mode shapes from step to step.
+
+    Parameters
+    ----------
+    shapes : list of ndarray
+        Per step (m, p, 6) shapes at the points (m <= count).
+    previous : list of int or None
+        Per step the index of the step it is tracked from (None: ranks as they are).
+    count : int
+        Columns.
+    length : float
+        m, the model's size; rotations are weighted by it in the MAC.
+
+    Returns
+    -------
+    order : ndarray
+        (steps, count) int: rank of each column's mode, -1 where none.
+    mac : ndarray
+        (steps, count): MAC of each column against the same column at the previous step.
+    """
+    steps = len(shapes)
+    order = np.full((steps, count), -1, dtype=int)
+    mac = np.full((steps, count), np.nan)
+    vectors = [_mac_vectors(s, length) for s in shapes]
+    for step, back in enumerate(previous):
+        found = vectors[step].shape[0]
+        if back is None:
+            order[step, :found], mac[step, :found] = np.arange(found), 1.0
+            continue
+        columns = np.flatnonzero(order[back] >= 0)
+        matrix = _mac(vectors[back][order[back, columns]], vectors[step])
+        rows, ranks = linear_sum_assignment(matrix, maximize=True)
+        order[step, columns[rows]] = ranks
+        mac[step, columns[rows]] = matrix[rows, ranks]
+        unclaimed = np.setdiff1d(np.arange(found), ranks)
+        free = np.flatnonzero(order[step] < 0)[:unclaimed.size]
+        order[step, free] = unclaimed[:free.size]
+    return order, mac
+
+
+def _check_steps(steps: list, shape: tuple) -> None:
+    """ValueError unless there are steps, all setting the same keys, as many as ``shape`` holds."""
+    if not steps or not steps[0]:
+        raise ValueError("a sweep needs at least one step setting at least one key")
+    if any(set(step) != set(steps[0]) for step in steps):
+        raise ValueError(f"every step must set the same keys: {', '.join(steps[0])}")
+    if math.prod(shape) != len(steps):
+        raise ValueError(f"shape {shape} does not hold {len(steps)} steps")
+
+
+def _edited(model: Model, keys, step: dict) -> Model:
+    """``model`` with the values of ``step``; a breach of the contract names the step."""
+    try:
+        return with_values(model, {key: step[key.text] for key in keys})
+    except ModelError as error:
+        where = ", ".join(f"{key.text} = {step[key.text]:g}" for key in keys)
+        raise ModelError(error.file, f"{error.message} (in the step {where})",
+                         element=error.element, key=error.key) from None
+
+
+def _run(models, count, keys, workers, dask, progress):
+    """[StepSolution] of every model in order, and what ran them."""
+    bar = _progress(len(models), progress)
+    try:
+        if dask is not None:
+            return _on_dask(models, count, keys, dask, workers, bar)
+        if workers > 1:
+            with ProcessPoolExecutor(max_workers=workers) as pool:
+                futures = {pool.submit(solve_step, m, count, keys): i for i, m in enumerate(models)}
+                return _collected(as_completed(futures), futures, bar), f"{workers} processes"
+        solutions = []
+        for m in models:
+            solutions.append(solve_step(m, count, keys))
+            bar.update()
+        return solutions, "serial"
+    finally:
+        bar.close()
+
+
+def _on_dask(models, count, keys, dask, workers, bar):
+    """Run the steps on a dask.distributed cluster (see :func:`sweep`)."""
+    from distributed import Client, LocalCluster
+
+    if isinstance(dask, Client):
+        return _dask_map(dask, models, count, keys, bar), f"dask {dask.scheduler.address}"
+    if dask == "local":
+        with LocalCluster(n_workers=max(workers, 2), threads_per_worker=1, dashboard_address=None,
+                          silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
+            return _dask_map(client, models, count, keys, bar), f"dask LocalCluster ({max(workers, 2)} workers)"
+    with Client(dask, timeout=SCHEDULER_TIMEOUT) as client:
+        return _dask_map(client, models, count, keys, bar), f"dask {dask}"
+
+
+def _dask_map(client, models, count, keys, bar):
+    """[StepSolution] of every model in order, solved on the cluster of ``client``."""
+    from distributed import as_completed as dask_completed
+
+    futures = client.map(solve_step, models, count=count, sensitivity_keys=keys, pure=False)
+    index = {future.key: i for i, future in enumerate(futures)}
+    return _collected(dask_completed(futures), {f: index[f.key] for f in futures}, bar)
+
+
+def _collected(done, index_of, bar) -> list:
+    """Results of futures in step order, ``done`` yielding them as they finish."""
+    solutions = [None] * len(index_of)
+    for future in done:
+        solutions[index_of[future]] = future.result()
+        bar.update()
+    return solutions
+
+
+def _progress(total: int, wanted: bool):
+    """A tqdm bar on stderr, silent unless ``wanted`` and stderr is a terminal."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, unit="step", file=sys.stderr,
+                disable=not (wanted and sys.stderr.isatty()))
+
+
+def _length_scale(model: Model) -> float:
+    """m: the diagonal of the box around the model's points and mass centres (1 if that is 0)."""
+    places = np.array([*model.points.values(), *(r.com for r in model.rigids)], dtype=float)
+    size = float(np.linalg.norm(np.ptp(places, axis=0)))
+    return size if size > 0 else 1.0
+
+
+def _mac_vectors(shapes: np.ndarray, length: float) -> np.ndarray:
+    """(m, 6 p) shape vectors: translations, and rotations times ``length`` (both m)."""
+    scaled = np.concatenate([shapes[..., :3], shapes[..., 3:] * length], axis=-1)
+    return scaled.reshape(scaled.shape[0], -1)
+
+
+def _mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(n_a, n_b) MAC between the rows of ``a`` and of ``b``."""
+    from linmstmm.modes import mac_matrix
+
+    return mac_matrix(a, b) if a.size and b.size else np.zeros((a.shape[0], b.shape[0]))
+
+
+def _padded(rows, count: int) -> np.ndarray:
+    """(steps, count) float rows, nan beyond each row's end."""
+    out = np.full((len(rows), count), np.nan)
+    for i, row in enumerate(rows):
+        out[i, :len(row)] = row
+    return out
+
+
+def _tracked(by_rank: np.ndarray, order: np.ndarray) -> np.ndarray:
+    """``by_rank`` (steps, count) in tracked column order (nan where a column has no mode)."""
+    rows = np.arange(by_rank.shape[0])[:, None]
+    return np.where(order >= 0, by_rank[rows, np.maximum(order, 0)], np.nan)
+
+
+def _json_rows(array: np.ndarray) -> list:
+    """A 2-D float array as lists, nan as None (JSON null)."""
+    return [[None if math.isnan(v) else float(v) for v in row] for row in array]

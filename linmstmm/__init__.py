@@ -20,6 +20,9 @@ Public names (each documented where it is defined):
 * response: :func:`load_loads` -> :class:`LoadCase`, :func:`respond` and
   :func:`modal_response` -> :class:`ResponseResult` (time histories),
   :func:`frf` -> :class:`FRFResult` (receptance), :class:`PointLoad`;
+* dashpots: :func:`direct_frf` -> :class:`FRFResult` (the direct solve,
+  spring dashpots acting), :func:`damped_frequencies` -> :class:`DampedResult`
+  (complex roots of det Ū_all);
 * parameter studies: the modules :mod:`linmstmm.parameters` (keys naming
   model values), :mod:`linmstmm.sweep` (sweeps with modes tracked by MAC)
   and :mod:`linmstmm.sensitivity` (∂f/∂p from the mode shapes).
@@ -51,6 +54,9 @@ _SOURCES = {
     "respond": "linmstmm.response",
     "modal_response": "linmstmm.response",
     "frf": "linmstmm.response",
+    "direct_frf": "linmstmm.forced",
+    "damped_frequencies": "linmstmm.damped",
+    "DampedResult": "linmstmm.damped",
     "LoadCase": "linmstmm.response",
     "PointLoad": "linmstmm.response",
     "ResponseResult": "linmstmm.response",

@@ -193,3 +193,24 @@ def _half_windings(log_det, paths, wheres, max_points: int, initial_points: int 
             thetas[i] = np.r_[thetas[i], middles][order]
             values[i], slopes[i] = np.r_[values[i], more][order], np.r_[slopes[i], more_slopes][order]
             finite[i] = finite[i] and ok
+
+
+def count_inside(log_det, centre: complex, radius: float, height: float | None = None,
+                 max_points: int = MAX_POINTS) -> int:
+    """Zeros of an entire function inside an ellipse, with multiplicity, by the whole contour.
+
+    For a determinant without the symmetries of an undamped det Ū_all (a model
+    with dashpots: its roots ω and −ω̄ lie off the real axis), so the whole
+    ellipse ``centre + radius cos φ + i height sin φ`` (``height`` default
+    ``radius``: a circle; all in rad/s) is followed once, φ = 2θ for θ in [0, π].
+
+    log_det : callable complex omega (n,) -> (phase factor (n,), log|det| (n,)).
+    Raises RuntimeError if the count cannot be made.
+    """
+    height = radius if height is None else height
+    winding = _raised(_half_windings(
+        log_det, [lambda theta: centre + radius * np.cos(2 * theta) + 1j * height * np.sin(2 * theta)],
+        [f"the ellipse about {centre:.6g} rad/s"], max_points)[0])
+    if winding % 2:
+        raise RuntimeError(f"the root count in the ellipse about {centre:.6g} rad/s is not an integer")
+    return winding // 2

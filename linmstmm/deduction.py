@@ -259,11 +259,46 @@ class Deduction:
         outputs, rows, _ = self._carry(frequencies(omega), stable=False)
         return outputs, rows
 
-    def _carry(self, omega, stable: bool):
+    def forced(self, omega, jumps, probes, stable: bool = True):
+        """The overall transfer equation with point loads, and the states they give.
+
+        Parameters
+        ----------
+        omega : (n,) frequencies of the carry, rad/s (complex allowed).
+        jumps : {(element, port): (12,) or (n, 12)}: the state on the side of
+            port ``port`` of transfer element ``element`` towards the root is
+            the state on the other side plus this jump (a point force F and
+            moment T there: ``[0, 0, T, F]``, N m and N; see
+            :func:`linmstmm.forced.load_jumps`).
+        probes : {name: (element, port)}: the ports whose displacement and
+            rotation are wanted (an element's output, or a tip's input).
+        stable : orthonormalise on the way, as :meth:`log_det` does (each
+            jump is one more unknown, pinned to 1 by a row of its own, so it is
+            transformed like the others), without periodic runs.
+
+        Returns
+        -------
+        system : (n, N + L, N + L) Ū_all with one more column (the jump's
+            unknown) and row (its value) per jump, L = len(jumps), less the
+            released unknowns; ``system @ w = rhs`` holds the unknowns w.
+        rhs : (n, N + L): 1 in the rows of the jumps, 0 elsewhere.
+        probes : name -> :class:`PortState` (n, 6, k) on the full labels of w
+            (``full_order + L`` of them; released ones are 0).
+        """
+        omega = frequencies(omega)
+        loads = _Loads(self, jumps, probes, omega.size)
+        outputs, rows, _ = self._carry(omega, stable, loads)
+        system = self._assemble(omega, outputs, rows, loads=len(jumps))
+        rhs = np.zeros(system.shape[:2], dtype=system.dtype)
+        rhs[:, system.shape[1] - len(jumps):] = 1.0
+        return system, rhs, loads.states
+
+    def _carry(self, omega, stable: bool, loads=None):
         """Carry states from the tips to the root.
 
         stable : orthonormalise columns on the way (:class:`_Orthonormaliser`)
         and split beams into pieces of βL <= _BEAM_PIECE_BETA_L.
+        loads : the point loads and probes of :meth:`forced` (:class:`_Loads`), or None.
 
         rows[0] is the main equation's known side, ``−Z_root`` (12 rows); the
         geometric rows follow (6 each). For a boundary-less model Z_root is the
@@ -275,6 +310,7 @@ class Deduction:
         with det Ū_all = det(Ū built from these) · exp(log_scale).
         """
         n = omega.size
+        loads = loads or _Loads(self, {}, {}, n)
         elements = self.topology.elements
         outputs: dict[int, PortState] = {}
         open_states: dict[int, PortState] = {}
@@ -282,7 +318,8 @@ class Deduction:
         rows = [["root", given.columns, -given.matrix]]
         normaliser = _Orthonormaliser(omega) if stable else None
         order = self.topology.order
-        runs = {run.start: run for run in self.periodic_runs()} if stable else {}
+        runs = {run.start: run for run in self.periodic_runs()} if stable and not loads.active else {}
+        loads.watch_tips(open_states)
         position = 0
         while position < len(order):
             e = order[position]
@@ -296,6 +333,7 @@ class Deduction:
                     inputs.append(normaliser.enter_cut_side(link, lambda side: self.tip_state(side, n)))
                 else:
                     inputs.append(self.tip_state(link, n))
+                inputs[-1] = loads.jumped((e, p), inputs[-1], rows)
             run = runs.get(position)
             powered = None if run is None else self._carry_run(run, omega, inputs[0], normaliser, rows, open_states)
             if powered is not None:
@@ -319,9 +357,12 @@ class Deduction:
                 rows.append([label, *self._combined((e, k), [(inputs[0].columns, -inputs[0].matrix[:, :6]),
                                                              (state.columns, constant_times(incidence, state.matrix))])])
             state = PortState(*self._combined((e,), terms), reference=_largest([state.reference for state in inputs]))
+            state = loads.jumped((e, element.output), state, rows)
             if stable:
                 state = normaliser.apply(state, rows, open_states)
             outputs[e] = open_states[e] = state
+            loads.watch((e, element.output), state, open_states)
+        loads.finish(rows, open_states)
         log_scale = normaliser.log_scale if stable else np.zeros(n)
         return outputs, rows, log_scale
 
@@ -380,10 +421,12 @@ class Deduction:
         ubar = self._assemble(omega, outputs, rows)
         return (ubar, scale) if stable else ubar
 
-    def _assemble(self, omega, outputs, rows) -> np.ndarray:
-        """Ū_all (n, N, N) from the carried root state and the rows, less released ones."""
+    def _assemble(self, omega, outputs, rows, loads: int = 0) -> np.ndarray:
+        """Ū_all (n, N, N) from the carried root state and the rows, less released ones;
+        with ``loads`` (n, N + loads, N + loads), the loads' columns and rows last (complex)."""
         root = self.root_state(outputs)
-        ubar = zeros_like_stack(omega, (self.full_order, self.full_order))
+        ubar = zeros_like_stack(omega.astype(complex) if loads else omega,
+                                (self.full_order + loads, self.full_order + loads))
         ubar[:, :12, _index(root.columns)] = root.matrix
         ubar[:, :12, _index(rows[0][1])] += rows[0][2]  # −Z_root: a ring's shares the root state's columns
         start = 12
@@ -416,6 +459,58 @@ class Deduction:
         ubar, log_scale = self.matrix(omega, stable=True)
         sign, log_abs = np.linalg.slogdet(ubar)
         return sign, log_abs + log_scale
+
+
+class _Loads:
+    """The point loads and probes of one forced carry (:meth:`Deduction.forced`).
+
+    Jump j enters as a fresh unknown, label ``full_order + j``, with a row of
+    its own that pins it to 1 (appended when it enters, moved after every
+    other row at the end): the orthonormalisation then transforms it like
+    any unknown. A probe is the displacement rows of the state at its port,
+    kept among the open states (key ``("probe", name)``) so that every
+    orthonormalisation rewrites it too.
+    """
+
+    def __init__(self, deduction: Deduction, jumps, probes, n: int):
+        self.deduction, self.jumps, self.probes, self.n = deduction, jumps, probes, n
+        self.labels = {port: deduction.full_order + j for j, port in enumerate(jumps)}
+        self.states: dict[str, PortState] = {}
+
+    @property
+    def active(self) -> bool:
+        return bool(self.jumps or self.probes)
+
+    def jumped(self, port, state: PortState, rows) -> PortState:
+        """``state`` plus the jump at ``port`` (if any) on its fresh unknown, whose row joins ``rows``."""
+        if port not in self.jumps:
+            return state
+        label = self.labels[port]
+        jump = np.broadcast_to(self.jumps[port], (self.n, 12))[:, :, None]
+        rows.append([("load", label), np.array([label]), np.ones((self.n, 1, 1), dtype=jump.dtype)])
+        columns = np.r_[state.columns, label]
+        order = np.argsort(columns, kind="stable")
+        matrix = np.concatenate([state.matrix.astype(np.result_type(state.matrix, jump)), jump], axis=2)
+        return PortState(columns[order], matrix[:, :, order])
+
+    def watch_tips(self, open_states) -> None:
+        """Start the probes at tips (a boundary end's or cut side's input) from their tip states."""
+        for name, (e, p) in self.probes.items():
+            if p != self.deduction.topology.elements[e].output:
+                tip = self.deduction.tip_state(self.deduction.topology.elements[e].ports[p].link, self.n)
+                open_states["probe", name] = PortState(tip.columns, tip.matrix[:, :6])
+
+    def watch(self, port, state: PortState, open_states) -> None:
+        """Start the probes at ``port`` (an element's output) from its ``state``."""
+        for name, where in self.probes.items():
+            if where == port:
+                open_states["probe", name] = PortState(state.columns, state.matrix[:, :6])
+
+    def finish(self, rows, open_states) -> None:
+        """Move the loads' rows last (in place) and collect the probes into ``states``."""
+        rows[:] = ([row for row in rows if not isinstance(row[0], tuple)]
+                   + [row for row in rows if isinstance(row[0], tuple)])
+        self.states = {name: open_states.pop(("probe", name)) for name in self.probes}
 
 
 def _index(columns):
@@ -531,7 +626,7 @@ class _Orthonormaliser:
         stacked = np.concatenate(parts, axis=1)
         if stacked.shape[1] < stacked.shape[2]:
             return state
-        kinds = [_row_kinds(block) for block in blocks] + [np.arange(12) // 3]
+        kinds = [_row_kinds(block) for block in blocks] + [np.arange(state.matrix.shape[1]) // 3]
         row_scale = self._unit_scale(stacked, np.concatenate(kinds))
         q, r = np.linalg.qr(stacked * row_scale[:, :, None])
         diagonal = np.diagonal(r, axis1=1, axis2=2)
@@ -563,11 +658,17 @@ class _Orthonormaliser:
 
 def _row_kinds(block) -> np.ndarray:
     """Kind of each row of an orthonormaliser block (:meth:`_Orthonormaliser._unit_scale`):
-    a joint row says its own; a state, a cut side and the other rows are displacement,
-    rotation, moment, force, three rows each, as far as they go."""
+    0 displacement, 1 rotation, 2 moment, 3 force. A joint row says its own; a
+    point load's row (it pins the load's unknown to 1, :class:`_Loads`) is weighed
+    with the forces its unknown brings in: weighed as a displacement, the QR lost
+    up to 5 digits of a cantilever's receptance (closed form, βL from 1 to 50). A
+    state, a cut side and the other rows are displacement, rotation, moment,
+    force, three rows each, as far as they go."""
     kind, key, _, matrix = block
     if kind == "row" and len(key) > 3:
         return key[3]
+    if kind == "row" and isinstance(key[0], tuple):
+        return np.full(matrix.shape[1], 3)
     return np.arange(matrix.shape[1]) // 3
 
 

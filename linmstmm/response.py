@@ -44,7 +44,9 @@ The frequency response (receptance) between a load and the points is the
 modal sum H(Ω) = Σ_k φ^k (d · φ^k_load) / (M_k (ω_k² − Ω² + i Ω c_k)).
 
 A spring's dashpot ``c`` couples the modes; this modal route cannot honour
-it and refuses such a model (:func:`refuse_dashpots`) instead of dropping it.
+it and the time response refuses such a model (:func:`refuse_dashpots`)
+instead of dropping it. The FRF of such a model is solved directly
+(:func:`linmstmm.forced.direct_frf`).
 
 Load file (TOML)
 ----------------
@@ -597,7 +599,7 @@ def refuse_dashpots(model: Model, what: str) -> None:
 
     The modal route's modes are undamped and their damping is proportional
     (``[damping]``) or modal (ratios); a discrete dashpot couples the modes,
-    so the modal ``what`` ("time response", "FRF") cannot honour it.
+    so the modal ``what`` (e.g. "time response") cannot honour it.
     """
     for spring in model.springs:
         if spring.c is not None and np.any(spring.c > 0):

@@ -2,14 +2,17 @@
 
 * :func:`frf_study` — the receptance of a unit load at one point along one
   direction, over an equally spaced sweep, with a JSON-ready summary of what
-  went in (modes, damping, units); :func:`frf_text` prints it.
+  went in (route, modes, damping, units); :func:`frf_text` prints it. A
+  model with spring dashpots takes the direct route
+  (:func:`linmstmm.forced.direct_frf`), every other one the modal sum.
 * :func:`peak_responses` — the largest |value| of every component of a
   :class:`~linmstmm.response.ResponseResult` and when; :func:`peaks_text`.
 * :func:`determinant_scan` — log|det Ū_all| over a frequency grid and the
   natural frequencies found there (:class:`ScanResult`).
 
 Errors name the parameter at fault (``point``, ``response_points``,
-``direction``, ``fmax``) in a :class:`~linmstmm.model.ModelError`; damping
+``direction``, ``fmax``, ``modes``, ``damping_ratio``) in a
+:class:`~linmstmm.model.ModelError`; damping
 ratios that do not fit the modes raise
 :class:`~linmstmm.response.DampingRatioError`.
 """
@@ -19,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from linmstmm.forced import direct_frf, has_dashpots
 from linmstmm.mode_bound import check_range_request
 from linmstmm.model import COMPONENTS, Model, ModelError, _did_you_mean
 from linmstmm.modes import ModalResult, mode_shapes
@@ -27,8 +31,8 @@ from linmstmm.response import (
     ResponseResult,
     frf,
     quantity_units,
-    refuse_dashpots,
 )
+from linmstmm.solve import natural_frequencies
 from linmstmm.stages import report
 
 #: Frequencies in a scan and in a receptance sweep, by default.
@@ -47,6 +51,13 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
               modes: int | None = None, damping_ratio=None) -> tuple[FRFResult, dict]:
     """Receptance to a unit load at ``point`` along ``direction``, with its summary.
 
+    A model without spring dashpots takes the modal route (the modal sum,
+    :func:`linmstmm.response.frf`); a model with a spring dashpot ``c`` takes
+    the direct route (:func:`linmstmm.forced.direct_frf`: the transfer
+    equations solved at each frequency in complex arithmetic, dashpots and
+    the model's Rayleigh damping exact, no modes), which neither ``modes``
+    nor ``damping_ratio`` fits.
+
     Parameters
     ----------
     model : Model
@@ -62,11 +73,12 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
     response_points : sequence of str, optional
         Response points (default: the load point).
     modes : int, optional
-        Elastic modes in the sum (default: every mode up to FRF_MODE_REACH × fmax).
+        Elastic modes in the sum (default: every mode up to FRF_MODE_REACH × fmax);
+        modal route only.
     damping_ratio : sequence of float, optional
         Modal damping ratios (one, or one per elastic mode in the sum); given,
         they replace the model's damping; without them the model's Rayleigh
-        damping is used (undamped without it).
+        damping is used (undamped without it). Modal route only.
 
     Returns
     -------
@@ -74,42 +86,83 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
         The receptance on the sweep (``excitation_hz``).
     summary : dict
         JSON-ready: ``model``, ``load`` {point, direction}, ``fmax_hz``, the damping
-        used (:func:`damping_in_use`), ``modes_in_sum``, ``rigid_body_modes``,
-        ``frequencies_hz`` (the elastic natural frequencies in the sum, Hz),
-        ``load_unit`` and ``receptance_units`` (per component).
+        used (:func:`damping_in_use`), ``route`` ("modal" or "direct"),
+        ``modes_in_sum`` (0 on the direct route), ``rigid_body_modes``,
+        ``frequencies_hz`` (modal route: the elastic natural frequencies in the
+        sum; direct route: the undamped model's elastic natural frequencies up
+        to fmax; Hz), ``load_unit`` and ``receptance_units`` (per component).
 
     Raises
     ------
     ModelError
         For an unknown point (key ``point`` or ``response_points``) or
         direction (key ``direction``), a range holding too many modes or none
-        (key ``fmax``), or a spring with a dashpot (key ``c``).
+        (key ``fmax``), or ``modes`` or ``damping_ratio`` given for a model
+        with dashpots (key ``modes`` or ``damping_ratio``).
     DampingRatioError
         For damping ratios that do not fit the modes.
     """
-    refuse_dashpots(model, "FRF")
+    direct = has_dashpots(model)
+    if direct:
+        _refuse_modal_options(model, modes, damping_ratio)
     targets = [point] if response_points is None else list(response_points)
     _check_points(model, "point", [point])
     _check_points(model, "response_points", targets)
     if direction not in COMPONENTS:
         raise ModelError(model.source or model.name, f"direction must be one of {', '.join(COMPONENTS)}, "
                          f"got {direction!r}", key="direction")
+    sweep = fmax * np.arange(1, frequencies + 1) / frequencies
+    damping = damping_in_use(model, damping_ratio)
+    unit = np.eye(6)[COMPONENTS.index(direction)]
+    if direct:
+        result, in_sum, rigid, natural = _direct_sweep(model, point, unit, sweep, targets, fmax)
+    else:
+        result, in_sum, rigid, natural = _modal_sweep(model, point, unit, sweep, targets, fmax, modes,
+                                                      damping_ratio, damping)
+    load_unit = "N m" if direction.startswith("r") else "N"
+    summary = {"model": model.name, "load": {"point": point, "direction": direction}, "fmax_hz": fmax,
+               **damping, "route": "direct" if direct else "modal", "modes_in_sum": in_sum,
+               "rigid_body_modes": rigid, "frequencies_hz": natural,
+               "load_unit": load_unit, "receptance_units": receptance_units(load_unit)}
+    return result, summary
+
+
+def _modal_sweep(model: Model, point: str, unit, sweep, targets, fmax: float, modes, damping_ratio,
+                 damping: dict):
+    """(FRFResult, elastic modes in the sum, rigid-body modes, the elastic natural frequencies
+    in the sum, Hz) of the modal sum."""
     reach = None if modes else FRF_MODE_REACH * fmax
     if reach:
         check_range_request(model, reach, f"fmax = {fmax:g} Hz (the modal sum takes every mode "
                             f"up to {FRF_MODE_REACH:g} x fmax)", "ask for a lower fmax, or for N modes")
     shapes = mode_shapes(model, modes, fmax=reach)
-    sweep = fmax * np.arange(1, frequencies + 1) / frequencies
-    damping = damping_in_use(model, damping_ratio)
     report("receptance")
-    result = frf(shapes, point, np.eye(6)[COMPONENTS.index(direction)], sweep, targets,
-                 damping["damping"], damping_ratio=damping_ratio)
-    load_unit = "N m" if direction.startswith("r") else "N"
-    summary = {"model": model.name, "load": {"point": point, "direction": direction}, "fmax_hz": fmax,
-               **damping, "modes_in_sum": int(np.count_nonzero(shapes.omega > 0)),
-               "rigid_body_modes": shapes.rigid_body_modes, "frequencies_hz": _elastic_hz(shapes),
-               "load_unit": load_unit, "receptance_units": receptance_units(load_unit)}
-    return result, summary
+    result = frf(shapes, point, unit, sweep, targets, damping["damping"], damping_ratio=damping_ratio)
+    return result, int(np.count_nonzero(shapes.omega > 0)), shapes.rigid_body_modes, _elastic_hz(shapes)
+
+
+def _direct_sweep(model: Model, point: str, unit, sweep, targets, fmax: float):
+    """(FRFResult, 0, rigid-body modes, the undamped elastic natural frequencies up to fmax, Hz)
+    of the direct route, the model's Rayleigh damping added."""
+    natural = natural_frequencies(model, count=None, fmax=fmax)
+    report("receptance")
+    result = direct_frf(model, point, unit, sweep, targets, damping=model.damping)
+    return result, 0, natural.rigid_body_modes, natural.frequencies_hz.tolist()
+
+
+#: What each modal-route parameter is, for the direct route's refusal.
+_MODAL_PARAMETERS = {"modes": "a number of modes in the sum", "damping_ratio": "modal damping ratios"}
+
+
+def _refuse_modal_options(model: Model, modes, damping_ratio) -> None:
+    """ModelError (key ``modes`` or ``damping_ratio``) for either given to a model whose
+    dashpots take the direct route."""
+    for key, value in (("modes", modes), ("damping_ratio", damping_ratio)):
+        if value is not None:
+            raise ModelError(model.source or model.name,
+                             f"the model's spring dashpots 'c' take the direct route, which sums no modes: "
+                             f"{_MODAL_PARAMETERS[key]} belong to the modal route; give [damping] for "
+                             f"more damping", key=key)
 
 
 def _elastic_hz(shapes: ModalResult) -> list[float]:
@@ -198,13 +251,16 @@ def frf_text(result: FRFResult, summary: dict) -> str:
     from linmstmm.plot import significant_components
 
     load = summary["load"]
+    direct = summary.get("route") == "direct"
     damping = damping_text(summary)
     if damping == "undamped":
-        damping += " (unbounded at the natural frequencies)"
+        damping = "no Rayleigh damping" if direct else "undamped (unbounded at the natural frequencies)"
+    route = ("direct transfer-matrix solve, spring dashpots acting" if direct
+             else f"{summary['modes_in_sum']} elastic modes in the sum")
+    natural = ", ".join(f"{f:.6g}" for f in summary["frequencies_hz"]) or "none"
     lines = [(f"{summary['model']}: receptance to a unit load {load['direction']} at {load['point']} "
-              f"[per {summary['load_unit']}], 0-{summary['fmax_hz']:g} Hz, "
-              f"{summary['modes_in_sum']} elastic modes in the sum, {damping}"),
-             f"  natural frequencies [Hz]: {', '.join(f'{f:.6g}' for f in summary['frequencies_hz']) or 'none'}",
+              f"[per {summary['load_unit']}], 0-{summary['fmax_hz']:g} Hz, {route}, {damping}"),
+             f"  natural frequencies{' (undamped)' if direct else ''} [Hz]: {natural}",
              f"  {'point':<20}{'component':>10}{'largest |H|':>14}{'unit':>12}{'at [Hz]':>12}"]
     magnitude = np.abs(result.receptance)
     for p, c in significant_components(result.receptance):

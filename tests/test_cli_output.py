@@ -2,7 +2,8 @@
 
 * ``freqs``, ``modes``, ``frf`` and ``response`` on one model: the keys they
   share (``model``, ``frequencies_hz``, ``rigid_body_modes``) carry the same
-  values, and no other name for a natural frequency is left;
+  values, and no other name for a natural frequency is left (``freqs
+  --damped`` included);
 * ``modes`` and ``freqs`` give identical frequencies on every bundled model,
   ``modes`` from one solve (one deduction and root finder);
 * ``--csv`` files hold what the JSON holds, with the units in the headers;
@@ -73,6 +74,19 @@ def test_shared_keys_have_one_name_and_one_value(run):
             assert data[key] == reference[key], (command, key)
         assert not [key for key in data if "natural_freq" in key], command
     assert results["frf"]["excitation_hz"] == [10.0, 20.0, 30.0, 40.0, 50.0]
+
+
+def test_freqs_damped_follows_the_naming_scheme(run):
+    """Without damping the damped roots are the undamped ones: ``frequencies_hz`` (|s| / 2π) and
+    ``damped_frequencies_hz`` are then the frequencies ``freqs`` gives; no other name is used."""
+    undamped = json_of(run, "freqs", CANTILEVER, "--count", "4")
+    damped = json_of(run, "freqs", CANTILEVER, "--count", "4", "--damped")
+    for key in ("model", "rigid_body_modes"):
+        assert damped[key] == undamped[key], key
+    assert not [key for key in damped if "natural_freq" in key or key.endswith("_freq_hz")]
+    for key in ("frequencies_hz", "damped_frequencies_hz", "undamped_frequencies_hz"):
+        np.testing.assert_allclose(damped[key], undamped["frequencies_hz"], rtol=1e-10, err_msg=key)
+    assert np.abs(damped["damping_ratio"]).max() < 1e-10
 
 
 @pytest.mark.parametrize("path", MODELS, ids=[str(p.relative_to(ROOT / "models")) for p in MODELS])

@@ -115,12 +115,23 @@ def writing(model, option: str, path):
                          key=option) from error
 
 
+#: Library parameters whose option is not named after them.
+OPTION_OF = {"damping_ratio": "--zeta"}
+
+
+def option_of(parameter: str) -> str:
+    """The option that sets the library's ``parameter``: ``--response-points`` for
+    ``response_points``, ``--zeta`` for ``damping_ratio`` (:data:`OPTION_OF`)."""
+    return OPTION_OF.get(parameter, "--" + parameter.replace("_", "-"))
+
+
 @contextmanager
 def as_options(model, *parameters: str):
     """Name the option, not the library's parameter, in errors on ``parameters``.
 
-    A ModelError whose key is one of ``parameters`` (``response_points``) is
-    raised again with the key of the option (``--response-points``); a
+    A ModelError whose key is one of ``parameters`` (``response_points``,
+    ``damping_ratio``) is raised again with the key of the option
+    (``--response-points``, ``--zeta``: :func:`option_of`); a
     DampingRatioError becomes a ModelError on ``--zeta``.
     """
     try:
@@ -130,8 +141,7 @@ def as_options(model, *parameters: str):
     except ModelError as error:
         if error.key not in parameters:
             raise
-        raise ModelError(error.file, error.message, error.element,
-                         key="--" + error.key.replace("_", "-")) from error
+        raise ModelError(error.file, error.message, error.element, key=option_of(error.key)) from error
 
 
 def emit(args, model, data: dict, table, csv_table=None) -> None:

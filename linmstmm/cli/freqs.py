@@ -1,9 +1,14 @@
-"""``linmstmm freqs MODEL``: natural frequencies by the transfer matrix method."""
+"""``linmstmm freqs MODEL``: natural frequencies by the transfer matrix method.
+
+With ``--damped``, the damped natural frequencies and damping ratios
+(:mod:`linmstmm.cli.damped`).
+"""
 from __future__ import annotations
 
 import math
 
 from linmstmm import load_model, natural_frequencies
+from linmstmm.cli.damped import add_damped_option, run_damped
 from linmstmm.cli.common import (
     add_output_options,
     add_request_options,
@@ -27,11 +32,14 @@ def add_freqs_command(subparsers) -> None:
                        help="how det Ū_all is evaluated: the numpy carry, or numba-compiled kernels "
                             "(about 5x cheaper per evaluation, 0.5-1.5 s to start in a new process); "
                             "auto: numpy in a new process")
+    add_damped_option(freqs)
     freqs.set_defaults(run=run_freqs)
 
 
 def run_freqs(args) -> int:
     """Run ``linmstmm freqs``; returns the exit status 0."""
+    if args.damped:
+        return run_damped(args)
     model = load_model(args.model)
     count, fmax = request(args)
     with as_options(model, "root"), stages(args, "freqs"):

@@ -1,7 +1,9 @@
 """``linmstmm frf MODEL --point P --direction D --fmax HZ``: receptance between a load and response points.
 
-The computation is :func:`linmstmm.studies.frf_study`; ``--zeta`` and the
-refusal of a spring dashpot ``c`` are as for ``response``.
+The computation is :func:`linmstmm.studies.frf_study`: the modal sum, with
+``--zeta`` as for ``response``; a model with a spring dashpot ``c`` takes the
+direct route (:func:`linmstmm.direct_frf`, no modes), which refuses
+``--modes`` and ``--zeta`` by name.
 """
 from __future__ import annotations
 
@@ -51,7 +53,8 @@ def add_frf_command(subparsers) -> None:
 def run_frf(args) -> int:
     """Run ``linmstmm frf``; returns the exit status 0."""
     model = load_model(args.model)
-    with as_options(model, "point", "response_points", "direction", "fmax"), stages(args, "frf"):
+    with (as_options(model, "point", "response_points", "direction", "fmax", "modes", "damping_ratio"),
+          stages(args, "frf")):
         result, summary = frf_study(model, args.point, args.direction, args.fmax, frequencies=args.frequencies,
                                     response_points=args.response_points, modes=args.modes,
                                     damping_ratio=args.zeta)

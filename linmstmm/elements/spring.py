@@ -54,6 +54,40 @@ def spring_transfer(k, axes, omega, release=None) -> np.ndarray:
     return np.broadcast_to(U_single, (np.size(omega), 12, 12)).copy()
 
 
+def damped_spring_transfer(k, c, axes, rate, release=None) -> np.ndarray:
+    """Transfer matrix stack (n, 12, 12), complex, of a spring with dashpots.
+
+    Each direction has the complex stiffness ``k + rate c``: at circular
+    frequency ω of a harmonic motion ``rate = iω``, and ``rate = s`` at a
+    complex frequency s of ``e^{st}``.
+
+    Parameters
+    ----------
+    k : (6,) stiffnesses, N/m and N m/rad, ``inf`` allowed (rigid direction).
+    c : (6,) viscous damping, N s/m and N m s/rad, same layout.
+    axes : (3, 3) rows = the spring's local axes.
+    rate : (n,) complex, 1/s.
+    release : (6,) bool or None: released directions get zero compliance (their
+    jump is an unknown of its own, :func:`joint_jump`); a dashpot there is
+    refused before (:func:`linmstmm.forced.refuse_released_dashpots`).
+
+    Returns
+    -------
+    (n, 12, 12) complex: ``u_O = u_I − C_t q``, ``θ_O = θ_I − C_r m`` with the
+    compliances ``1 / (k + rate c)`` (0 in a rigid direction).
+    """
+    axes = np.asarray(axes, dtype=float)
+    rate = np.reshape(np.asarray(rate, dtype=complex), (-1, 1))
+    with np.errstate(divide="ignore"):  # k = 0, c = 0: a released direction, zeroed below
+        compliance = 1.0 / (np.asarray(k, dtype=float) + rate * np.asarray(c, dtype=float))  # (n, 6)
+    if release is not None:
+        compliance[:, np.asarray(release, bool)] = 0.0
+    stack = np.broadcast_to(np.eye(12, dtype=complex), (rate.shape[0], 12, 12)).copy()
+    stack[:, U, Q] = -np.einsum("ji,nj,jk->nik", axes, compliance[:, :3], axes)
+    stack[:, R, M] = -np.einsum("ji,nj,jk->nik", axes, compliance[:, 3:], axes)
+    return stack
+
+
 def joint_jump(axes, released) -> np.ndarray:
     """(12, r) E: the state jump across the spring from its released jumps Δ (r,).
 

@@ -260,15 +260,19 @@ def _secant_polished(finder, predictions: np.ndarray, start: int, stop: int,
     Cluster members too: the launcher's pairs 1e-4 apart at 5.7-21 krad/s are
     predicted to 2e-5, where Newton on the pencil does not converge. A result
     stands where it stayed within half the gap to the neighbouring prediction,
-    alone on its root, and, for a cluster member, converged to xtol (a multiple
-    root's det keeps its sign: the secant creeps to the rounding floor there).
+    alone on its root, and converged to xtol for a cluster member (a multiple
+    root's det keeps its sign: the secant creeps to the rounding floor there), to
+    CERTIFIED_STEP for the others (a secant that stalled above it on a noisy det,
+    1.3e-9 on a ring's 10th root, goes to the pencil).
     """
+    from linmstmm.roots import CERTIFIED_STEP  # roots imports this module
+
     found, steps = secant_roots(finder.log_det, predictions[start:stop], finder.xtol, finder.UNCERTAIN)
     in_cluster = np.zeros(predictions.size, dtype=bool)
     for group in _clusters(predictions):
         in_cluster[group] = len(group) > 1
     settled = np.array([not np.isnan(root) and abs(root - predictions[i]) <= 0.5 * _gap(predictions, i)
-                        and (not in_cluster[i] or steps[i - start] <= finder.xtol)
+                        and steps[i - start] <= (finder.xtol if in_cluster[i] else CERTIFIED_STEP)
                         and not _known(root, known, finder.SAME_ROOT)
                         for i, root in enumerate(found, start)], dtype=bool)
     for i in np.flatnonzero(settled):  # two that settled on one root: neither stands

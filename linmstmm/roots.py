@@ -681,10 +681,18 @@ class RootFinder:
         """The lowest ``count`` roots, warm-started from ``guesses`` (rad/s).
 
         Guesses (e.g. the roots of a neighbouring scene of the same model) are
-        polished all at once; the result stands only if one count over
-        (floor, just above the count-th root) confirms that none was
-        missed. Otherwise the full search runs.
+        taken as predictions (:func:`~linmstmm.predicted.predicted_roots`: the
+        secant on det, one certifying count); where that cannot certify them,
+        they are polished on the pencil and one count over (floor, just above
+        the count-th root) must confirm that none was missed. Otherwise the
+        full search runs.
         """
+        guesses = np.sort(np.asarray(guesses, dtype=float))
+        found = predicted_roots(self, guesses, count) if guesses.size >= count else None
+        if found is not None:
+            found = self._separated(found)
+            self._check_floor(found)
+            return found[:count]
         found = self._confirmed(self._polished(guesses, []), count)
         return found if found is not None else self._search(count, None)
 

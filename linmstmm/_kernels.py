@@ -149,18 +149,6 @@ def _multiply_rows(matrix, source, target):
 
 
 @njit(cache=True)
-def _multiply(matrix, source, target):
-    """target = matrix @ source, (12, 12) float by (12, k)."""
-    target[:, :] = 0.0
-    for i in range(12):
-        for j in range(12):
-            a = matrix[i, j]
-            if a != 0.0:
-                for c in range(source.shape[1]):
-                    target[i, c] += a * source[j, c]
-
-
-@njit(cache=True)
 def _place_add(source, target, place, sign, rows):
     for i in range(rows):
         for c in range(source.shape[1]):
@@ -339,7 +327,7 @@ def _run(program, omegas, work, reference, log_scale):
             elif code == CARRY:
                 target = _view(work[m], slot_offset[a], 12, slot_width[a])
                 source = _view(work[m], slot_offset[b], 12, slot_width[b])
-                _multiply(matrices[c], source, target)
+                _multiply_rows(matrices[c], source, target)
                 if d >= 0:
                     w2 = omegas[m] * omegas[m]
                     inertial = matrices[d]

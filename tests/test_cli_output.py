@@ -22,8 +22,9 @@ import pytest
 
 import linmstmm.solve
 from linmstmm import cli, mode_shapes, natural_frequencies
-from linmstmm.model import ModelError, load_model
+from linmstmm.model import load_model
 from linmstmm.stages import listening
+from builders import BUNDLED_MODELS
 
 ROOT = Path(__file__).resolve().parents[1]
 CANTILEVER = ROOT / "models" / "cantilever_tip_mass.toml"
@@ -31,15 +32,7 @@ CHAIN = ROOT / "models" / "spring_mass_chain.toml"
 STEP = ROOT / "models" / "loads" / "cantilever_step.toml"  # [output] modes = 10
 
 
-def is_model(path: Path) -> bool:
-    try:
-        load_model(path)
-    except ModelError:
-        return False
-    return True
-
-
-MODELS = [p for p in sorted((ROOT / "models").rglob("*.toml")) if is_model(p)]
+MODELS = BUNDLED_MODELS
 
 
 @pytest.fixture

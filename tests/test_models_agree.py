@@ -21,7 +21,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from linmstmm.model import ModelError, load_model
+from linmstmm.model import load_model
+from builders import BUNDLED_MODELS
 
 ROOT = Path(__file__).resolve().parents[1]
 AGREEMENT = 1e-7
@@ -31,15 +32,7 @@ LAUNCHER2 = ROOT / "models" / "launcher2" / "launcher2.toml"
 ROUNDING = 2e-15
 
 
-def is_model(path: Path) -> bool:
-    try:
-        load_model(path)
-    except ModelError:
-        return False
-    return True
-
-
-MODELS = [p for p in sorted((ROOT / "models").rglob("*.toml")) if is_model(p)]
+MODELS = BUNDLED_MODELS
 
 
 def run(*args) -> subprocess.CompletedProcess:

@@ -690,9 +690,7 @@ class RootFinder:
         guesses = np.sort(np.asarray(guesses, dtype=float))
         found = predicted_roots(self, guesses, count) if guesses.size >= count else None
         if found is not None:
-            found = self._separated(found)
-            self._check_floor(found)
-            return found[:count]
+            return self._separated_above_floor(found)[:count]
         found = self._confirmed(self._polished(guesses, []), count)
         return found if found is not None else self._search(count, None)
 
@@ -1107,15 +1105,20 @@ class RootFinder:
             predictions = self.predictor(count + PREDICTION_MARGIN + count // 10)
             found = predicted_roots(self, predictions, count) if self._usable(predictions) else None
             if found is not None:  # certified up to above the count-th: complete below omega_max too
-                found = self._separated(found)
-                self._check_floor(found)
+                found = self._separated_above_floor(found)
                 return [w for w in found[:count] if omega_max is None or w <= omega_max]
         found = self._scan_ahead(count, omega_max) if count is not None or omega_max is not None else None
         if found is None:
             found = self._search(count, omega_max)
+        found = self._separated_above_floor(found)
+        return found[:count] if count is not None else found
+
+    def _separated_above_floor(self, found: list[float]) -> list[float]:
+        """``found`` (rad/s) with each multiple root that is a cluster split into its roots
+        (:meth:`_separated`), then checked for roots below the floor (:meth:`_check_floor`)."""
         found = self._separated(found)
         self._check_floor(found)
-        return found[:count] if count is not None else found
+        return found
 
     def _usable(self, predictions: np.ndarray) -> bool:
         """False where the lowest prediction (rad/s) is below FLOOR_MARGIN floors: the

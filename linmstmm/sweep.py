@@ -33,7 +33,6 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from linmstmm.model import Model, ModelError
 from linmstmm.parameters import get_value, parse_key, with_values
@@ -335,6 +334,8 @@ def track(shapes, previous, count: int, length: float) -> tuple[np.ndarray, np.n
     mac : ndarray
         (steps, count): MAC of each column against the same column at the previous step.
     """
+    from scipy.optimize import linear_sum_assignment  # scipy.optimize costs every command 0.1 s to import
+
     steps = len(shapes)
     order = np.full((steps, count), -1, dtype=int)
     mac = np.full((steps, count), np.nan)

@@ -23,8 +23,8 @@ import mpmath
 import numpy as np
 
 from linmstmm.elements.frames import state_rotation
-from linmstmm.numeric import (cos, cosh, frequencies, is_mp, magnitude, sin, sin_over, sinh, sqrt,
-                              zeros_like_stack)
+from linmstmm.numeric import (constant_times, cos, cosh, frequencies, is_mp, magnitude, sin, sin_over, sinh,
+                              sqrt, zeros_like_stack)
 
 #: |βL| below which the Krylov functions are summed as power series.
 _SERIES_LIMIT = 2.0
@@ -166,7 +166,12 @@ def beam_transfer(beam, omega, reverse=False, length=None) -> np.ndarray:
     length : m, the piece starting at the input end (default: whole beam).
     """
     rotation = _state_rotation(tuple(np.ravel(beam.axes)), reverse)
-    return rotation @ beam_local_transfer(beam, omega, length) @ rotation.T
+    local = beam_local_transfer(beam, omega, length)
+    if not is_mp(local):
+        return rotation @ local @ rotation.T
+    # mpmath: only the rotation's non-zero entries multiply (three quarters are zero)
+    turned = constant_times(rotation, local)
+    return np.swapaxes(constant_times(rotation, np.swapaxes(turned, 1, 2)), 1, 2)
 
 
 @functools.lru_cache(maxsize=256)

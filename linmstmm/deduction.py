@@ -369,7 +369,7 @@ class Deduction:
     def periodic_runs(self) -> list:
         """Runs of a repeated cell in the carry order (:mod:`linmstmm.periodic`); found once."""
         if self._runs is None:
-            self._runs = find_runs(self.topology, self._polynomial_parts)
+            self._runs = find_runs(self.topology)
         return self._runs
 
     def _carry_run(self, run, omega, state, normaliser, rows, open_states):

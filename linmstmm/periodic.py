@@ -33,6 +33,10 @@ PAIRING_LIMIT = 1e4
 MIN_REPETITIONS = 8
 #: Longest cell looked for, elements.
 MAX_PERIOD = 4
+#: Entries of an element's :func:`signatures`.
+SIGNATURE_SIZE = 17
+#: Cells whose signatures agree to this (relative to each quantity's size) are equal.
+SAME = 1e-14
 
 
 @dataclass(frozen=True)
@@ -50,13 +54,13 @@ class Run:
         return self.start + len(self.cell) * self.repetitions
 
 
-def find_runs(topology, parts) -> list[Run]:
+def find_runs(topology) -> list[Run]:
     """Runs of a repeated cell of single-input rigid bodies, springs and junctions
     (not joints: a released direction adds an unknown and a row of its own).
 
-    parts : callable element id -> (kinematic, inertial or None), the element's
-    U = kinematic + ω² inertial. Inside a run every element's only input is the
-    previous element's output; equal cells have equal parts to 1e-14.
+    Inside a run every element's only input is the previous element's output,
+    and equal cells have equal :func:`signatures` (to 1e-14 of each quantity's
+    own size): the data their transfer matrices are made of.
     """
     order = topology.order
     elements = topology.elements
@@ -66,15 +70,13 @@ def find_runs(topology, parts) -> list[Run]:
                         for e in order])
     follows = np.array([i > 0 and elements[order[i]].ports[elements[order[i]].inputs[0]].link[:2]
                         == ("element", order[i - 1]) for i in range(size)])
-    stacked = [parts(e) if ok else (np.full((12, 12), np.nan), None) for e, ok in zip(order, chained)]
-    kinematic = np.array([k for k, _ in stacked])
-    inertial = np.array([np.zeros((12, 12)) if i is None else i for _, i in stacked])
-    has_inertial = np.array([i is not None for _, i in stacked])
+    values, scales = signatures([elements[e] for e in order], chained)
     streaks = {}
     for period in range(1, min(MAX_PERIOD, size - 1) + 1):
         # good[j]: element j + period repeats element j and is chained to its predecessor
-        good = (_close(kinematic[:-period], kinematic[period:]) & _close(inertial[:-period], inertial[period:])
-                & (has_inertial[:-period] == has_inertial[period:]) & chained[period:] & follows[period:])
+        tolerance = SAME * np.maximum(scales[:-period], scales[period:])
+        good = (np.all(np.abs(values[:-period] - values[period:]) <= tolerance, axis=1)
+                & chained[period:] & follows[period:])
         streak = np.zeros(size + 1, dtype=int)  # consecutive good from j on
         for j in range(len(good) - 1, -1, -1):
             streak[j] = streak[j + 1] + 1 if good[j] else 0
@@ -97,10 +99,34 @@ def find_runs(topology, parts) -> list[Run]:
     return runs
 
 
-def _close(a, b) -> np.ndarray:
-    """(m,) whether each pair of (12, 12) matrices agrees to 1e-14 of its size."""
-    scale = np.maximum(np.abs(a).max(axis=(1, 2)), np.abs(b).max(axis=(1, 2)))
-    return np.all(np.abs(a - b) <= 1e-14 * scale[:, None, None], axis=(1, 2))
+def signatures(elements, chained) -> tuple[np.ndarray, np.ndarray]:
+    """(values, scales), each (n, SIGNATURE_SIZE): what each element's transfer matrix is
+    made of, and the size each value is compared at.
+
+    A rigid body: mass (kg), inertia about its mass centre (kg m²), mass centre and
+    output port from the input port (m); a spring: compliances 1/k (0 where rigid)
+    and its axes. Differences of positions, not positions: a chain's cells far from
+    the origin are equal to their size, not to the origin's distance. Elements not
+    ``chained`` get NaN (equal to nothing); the first entry tells the kinds apart.
+    """
+    values = np.zeros((len(elements), SIGNATURE_SIZE))
+    scales = np.zeros((len(elements), SIGNATURE_SIZE))
+    for i, (element, ok) in enumerate(zip(elements, chained)):
+        if not ok:
+            values[i] = np.nan
+        elif element.kind == "rigid":
+            body = element.record
+            start = element.ports[element.inputs[0]].position
+            arms = np.concatenate([body.com - start, element.ports[element.output].position - start])
+            values[i] = np.concatenate([[1.0, body.mass], np.ravel(body.inertia), arms])
+            scales[i, 1:] = np.repeat([abs(body.mass), np.abs(body.inertia).max(), np.abs(arms).max()], [1, 9, 6])
+        elif element.kind == "spring":
+            compliance = 1 / np.asarray(element.record.k, dtype=float)
+            values[i, :16] = np.concatenate([[2.0], compliance, np.ravel(element.record.axes)])
+            scales[i, 1:16] = np.repeat([np.abs(compliance).max(), 1.0], [6, 9])
+        else:  # a junction: the identity
+            values[i, 0] = 3.0
+    return values, scales
 
 
 def pairing_growth(power: np.ndarray) -> np.ndarray:

@@ -7,6 +7,8 @@ ill-conditioned to power.
 """
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from test_extremes import chain_along_x, chain_reference_hz
@@ -41,6 +43,27 @@ def test_a_different_mass_splits_the_chain_into_two_runs():
     masses[20] = 2.0
     runs = deduction_of(chain_along_x(masses, [1e6] * 40)).periodic_runs()
     assert sorted(run.repetitions for run in runs) == [19, 20]
+
+
+@pytest.mark.parametrize("field", ["mass", "stiffness"])
+def test_a_difference_of_1e_12_splits_the_chain(field):
+    """Equal means equal to 1e-14 of the quantity itself: a cell 1e-12 off is not the same cell."""
+    masses, stiffnesses = [1.0] * 40, [1e6] * 40
+    (masses if field == "mass" else stiffnesses)[20] *= 1 + 1e-12
+    runs = deduction_of(chain_along_x(masses, stiffnesses)).periodic_runs()
+    assert len(runs) == 2
+
+
+def test_a_chain_far_from_the_origin_is_still_one_run():
+    """Cells are compared by differences of positions (lever arms), not by positions: 1e6 m
+    away, rounding of the coordinates (1e-10 m) must not split the run."""
+    model = chain_along_x([1.0] * 40, [1e6] * 40)
+    shift = np.array([1e6 + 0.1, -3e5, 0.0])
+    moved = dataclasses.replace(
+        model, points={name: x + shift for name, x in model.points.items()},
+        rigids=tuple(dataclasses.replace(body, com=body.com + shift) for body in model.rigids))
+    runs = deduction_of(moved).periodic_runs()
+    assert [(len(run.cell), run.repetitions) for run in runs] == [(2, 40)]
 
 
 def test_short_chains_have_no_runs():

@@ -109,23 +109,31 @@ def signatures(elements, chained) -> tuple[np.ndarray, np.ndarray]:
     the origin are equal to their size, not to the origin's distance. Elements not
     ``chained`` get NaN (equal to nothing); the first entry tells the kinds apart.
     """
-    values = np.zeros((len(elements), SIGNATURE_SIZE))
+    values = np.full((len(elements), SIGNATURE_SIZE), np.nan)
     scales = np.zeros((len(elements), SIGNATURE_SIZE))
-    for i, (element, ok) in enumerate(zip(elements, chained)):
-        if not ok:
-            values[i] = np.nan
-        elif element.kind == "rigid":
-            body = element.record
-            start = element.ports[element.inputs[0]].position
-            arms = np.concatenate([body.com - start, element.ports[element.output].position - start])
-            values[i] = np.concatenate([[1.0, body.mass], np.ravel(body.inertia), arms])
-            scales[i, 1:] = np.repeat([abs(body.mass), np.abs(body.inertia).max(), np.abs(arms).max()], [1, 9, 6])
-        elif element.kind == "spring":
-            compliance = 1 / np.asarray(element.record.k, dtype=float)
-            values[i, :16] = np.concatenate([[2.0], compliance, np.ravel(element.record.axes)])
-            scales[i, 1:16] = np.repeat([np.abs(compliance).max(), 1.0], [6, 9])
-        else:  # a junction: the identity
-            values[i, 0] = 3.0
+    kinds = np.array([element.kind if ok else "" for element, ok in zip(elements, chained)])
+    rigid = np.flatnonzero(kinds == "rigid")
+    if rigid.size:  # gathered in lists, computed in one go: a chain has thousands
+        bodies = [elements[i] for i in rigid]
+        start = np.array([body.ports[body.inputs[0]].position for body in bodies], dtype=float)
+        arms = np.hstack([np.array([body.record.com for body in bodies], dtype=float) - start,
+                          np.array([body.ports[body.output].position for body in bodies], dtype=float) - start])
+        mass = np.array([body.record.mass for body in bodies], dtype=float)
+        inertia = np.array([np.ravel(body.record.inertia) for body in bodies], dtype=float)
+        values[rigid] = np.hstack([np.ones((rigid.size, 1)), mass[:, None], inertia, arms])
+        scales[rigid, 1:] = np.hstack([np.abs(mass)[:, None],
+                                       np.repeat(np.abs(inertia).max(axis=1, keepdims=True), 9, axis=1),
+                                       np.repeat(np.abs(arms).max(axis=1, keepdims=True), 6, axis=1)])
+    spring = np.flatnonzero(kinds == "spring")
+    if spring.size:
+        compliance = 1 / np.array([elements[i].record.k for i in spring], dtype=float)
+        axes = np.array([np.ravel(elements[i].record.axes) for i in spring], dtype=float)
+        values[spring] = np.hstack([np.full((spring.size, 1), 2.0), compliance, axes, np.zeros((spring.size, 1))])
+        scales[spring, 1:16] = np.hstack([np.repeat(np.abs(compliance).max(axis=1, keepdims=True), 6, axis=1),
+                                          np.ones((spring.size, 9))])
+    junction = np.flatnonzero(kinds == "junction")
+    values[junction] = 0.0
+    values[junction, 0] = 3.0
     return values, scales
 
 

@@ -116,24 +116,18 @@ class DampedResult(Result):
         return cls(data["model"], pairs[:, 0] + 1j * pairs[:, 1], decode_array(data["undamped_frequencies_hz"]),
                    data["rigid_body_modes"], data["seconds"])
 
-    def plot(self, title: str = ""):
-        """Damping ratio against damped natural frequency, the undamped natural
-        frequencies marked (:func:`linmstmm.plot.damped_figure`).
-
-        Parameters
-        ----------
-        title : str
-            The figure's title (default: the model's name).
+    def plot(self):
+        """Draw ζ against the damped natural frequency, the undamped ones as dotted lines.
 
         Returns
         -------
         matplotlib.figure.Figure
-            Not saved; matplotlib is imported on this call.
+            One axis (:func:`linmstmm.plot.damped_figure`), unsaved.
         """
         from linmstmm.plot import damped_figure
 
         return damped_figure(self.damped_frequencies_hz, self.damping_ratio, self.undamped_frequencies_hz,
-                             title=title or f"{self.model}: damped natural frequencies")
+                             title=f"{self.model}: damped natural frequencies")
 
 
 def damped_log_det(model: Model, root: str | None = None):

@@ -1158,24 +1158,18 @@ class FEResult(Result):
                    decode_array(data["error_estimate"]), data["elements_per_beam"], data["n_dof"], data["seconds"],
                    None if shapes is None else decode_array(shapes, ndim=2), data.get("note", ""))
 
-    def plot(self, title: str = ""):
-        """The frequencies against their mode number, and below them their estimated
-        relative errors (:func:`linmstmm.plot.frequency_figure`).
-
-        Parameters
-        ----------
-        title : str
-            The figure's title (default: the model's name and the method).
+    def plot(self):
+        """Draw the frequencies against their mode number and, on a second axis, their estimated errors.
 
         Returns
         -------
         matplotlib.figure.Figure
-            Not saved; matplotlib is imported on this call.
+            Unsaved (:func:`linmstmm.plot.frequency_figure` with ``error_estimate``).
         """
         from linmstmm.plot import frequency_figure
 
         return frequency_figure(self.frequencies_hz, self.rigid_body_modes, self.error_estimate,
-                                title=title or f"{self.model}: natural frequencies (finite elements)")
+                                title=f"{self.model}: natural frequencies (finite elements)")
 
 
 def _romberg(values, max_order: int = 4):

@@ -26,7 +26,7 @@ from linmstmm.response import QUANTITY_UNITS
 
 __all__ = ["AMPLITUDE", "animate_mode", "damped_figure", "frequency_figure", "frf_figure", "mode_shape_figure",
            "plot_frf", "plot_mac", "plot_mode", "plot_response", "plot_scan", "response_figure",
-           "significant_components", "sweep_figure"]
+           "scan_figure", "significant_components", "sweep_figure"]
 
 #: FRF components below this fraction of the largest of their kind are not drawn.
 SIGNIFICANT = 1e-6
@@ -50,7 +50,12 @@ def _canvas(figsize, rows=1, columns=1, **options):
 # --- determinant scan ---------------------------------------------------------------
 
 def plot_scan(omegas, sign, log_abs, roots, count, path, title: str = "") -> None:
-    """Write the det/count scan figure.
+    """Write the det/count scan figure (:func:`scan_figure`, same arguments but the path) as a PNG."""
+    scan_figure(omegas, sign, log_abs, roots, count, title).savefig(path, format="png", dpi=_DPI)
+
+
+def scan_figure(omegas, sign, log_abs, roots, count, title: str = "") -> Figure:
+    """The det/count scan figure, not yet saved.
 
     omegas : (n,) scanned circular frequencies, rad/s. sign, log_abs : (n,)
     sign and natural log of |det Ū_all| there. roots : natural frequencies
@@ -81,7 +86,7 @@ def plot_scan(omegas, sign, log_abs, roots, count, path, title: str = "") -> Non
     bottom.set_ylabel("N(f): roots ≤ f")
     bottom.set_xlabel("frequency [Hz]")
     bottom.set_xlim(hz[0], hz[-1])
-    figure.savefig(path, format="png", dpi=_DPI)
+    return figure
 
 
 # --- response and FRF ---------------------------------------------------------------

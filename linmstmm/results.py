@@ -4,11 +4,12 @@
 (:class:`~linmstmm.solve.FrequencyResult`, :class:`~linmstmm.modes.ModalResult`,
 :class:`~linmstmm.fe.FEResult`, :class:`~linmstmm.damped.DampedResult`,
 :class:`~linmstmm.response.ResponseResult`, :class:`~linmstmm.response.FRFResult`,
-:class:`~linmstmm.sweep.SweepResult`). Each subclass gives
+:class:`~linmstmm.sweep.SweepResult`, :class:`~linmstmm.studies.ScanResult`). Each subclass gives
 
 * ``to_dict()``: its JSON object (what the command line prints);
 * ``_restoring_dict()``: what ``to_dict`` leaves out that rebuilding needs
-  (mode shapes, the augmented eigenvectors, modal coordinates; none for most);
+  (mode shapes, the augmented eigenvectors, modal coordinates, a scan's grid;
+  none for most);
 * ``_from_data(data)``: the object rebuilt from the two together;
 * ``plot(...)``: its figure.
 

@@ -91,23 +91,18 @@ class FrequencyResult(Result):
                    data["indeterminate_released"], data.get("frequencies_hz_text"), data.get("omega_rad_s_text"),
                    data["evaluations"])
 
-    def plot(self, title: str = ""):
-        """The frequencies against their mode number (:func:`linmstmm.plot.frequency_figure`).
-
-        Parameters
-        ----------
-        title : str
-            The figure's title (default: the model's name and the method).
+    def plot(self):
+        """Draw the frequencies against their mode number.
 
         Returns
         -------
         matplotlib.figure.Figure
-            Not saved; matplotlib is imported on this call.
+            :func:`linmstmm.plot.frequency_figure`, titled by the model and method; unsaved.
         """
         from linmstmm.plot import frequency_figure
 
-        return frequency_figure(self.frequencies_hz, self.rigid_body_modes,
-                                title=title or f"{self.model}: natural frequencies (transfer matrix method)")
+        title = f"{self.model}: natural frequencies (transfer matrix method)"
+        return frequency_figure(self.frequencies_hz, self.rigid_body_modes, title=title)
 
 
 def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: str = "auto", **options):

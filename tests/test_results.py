@@ -26,6 +26,7 @@ from matplotlib.figure import Figure  # noqa: E402
 import linmstmm as lm  # noqa: E402
 from linmstmm.response import step  # noqa: E402
 from linmstmm.results import Result, decode_array, encode_array  # noqa: E402
+from linmstmm.studies import ScanResult, determinant_scan  # noqa: E402
 from linmstmm.sweep import SweepResult, Vary, grid, sweep  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -112,6 +113,10 @@ def _sweep(_):
     return sweep(model, steps, count=3, shape=shape, sensitivity=True)
 
 
+def _scan(models):
+    return determinant_scan(models["cantilever"], fmax=60.0, points=200)
+
+
 #: name -> (result class, builder from the shared models)
 BUILDS = {
     "launcher frequencies": (lm.FrequencyResult, _launcher_frequencies),
@@ -122,6 +127,7 @@ BUILDS = {
     "response": (lm.ResponseResult, _response),
     "frf": (lm.FRFResult, _frf),
     "sweep": (SweepResult, _sweep),
+    "scan": (ScanResult, _scan),
 }
 #: The classes whose to_dict (the command line's object) holds everything.
 COMPLETE_DICT = {lm.FrequencyResult, lm.DampedResult, lm.FRFResult, SweepResult}
@@ -136,7 +142,7 @@ def results(cantilever, cantilever_modes):
 def test_every_result_class_derives_from_the_base_with_its_own_kind():
     classes = {cls for cls, _ in BUILDS.values()}
     assert all(issubclass(cls, lm.Result) for cls in classes)
-    assert len({cls.kind for cls in classes}) == len(classes) == 7
+    assert len({cls.kind for cls in classes}) == len(classes) == 8
     assert lm.Result is Result
 
 
@@ -162,6 +168,7 @@ def test_the_results_hold_what_the_round_trips_must_keep(results):
     assert results["modes"].port_states and results["modes"].boundary_unknowns.size
     assert results["sweep"].sensitivities and results["sweep"].order.dtype.kind == "i"
     assert len(results["sweep"].shape) == 2 and np.isnan(results["sweep"].frequencies_hz_by_rank).sum() == 0
+    assert results["scan"].roots.size == 4 and results["scan"].omega.size == 200
 
 
 @pytest.mark.parametrize("name", BUILDS)
@@ -177,7 +184,7 @@ def test_from_dict_of_to_dict(results, name):
     assert cls.__name__ in str(error.value)
 
 
-@pytest.mark.parametrize("name", ["launcher frequencies", "modes", "fe", "damped", "response", "frf", "sweep"])
+@pytest.mark.parametrize("name", ["launcher frequencies", "modes", "fe", "damped", "response", "frf", "sweep", "scan"])
 def test_load_refuses_a_file_of_another_kind(results, name, tmp_path):
     result = results[name]
     path = tmp_path / "result.json"
@@ -245,6 +252,9 @@ def test_the_figures_draw_the_results_numbers(results, cantilever):
     swept = results["sweep"]
     lines = swept.plot().axes[0].get_lines()
     assert len(lines) == swept.frequencies_hz.shape[1] * 2  # a line per mode and per value of the second key
+    scan = results["scan"]
+    count, = [line for line in scan.plot().axes[1].get_lines() if line.get_drawstyle() == "steps-post"]
+    assert np.array_equal(count.get_ydata(), scan.count())
 
 
 def test_matplotlib_is_imported_by_plot_only(tmp_path):

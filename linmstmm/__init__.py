@@ -25,7 +25,10 @@ Public names (each documented where it is defined):
   (complex roots of det Ū_all);
 * parameter studies: the modules :mod:`linmstmm.parameters` (keys naming
   model values), :mod:`linmstmm.sweep` (sweeps with modes tracked by MAC)
-  and :mod:`linmstmm.sensitivity` (∂f/∂p from the mode shapes).
+  and :mod:`linmstmm.sensitivity` (∂f/∂p from the mode shapes);
+* results: :class:`Result`, the base of every result class above
+  (``to_dict``/``from_dict``, ``save``/``load`` as JSON, ``plot()`` returning
+  a matplotlib Figure).
 
 The names are imported on first use, so ``import linmstmm`` stays light
 (in particular, matplotlib is only imported by the plotting functions).
@@ -65,6 +68,7 @@ _SOURCES = {
     "parameters": "linmstmm.parameters",
     "sweep": "linmstmm.sweep",
     "sensitivity": "linmstmm.sensitivity",
+    "Result": "linmstmm.results",
 }
 
 #: Public names that are modules (the rest are defined in their module).

@@ -27,6 +27,7 @@ from linmstmm.counting import count_inside
 from linmstmm.forced import rayleigh_equivalent, refuse_released_dashpots, released_deduction
 from linmstmm.model import Model
 from linmstmm.modes import SAME_FREQUENCY, _group
+from linmstmm.results import Result, decode_array
 from linmstmm.solve import natural_frequencies
 from linmstmm.threads import single_blas_thread
 from linmstmm.topology import build_topology
@@ -48,7 +49,7 @@ HEIGHT = 1.5
 
 
 @dataclass(frozen=True)
-class DampedResult:
+class DampedResult(Result):
     """Damped natural frequencies, ascending in damped frequency.
 
     Attributes
@@ -73,6 +74,8 @@ class DampedResult:
     undamped_frequencies_hz: np.ndarray
     rigid_body_modes: int
     seconds: float
+
+    kind = "damped"
 
     @property
     def damped_frequencies_hz(self) -> np.ndarray:
@@ -105,6 +108,26 @@ class DampedResult:
                 "undamped_frequencies_hz": self.undamped_frequencies_hz.tolist(),
                 "rigid_body_modes": int(self.rigid_body_modes), "seconds": float(self.seconds),
                 "method": "mstmm-damped"}
+
+    @classmethod
+    def _from_data(cls, data: dict) -> DampedResult:
+        """The result :meth:`to_dict` describes (which holds all of it)."""
+        pairs = decode_array(data["roots"], ndim=2).reshape(-1, 2)
+        return cls(data["model"], pairs[:, 0] + 1j * pairs[:, 1], decode_array(data["undamped_frequencies_hz"]),
+                   data["rigid_body_modes"], data["seconds"])
+
+    def plot(self):
+        """Draw ζ against the damped natural frequency, the undamped ones as dotted lines.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            One axis (:func:`linmstmm.plot.damped_figure`), unsaved.
+        """
+        from linmstmm.plot import damped_figure
+
+        return damped_figure(self.damped_frequencies_hz, self.damping_ratio, self.undamped_frequencies_hz,
+                             title=f"{self.model}: damped natural frequencies")
 
 
 def damped_log_det(model: Model, root: str | None = None):

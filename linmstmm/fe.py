@@ -99,6 +99,7 @@ from scipy.sparse.linalg import LinearOperator, eigsh, splu
 
 from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Beam, Model, Rigid
+from linmstmm.results import Result, decode_array, encode_array
 
 #: A substituted constraint row whose entries all fall below this fraction of
 #: the largest term that entered it is redundant (implied by earlier rows).
@@ -1094,7 +1095,7 @@ def fe_modes(fe: FEModel, count=10, lam_max=None, at_least=0):
 # Frequencies with mesh refinement
 
 @dataclass(frozen=True, eq=False)
-class FEResult:
+class FEResult(Result):
     """Natural frequencies by the finite-element route.
 
     frequencies_hz : (m,) elastic natural frequencies, ascending, Hz, each
@@ -1124,6 +1125,8 @@ class FEResult:
     mode_shapes: np.ndarray | None = None
     note: str = ""
 
+    kind = "fe"
+
     def to_dict(self) -> dict:
         """JSON-ready summary (the ``freqs --json`` keys plus the FE ones).
 
@@ -1142,6 +1145,31 @@ class FEResult:
                 "seconds": float(self.seconds),
                 "method": "fe",
                 **({"note": self.note} if self.note else {})}
+
+    def _restoring_dict(self) -> dict:
+        """The mode shapes :meth:`to_dict` leaves out (None when not computed)."""
+        return {"mode_shapes": None if self.mode_shapes is None else encode_array(self.mode_shapes)}
+
+    @classmethod
+    def _from_data(cls, data: dict) -> FEResult:
+        """The result :meth:`~linmstmm.results.Result.to_record` describes."""
+        shapes = data["mode_shapes"]
+        return cls(data["model"], decode_array(data["frequencies_hz"]), data["rigid_body_modes"],
+                   decode_array(data["error_estimate"]), data["elements_per_beam"], data["n_dof"], data["seconds"],
+                   None if shapes is None else decode_array(shapes, ndim=2), data.get("note", ""))
+
+    def plot(self):
+        """Draw the frequencies against their mode number and, on a second axis, their estimated errors.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            Unsaved (:func:`linmstmm.plot.frequency_figure` with ``error_estimate``).
+        """
+        from linmstmm.plot import frequency_figure
+
+        return frequency_figure(self.frequencies_hz, self.rigid_body_modes, self.error_estimate,
+                                title=f"{self.model}: natural frequencies (finite elements)")
 
 
 def _romberg(values, max_order: int = 4):

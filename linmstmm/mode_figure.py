@@ -1,7 +1,8 @@
 """Mode-shape figures: three orthographic views and an isometric view of one mode.
 
 :func:`plot_mode` writes a PNG, :func:`animate_mode` an animated GIF (one
-period of the motion, a single shared palette). Both are re-exported by
+period of the motion, a single shared palette), :func:`mode_shape_figure`
+returns the PNG's figure unsaved. All three are re-exported by
 :mod:`linmstmm.plot`. Every view is a 2-D projection drawn on matplotlib's
 Agg canvas; no window is opened and pyplot's global state is not touched.
 
@@ -127,11 +128,16 @@ def plot_mode(result: ModalResult, model: Model, k: int, path) -> None:
     by |translation| as a fraction of the largest; the title gives the mode
     number (from 1), the frequency, the modal mass and the drawing scale.
     """
+    mode_shape_figure(result, model, k).savefig(path, format="png", dpi=_DPI)
+
+
+def mode_shape_figure(result: ModalResult, model: Model, k: int) -> Figure:
+    """The figure :func:`plot_mode` writes (same arguments but the path), not yet saved."""
     scene = _scene(result, model, k)
     figure, views = _mode_canvas(scene)
     for view in views:
         view.pose(1.0)
-    figure.savefig(path, format="png", dpi=_DPI)
+    return figure
 
 
 def animate_mode(result: ModalResult, model: Model, k: int, path,

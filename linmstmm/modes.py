@@ -37,6 +37,7 @@ from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import beam_transfer
 from linmstmm.model import Model, ModelError
 from linmstmm.nullspace import NULL_TOLERANCE, equilibration
+from linmstmm.results import Result, decode_array, decode_arrays, encode_array
 from linmstmm.solve import search_note, solve_roots
 from linmstmm.stages import report
 from linmstmm.threads import single_blas_thread
@@ -77,7 +78,7 @@ class BeamField:
 
 
 @dataclass(frozen=True, eq=False)
-class ModalResult:
+class ModalResult(Result):
     """Modes of a model, ascending in frequency (rigid-body modes first).
 
     omega : (n,) rad/s; ``frequencies_hz`` (n,) Hz.
@@ -112,6 +113,8 @@ class ModalResult:
     beam_fields: dict[str, BeamField]
     normalization: str
     note: str = ""
+
+    kind = "modes"
 
     @property
     def frequencies_hz(self) -> np.ndarray:
@@ -204,6 +207,50 @@ class ModalResult:
                                 "displacements": f.displacements.tolist()}
                             for b, f in self.beam_fields.items()},
         }
+
+    def _restoring_dict(self) -> dict:
+        """The augmented eigenvectors :meth:`to_dict` leaves out: z̄, its column labels and the port states."""
+        return {"boundary_unknowns": encode_array(self.boundary_unknowns),
+                "unknown_labels": list(self.unknown_labels),
+                "port_states": {port: encode_array(states) for port, states in self.port_states.items()}}
+
+    @classmethod
+    def _from_data(cls, data: dict) -> ModalResult:
+        """The result :meth:`~linmstmm.results.Result.to_record` describes."""
+        fields = {name: BeamField(decode_array(f["stations"]), decode_array(f["positions"], ndim=2),
+                                  decode_array(f["displacements"], ndim=3))
+                  for name, f in data["beam_fields"].items()}
+        return cls(data["model"], decode_array(data["omega"]), data["rigid_body_modes"],
+                   decode_array(data["modal_mass"]), decode_array(data["modal_stiffness"]),
+                   decode_array(data["orthogonality_mass"], ndim=2),
+                   decode_array(data["orthogonality_stiffness"], ndim=2),
+                   decode_array(data["boundary_unknowns"], ndim=2), tuple(data["unknown_labels"]),
+                   decode_arrays(data["port_states"], ndim=2), decode_arrays(data["point_displacements"], ndim=2),
+                   decode_arrays(data["com_displacements"], ndim=2), fields, data["normalization"],
+                   data.get("note", ""))
+
+    def plot(self, model: Model, mode: int = 0):
+        """One mode drawn over the undeformed ``model`` (:func:`linmstmm.plot.mode_shape_figure`).
+
+        Three orthographic views and an isometric one, coloured by the size
+        of the translation; the title gives the frequency, modal mass and
+        drawing scale.
+
+        Parameters
+        ----------
+        model : Model
+            The model these modes are of (its points, bodies and springs).
+        mode : int
+            Index of the mode, from 0 (rigid-body modes first).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            Not saved; matplotlib is imported on this call.
+        """
+        from linmstmm.plot import mode_shape_figure
+
+        return mode_shape_figure(self, model, mode)
 
 
 def mac_matrix(a, b) -> np.ndarray:

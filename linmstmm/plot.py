@@ -1,8 +1,10 @@
-"""Figures of modes, determinant scans, responses, FRFs and MAC matrices.
+"""Figures of modes, determinant scans, responses, FRFs, frequencies, sweeps and MAC matrices.
 
-Every function draws on matplotlib's Agg canvas straight into a file (PNG,
-or GIF for :func:`animate_mode`); no window is opened and pyplot's global
-state is not touched.
+Every function draws on matplotlib's Agg canvas: the ``plot_*`` and
+``animate_mode`` functions straight into a file (PNG, or GIF for
+:func:`animate_mode`), the ``*_figure`` functions into a Figure they return
+unsaved (what the results' ``plot()`` methods give). No window is opened and
+pyplot's global state is not touched.
 
 The mode figures (:func:`plot_mode`, :func:`animate_mode`: three
 orthographic views and an isometric one) are drawn by
@@ -18,12 +20,13 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MaxNLocator
 
-from linmstmm.mode_figure import AMPLITUDE, animate_mode, plot_mode
+from linmstmm.mode_figure import AMPLITUDE, animate_mode, mode_shape_figure, plot_mode
 from linmstmm.model import COMPONENTS
 from linmstmm.response import QUANTITY_UNITS
 
-__all__ = ["AMPLITUDE", "animate_mode", "frf_figure", "plot_frf", "plot_mac", "plot_mode", "plot_response",
-           "plot_scan", "significant_components"]
+__all__ = ["AMPLITUDE", "animate_mode", "damped_figure", "frequency_figure", "frf_figure", "mode_shape_figure",
+           "plot_frf", "plot_mac", "plot_mode", "plot_response", "plot_scan", "response_figure",
+           "scan_figure", "significant_components", "sweep_figure"]
 
 #: FRF components below this fraction of the largest of their kind are not drawn.
 SIGNIFICANT = 1e-6
@@ -47,7 +50,12 @@ def _canvas(figsize, rows=1, columns=1, **options):
 # --- determinant scan ---------------------------------------------------------------
 
 def plot_scan(omegas, sign, log_abs, roots, count, path, title: str = "") -> None:
-    """Write the det/count scan figure.
+    """Write the det/count scan figure (:func:`scan_figure`, same arguments but the path) as a PNG."""
+    scan_figure(omegas, sign, log_abs, roots, count, title).savefig(path, format="png", dpi=_DPI)
+
+
+def scan_figure(omegas, sign, log_abs, roots, count, title: str = "") -> Figure:
+    """The det/count scan figure, not yet saved.
 
     omegas : (n,) scanned circular frequencies, rad/s. sign, log_abs : (n,)
     sign and natural log of |det Ū_all| there. roots : natural frequencies
@@ -78,13 +86,19 @@ def plot_scan(omegas, sign, log_abs, roots, count, path, title: str = "") -> Non
     bottom.set_ylabel("N(f): roots ≤ f")
     bottom.set_xlabel("frequency [Hz]")
     bottom.set_xlim(hz[0], hz[-1])
-    figure.savefig(path, format="png", dpi=_DPI)
+    return figure
 
 
 # --- response and FRF ---------------------------------------------------------------
 
 def plot_response(result, path, quantity: str = "displacement", title: str = "") -> None:
-    """Write the response histories of a :class:`linmstmm.response.ResponseResult`.
+    """Write the response histories of a :class:`linmstmm.response.ResponseResult`
+    (:func:`response_figure`, same arguments but the path) as a PNG."""
+    response_figure(result, quantity, title).savefig(path, format="png", dpi=_DPI)
+
+
+def response_figure(result, quantity: str = "displacement", title: str = "") -> Figure:
+    """The response histories of a :class:`linmstmm.response.ResponseResult`, not yet saved.
 
     One row per response point: translations x, y, z on the left, rotations
     on the right. quantity : "displacement", "velocity" or "acceleration".
@@ -108,7 +122,7 @@ def plot_response(result, path, quantity: str = "displacement", title: str = "")
     axes[0, 0].set_title(f"{quantity}: translations")
     axes[0, 1].set_title(f"{quantity}: rotations")
     figure.suptitle(title or f"modal response, {quantity}")
-    figure.savefig(path, format="png", dpi=_DPI)
+    return figure
 
 
 def plot_frf(result, path, natural_hz=(), load_unit: str = "N", title: str = "") -> None:
@@ -203,6 +217,87 @@ def significant_components(receptance) -> list[tuple[int, int]]:
     for kind in (slice(0, 3), slice(3, 6)):
         chosen[:, kind] = (peak[:, kind] > 0) & (peak[:, kind] >= SIGNIFICANT * peak[:, kind].max(initial=0.0))
     return [(int(p), int(c)) for p, c in zip(*np.nonzero(chosen))]
+
+
+# --- frequencies, damped frequencies and sweeps -------------------------------------
+
+def frequency_figure(frequencies_hz, rigid_body_modes: int = 0, error_estimate=None, title: str = "") -> Figure:
+    """Natural frequencies against their mode number, not yet saved.
+
+    frequencies_hz : (n,) elastic natural frequencies, Hz, ascending (a repeated
+    one once per multiplicity). rigid_body_modes : zero-frequency modes, named
+    in the legend. error_estimate : (n,) relative error estimates of the
+    frequencies (e.g. the FE route's), drawn on a second axis below; None: none.
+    """
+    frequencies = np.asarray(frequencies_hz, dtype=float)
+    panels = 1 if error_estimate is None else 2
+    figure, axes = _canvas((7.0, 2.0 + 2.4 * panels), panels, 1, sharex=True)
+    number = np.arange(1, frequencies.size + 1)
+    top = axes[0, 0]
+    top.plot(number, frequencies, "o", color="tab:blue", markersize=4,
+             label=f"elastic modes ({rigid_body_modes} rigid-body modes at 0 Hz not shown)")
+    top.set_ylabel("natural frequency [Hz]")
+    top.legend(fontsize=8, loc="upper left")
+    top.grid(alpha=0.3)
+    top.set_title(title or "natural frequencies")
+    if error_estimate is not None:
+        bottom = axes[1, 0]
+        bottom.semilogy(number, np.asarray(error_estimate, dtype=float), "s", color="tab:orange", markersize=4)
+        bottom.set_ylabel("estimated relative error")
+        bottom.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel("elastic mode number")
+    axes[-1, 0].xaxis.set_major_locator(MaxNLocator(integer=True))
+    return figure
+
+
+def damped_figure(damped_hz, damping_ratio, undamped_hz=(), title: str = "") -> Figure:
+    """Damping ratio against damped natural frequency, not yet saved.
+
+    damped_hz : (n,) damped natural frequencies ω_d / 2π, Hz. damping_ratio :
+    (n,) ζ. undamped_hz : the undamped natural frequencies, Hz, marked by
+    dotted lines.
+    """
+    figure, axes = _canvas((7.0, 4.4))
+    axis = axes[0, 0]
+    for frequency in undamped_hz:
+        axis.axvline(frequency, color="0.5", ls=":", lw=0.8)
+    axis.plot(damped_hz, damping_ratio, "o", color="tab:red", markersize=5, label="damped mode")
+    axis.legend(handles=[*axis.get_legend_handles_labels()[0],
+                         Line2D([], [], color="0.5", ls=":", label="undamped natural frequency")],
+                fontsize=8, loc="best")
+    axis.set_xlabel("damped natural frequency ω_d / 2π [Hz]")
+    axis.set_ylabel("damping ratio ζ [-]")
+    axis.set_ylim(bottom=0.0)
+    axis.grid(alpha=0.3)
+    axis.set_title(title or "damped natural frequencies")
+    return figure
+
+
+def sweep_figure(result, log_x: bool = False) -> Figure:
+    """The tracked frequencies (Hz) of a :class:`linmstmm.sweep.SweepResult` against its first key, not yet saved.
+
+    One colour per tracked column; with a grid of several keys, one line per
+    combination of the other keys' values. log_x : logarithmic value axis.
+    """
+    figure, axes = _canvas((7.5, 4.8))
+    axis = axes[0, 0]
+    lines = result.values.shape[0] // result.shape[0]
+    x = result.values[:, 0].reshape(result.shape[0], lines)
+    frequencies = result.frequencies_hz.reshape(result.shape[0], lines, -1)
+    for column in range(frequencies.shape[2]):
+        colour = f"C{column % 10}"
+        for line in range(lines):
+            axis.plot(x[:, line], frequencies[:, line, column], "-o", color=colour, markersize=2.5,
+                      lw=1.2, label=f"mode {column + 1}" if line == 0 else None)
+    if log_x:
+        axis.set_xscale("log")
+    axis.set_xlabel(result.keys[0])
+    axis.set_ylabel("natural frequency [Hz]")
+    others = f"; one line per value of {', '.join(result.keys[1:])}" if len(result.shape) > 1 else ""
+    axis.set_title(f"{result.model}: modes followed by shape (MAC){others}", fontsize=9)
+    axis.legend(fontsize=8)
+    axis.grid(alpha=0.3)
+    return figure
 
 
 # --- MAC ----------------------------------------------------------------------------

@@ -94,6 +94,7 @@ import numpy as np
 
 from linmstmm.model import Model, ModelError, _did_you_mean, _read_toml, _Table
 from linmstmm.modes import ModalResult, mode_shapes
+from linmstmm.results import Result, decode_array, decode_arrays, encode_array
 
 #: Default [output] values of a load file.
 DEFAULT_DURATION = 1.0
@@ -214,7 +215,7 @@ class LoadCase:
 
 
 @dataclass(frozen=True, eq=False)
-class ResponseResult:
+class ResponseResult(Result):
     """Response histories.
 
     times : (n_t,) s. points : names, in order.
@@ -241,6 +242,8 @@ class ResponseResult:
     frequencies_hz: np.ndarray = field(default_factory=lambda: np.empty(0))
     rigid_body_modes: int = 0
 
+    kind = "response"
+
     def to_dict(self) -> dict:
         """Plain JSON-ready dictionary: point -> lists (n_t, 6); ``units`` per quantity and component.
 
@@ -261,6 +264,43 @@ class ResponseResult:
                                         ("velocity", self.velocity),
                                         ("acceleration", self.acceleration))}}
 
+    def _restoring_dict(self) -> dict:
+        """The modal coordinates :meth:`to_dict` leaves out."""
+        return {"modal": encode_array(self.modal)}
+
+    @classmethod
+    def _from_data(cls, data: dict) -> ResponseResult:
+        """The result :meth:`~linmstmm.results.Result.to_record` describes."""
+        points, times = tuple(data["points"]), decode_array(data["times"])
+
+        def histories(name):  # point -> (n_t, 6) back to (n_t, n_points, 6)
+            by_point = decode_arrays(data[name], ndim=2)
+            return np.stack([by_point[p] for p in points], axis=1) if points else np.empty((times.size, 0, 6))
+
+        return cls(times, points, histories("displacement"), histories("velocity"), histories("acceleration"),
+                   decode_array(data["modal"], ndim=2), data["elastic_modes"], data["static_correction"],
+                   data.get("note", ""), decode_array(data["frequencies_hz"]), data["rigid_body_modes"])
+
+    def plot(self, quantity: str = "displacement", title: str = ""):
+        """The histories at every point (:func:`linmstmm.plot.response_figure`): a row per
+        point, translations on the left, rotations on the right.
+
+        Parameters
+        ----------
+        quantity : str
+            "displacement", "velocity" or "acceleration".
+        title : str
+            The figure's title (default: "modal response, " and the quantity).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            Not saved; matplotlib is imported on this call.
+        """
+        from linmstmm.plot import response_figure
+
+        return response_figure(self, quantity, title)
+
 
 #: SI units of each response quantity: (translations, rotations).
 QUANTITY_UNITS = {"displacement": ("m", "rad"), "velocity": ("m/s", "rad/s"),
@@ -274,7 +314,7 @@ def quantity_units(quantity: str) -> list[str]:
 
 
 @dataclass(frozen=True, eq=False)
-class FRFResult:
+class FRFResult(Result):
     """Receptance between one load direction and the points.
 
     excitation_hz : (n_f,) excitation frequencies, Hz. points : names. receptance : (n_f, n_points, 6)
@@ -284,6 +324,8 @@ class FRFResult:
     excitation_hz: np.ndarray
     points: tuple[str, ...]
     receptance: np.ndarray
+
+    kind = "frf"
 
     @property
     def mobility(self) -> np.ndarray:
@@ -307,6 +349,37 @@ class FRFResult:
                 "receptance": {p: {"real": self.receptance[:, i].real.tolist(),
                                    "imag": self.receptance[:, i].imag.tolist()}
                                for i, p in enumerate(self.points)}}
+
+    @classmethod
+    def _from_data(cls, data: dict) -> FRFResult:
+        """The result :meth:`to_dict` describes (which holds all of it)."""
+        points, excitation = tuple(data["points"]), decode_array(data["excitation_hz"])
+        by_point = decode_arrays(data["receptance"], ndim=2)
+        receptance = (np.stack([by_point[p] for p in points], axis=1) if points
+                      else np.empty((excitation.size, 0, 6), dtype=complex))
+        return cls(excitation, points, receptance)
+
+    def plot(self, natural_hz=(), load_unit: str = "N", title: str = ""):
+        """Magnitude and phase of the receptance (:func:`linmstmm.plot.frf_figure`):
+        translations and rotations on separate magnitude axes, the phases below.
+
+        Parameters
+        ----------
+        natural_hz : sequence of float
+            Natural frequencies to mark, Hz.
+        load_unit : str
+            Unit of the load, "N" (a force) or "N m" (a moment).
+        title : str
+            The figure's title (default: "frequency response (receptance)").
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            Not saved; matplotlib is imported on this call.
+        """
+        from linmstmm.plot import frf_figure
+
+        return frf_figure(self, natural_hz, load_unit, title)
 
 
 # --- the solution ---------------------------------------------------------------

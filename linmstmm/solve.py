@@ -14,6 +14,7 @@ from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
 from linmstmm.precision import refine_roots, separated_cluster
 from linmstmm.predicted import predict_frequencies
 from linmstmm.determinant import determinant
+from linmstmm.results import Result, decode_array
 from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.stages import report
 from linmstmm.roots import CERTIFIED_STEP, RootFinder
@@ -28,7 +29,7 @@ ESCALATION_DIGITS = 20
 
 
 @dataclass(frozen=True)
-class FrequencyResult:
+class FrequencyResult(Result):
     """Elastic natural frequencies (Hz, ascending, repeated per multiplicity).
 
     rigid_body_modes : number of zero-frequency modes. ubar_order : order of
@@ -55,6 +56,8 @@ class FrequencyResult:
     omegas_text: list | None = None
     evaluations: int = 0
 
+    kind = "freqs"
+
     def to_dict(self) -> dict:
         """The ``linmstmm freqs --json`` object (``docs/cli.md``).
 
@@ -79,6 +82,27 @@ class FrequencyResult:
             **({"frequencies_hz_text": self.frequencies_text} if self.frequencies_text else {}),
             **({"omega_rad_s_text": self.omegas_text} if self.omegas_text else {}),
         }
+
+    @classmethod
+    def _from_data(cls, data: dict) -> FrequencyResult:
+        """The result :meth:`to_dict` describes (which holds all of it)."""
+        return cls(data["model"], decode_array(data["frequencies_hz"]), data["rigid_body_modes"],
+                   data["ubar_order"], data["seconds"], data["precision"], data.get("note", ""),
+                   data["indeterminate_released"], data.get("frequencies_hz_text"), data.get("omega_rad_s_text"),
+                   data["evaluations"])
+
+    def plot(self):
+        """Draw the frequencies against their mode number.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            :func:`linmstmm.plot.frequency_figure`, titled by the model and method; unsaved.
+        """
+        from linmstmm.plot import frequency_figure
+
+        title = f"{self.model}: natural frequencies (transfer matrix method)"
+        return frequency_figure(self.frequencies_hz, self.rigid_body_modes, title=title)
 
 
 def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: str = "auto", **options):

@@ -32,6 +32,7 @@ from linmstmm.response import (
     frf,
     quantity_units,
 )
+from linmstmm.results import Result, decode_array, encode_array
 from linmstmm.solve import natural_frequencies
 from linmstmm.stages import report
 
@@ -321,7 +322,7 @@ def peaks_text(points, peaks, times, quantity: str = "displacement") -> str:
 # --- determinant scan ---------------------------------------------------------------
 
 @dataclass(frozen=True, eq=False)
-class ScanResult:
+class ScanResult(Result):
     """log|det Ū_all| over a frequency grid, and the natural frequencies below its top.
 
     Attributes
@@ -351,6 +352,8 @@ class ScanResult:
     rigid_body_modes: int
     note: str = ""
 
+    kind = "scan"
+
     @property
     def frequencies_hz(self) -> np.ndarray:
         """(r,) the elastic natural frequencies found, Hz."""
@@ -377,6 +380,31 @@ class ScanResult:
         return {"model": self.model, "fmax_hz": float(self.omega[-1] / (2 * np.pi)), "points": self.omega.size,
                 "ubar_order": self.ubar_order, "rigid_body_modes": self.rigid_body_modes,
                 "frequencies_hz": self.frequencies_hz.tolist(), **({"note": self.note} if self.note else {})}
+
+    def _restoring_dict(self) -> dict:
+        """The grid and the roots in rad/s, which :meth:`to_dict` leaves out."""
+        return {"omega": encode_array(self.omega), "sign": encode_array(self.sign),
+                "log_abs": encode_array(self.log_abs), "roots": encode_array(self.roots)}
+
+    @classmethod
+    def _from_data(cls, data: dict) -> ScanResult:
+        """The result :meth:`~linmstmm.results.Result.to_record` describes."""
+        return cls(data["model"], decode_array(data["omega"]), decode_array(data["sign"]),
+                   decode_array(data["log_abs"]), decode_array(data["roots"]), data["ubar_order"],
+                   data["rigid_body_modes"], data.get("note", ""))
+
+    def plot(self):
+        """Draw log₁₀|det Ū_all| over the grid, coloured by its sign, and the root count N(f) under it.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            Two axes sharing the frequency (:func:`linmstmm.plot.scan_figure`), unsaved.
+        """
+        from linmstmm.plot import scan_figure
+
+        return scan_figure(self.omega, self.sign, self.log_abs, self.roots, self.count(),
+                           title=f"{self.model}: determinant scan")
 
 
 def determinant_scan(model: Model, fmax: float, points: int = DEFAULT_SCAN_POINTS) -> ScanResult:

@@ -36,6 +36,7 @@ import numpy as np
 
 from linmstmm.model import Model, ModelError
 from linmstmm.parameters import get_value, parse_key, with_values
+from linmstmm.results import Result, decode_array, decode_arrays
 
 #: How every step evaluates det Ū_all: the engine ``linmstmm freqs`` uses in a new process.
 #: Fixed, not "auto" (which follows what this process has loaded), so that a step gives
@@ -210,7 +211,7 @@ def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGI
 
 
 @dataclass(frozen=True, eq=False)
-class SweepResult:
+class SweepResult(Result):
     """A parameter study.
 
     keys : the varied keys. values : (steps, keys) their values, SI.
@@ -238,6 +239,8 @@ class SweepResult:
     seconds: float
     workers: str
 
+    kind = "sweep"
+
     @property
     def frequencies_hz(self) -> np.ndarray:
         """(steps, count) Hz in tracked order: column c follows one mode shape."""
@@ -257,6 +260,34 @@ class SweepResult:
             "notes": {str(step): note for step, note in self.notes.items()},
             "solves": len(self.values), "seconds": self.seconds, "workers": self.workers,
         }
+
+    @classmethod
+    def _from_data(cls, data: dict) -> SweepResult:
+        """The result :meth:`to_dict` describes (which holds all of it; null is nan)."""
+        return cls(data["model"], tuple(data["keys"]), decode_array(data["values"], ndim=2), tuple(data["shape"]),
+                   decode_array(data["frequencies_hz_by_rank"], ndim=2), decode_array(data["order"], int, ndim=2),
+                   decode_array(data["tracking_mac"], ndim=2),
+                   decode_arrays(data.get("sensitivity_hz_per_unit", {}), ndim=2),
+                   decode_array(data["rigid_body_modes"], int), {int(step): note for step, note in data["notes"].items()},
+                   data["seconds"], data["workers"])
+
+    def plot(self, log_x: bool = False):
+        """The tracked frequencies against the first varied key (:func:`linmstmm.plot.sweep_figure`):
+        a colour per tracked mode, a line per combination of the other keys' values.
+
+        Parameters
+        ----------
+        log_x : bool
+            A logarithmic axis of the key's values.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            Not saved; matplotlib is imported on this call.
+        """
+        from linmstmm.plot import sweep_figure
+
+        return sweep_figure(self, log_x)
 
 
 def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = False,

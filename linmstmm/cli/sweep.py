@@ -132,31 +132,6 @@ def _cell(value: float) -> str:
 
 
 def plot_sweep(result, path, log_x: bool = False) -> None:
-    """Write a PNG of the tracked frequencies (Hz) against the first varied key.
-
-    One colour per tracked column; with a grid of several keys, one line per
-    combination of the other keys' values. log_x : logarithmic value axis.
-    """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    figure = Figure(figsize=(7.5, 4.8), layout="constrained")
-    FigureCanvasAgg(figure)
-    axes = figure.subplots()
-    lines = result.values.shape[0] // result.shape[0]
-    x = result.values[:, 0].reshape(result.shape[0], lines)
-    frequencies = result.frequencies_hz.reshape(result.shape[0], lines, -1)
-    for column in range(frequencies.shape[2]):
-        colour = f"C{column % 10}"
-        for line in range(lines):
-            axes.plot(x[:, line], frequencies[:, line, column], "-o", color=colour, markersize=2.5,
-                      lw=1.2, label=f"mode {column + 1}" if line == 0 else None)
-    if log_x:
-        axes.set_xscale("log")
-    axes.set_xlabel(result.keys[0])
-    axes.set_ylabel("natural frequency [Hz]")
-    others = f"; one line per value of {', '.join(result.keys[1:])}" if len(result.shape) > 1 else ""
-    axes.set_title(f"{result.model}: modes followed by shape (MAC){others}", fontsize=9)
-    axes.legend(fontsize=8)
-    axes.grid(alpha=0.3)
-    figure.savefig(path, format="png", dpi=130)
+    """Write a PNG of the tracked frequencies (Hz) against the first varied key
+    (:meth:`linmstmm.sweep.SweepResult.plot`). log_x : logarithmic value axis."""
+    result.plot(log_x=log_x).savefig(path, format="png", dpi=130)

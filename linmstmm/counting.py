@@ -71,7 +71,7 @@ def divided_out(omega, sign, log_abs, roots):
     known root itself the value is not finite (the callers test for that), without
     a warning (they reached the command line's error output)."""
     factors = np.asarray(omega)[:, None] ** 2 - np.asarray(roots, dtype=float)[None, :] ** 2
-    with np.errstate(divide="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore"):  # log|det| -inf at the root: inf - inf
         return (sign * np.exp(-1j * np.angle(factors).sum(axis=1)),
                 log_abs - np.log(np.abs(factors)).sum(axis=1))
 

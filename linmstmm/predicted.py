@@ -81,7 +81,7 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2) -> 
     Returns (m,) ascending, m <= count (fewer if the model has fewer); none for
     a model of more than MAX_UNKNOWNS unknowns.
     """
-    from linmstmm.fe import assemble
+    from linmstmm.fe.assembly import assemble
 
     nodes = len(model.points) + len(model.rigids) + (elements_per_beam - 1) * len(model.beams)
     if 6 * nodes > MAX_UNKNOWNS:  # a dense solve would cost more than the search it saves

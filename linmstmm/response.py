@@ -576,7 +576,7 @@ def respond(model: Model, case: LoadCase, damping_ratio=None,
     DampingRatioError
         For damping ratios that do not fit the modes.
     """
-    from linmstmm.fe import static_displacements
+    from linmstmm.fe.flexibility import static_displacements
 
     refuse_dashpots(model, "time response")
     modes = mode_shapes(model, case.modes)

@@ -265,7 +265,7 @@ def _secant_polished(finder, predictions: np.ndarray, start: int, stop: int,
     CERTIFIED_STEP for the others (a secant that stalled above it on a noisy det,
     1.3e-9 on a ring's 10th root, goes to the pencil).
     """
-    from linmstmm.roots import CERTIFIED_STEP  # roots imports this module
+    from linmstmm.roots.settings import CERTIFIED_STEP  # the root search imports this module
 
     found, steps = secant_roots(finder.log_det, predictions[start:stop], finder.xtol, finder.UNCERTAIN)
     in_cluster = np.zeros(predictions.size, dtype=bool)

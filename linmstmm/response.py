@@ -92,7 +92,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from linmstmm.model import Model, ModelError, _did_you_mean, _read_toml, _Table
+from linmstmm.model import Model, ModelError
+from linmstmm.model_file import _did_you_mean, _read_toml, _Table
 from linmstmm.modes import ModalResult, mode_shapes
 
 #: Default [output] values of a load file.

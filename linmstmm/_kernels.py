@@ -8,7 +8,7 @@ counterpart that stays the readable reference and the test oracle:
 * :func:`beam_piece` — :func:`linmstmm.elements.beam.beam_transfer`;
 * :func:`evaluate` — :meth:`linmstmm.deduction.Deduction.matrix` and
   :meth:`~linmstmm.deduction.Deduction.log_det` with ``stable=True``: the carry
-  with Godunov orthonormalisation (:class:`linmstmm.deduction._Orthonormaliser`),
+  with Godunov orthonormalisation (:class:`linmstmm.godunov._Orthonormaliser`),
   beams cut into pieces of βL ≤ 4, Ū_all assembled, LU.
 
 Frequencies are evaluated in groups of consecutive entries that take the
@@ -159,7 +159,7 @@ def _place_add(source, target, place, sign, rows):
 def _unit_scale(stacked, kinds, scale):
     """Row scales of ``stacked`` (rows, k) into ``scale``: one per kind of row (``kinds``:
     0 displacement, 1 rotation, 2 moment, 3 force), the inverse root-mean-square size
-    of all rows of that kind (:meth:`linmstmm.deduction._Orthonormaliser._unit_scale`)."""
+    of all rows of that kind (:meth:`linmstmm.godunov._Orthonormaliser._unit_scale`)."""
     rows, width = stacked.shape
     peak = _size(stacked)
     if peak == 0.0:

@@ -43,7 +43,8 @@ def fe_mac(result: ModalResult, model: Model) -> tuple[np.ndarray, np.ndarray]:
     ModelError
         If ``result`` holds no elastic mode.
     """
-    from linmstmm.fe import assemble, fe_frequencies
+    from linmstmm.fe.assembly import assemble
+    from linmstmm.fe.frequencies import fe_frequencies
 
     elastic = result.omega > 0
     if not elastic.any():

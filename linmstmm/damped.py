@@ -24,9 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from linmstmm.counting import count_inside
+from linmstmm.eigenspaces import SAME_FREQUENCY, _group
 from linmstmm.forced import rayleigh_equivalent, refuse_released_dashpots, released_deduction
 from linmstmm.model import Model
-from linmstmm.modes import SAME_FREQUENCY, _group
 from linmstmm.results import Result, decode_array
 from linmstmm.solve import natural_frequencies
 from linmstmm.threads import single_blas_thread

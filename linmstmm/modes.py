@@ -25,18 +25,19 @@ mass-orthonormal by the eigen-decomposition of its small mass matrix.
 Units: displacements m, rotations rad, states as in the package
 (``Z = [X, Y, Z, Θx, Θy, Θz, Mx, My, Mz, Qx, Qy, Qz]``); a mass-normalised
 mode has M_k = 1 kg, so its amplitudes are in m/√kg.
+
+The null spaces are :mod:`linmstmm.eigenspaces`; the states, beam fields and
+the two inner products of a set of modes are :mod:`linmstmm.mode_fields`.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 
-from linmstmm.deduction import Deduction
-from linmstmm.elements.beam import beam_transfer
+from linmstmm.eigenspaces import _group, _null_basis, _whole_last_eigenspace
+from linmstmm.mode_fields import _Fields, _station_positions
 from linmstmm.model import Model, ModelError
-from linmstmm.nullspace import NULL_TOLERANCE, equilibration
 from linmstmm.results import Result, decode_array, decode_arrays, encode_array
 from linmstmm.solve import search_note, solve_roots
 from linmstmm.stages import report
@@ -46,16 +47,10 @@ from linmstmm.threads import single_blas_thread
 NORMALIZATIONS = ("mass", "max")
 #: The one default, of :func:`mode_shapes` and of ``linmstmm modes``: unit modal mass.
 DEFAULT_NORMALIZATION = "mass"
-#: Frequencies closer than this (relative) are one repeated frequency.
-SAME_FREQUENCY = 1e-9
-#: Relative frequency offset of the matrices that scale Ū_all for its null space.
-SCALE_PROBE = 1e-3
 #: Mode shapes whose mass orthogonality or Rayleigh quotient is off by more than this
 #: (relative) are named in the result's note (a free beam's 30th mode, βL = 36, was
 #: off by 1e-2 and its 60th by 100 %, without a word).
 SHAPE_ACCURACY = 1e-4
-#: Gauss–Legendre points along a beam beyond its largest wavenumber × length.
-EXTRA_QUADRATURE_POINTS = 20
 #: A mode "has no translation" when its largest translation is below this
 #: fraction of (largest rotation × model size); it is then scaled by rotation.
 _TRANSLATION_FLOOR = 1e-9
@@ -383,102 +378,6 @@ def _accuracy_note(omega: np.ndarray, mass: np.ndarray, stiffness: np.ndarray) -
             f"worst {np.max(np.maximum(off, rayleigh)):.1e})")
 
 
-# --- eigenspaces ------------------------------------------------------------
-
-def _group(omegas) -> list[tuple[float, int]]:
-    """(ω, multiplicity) from an ascending list that repeats each root per multiplicity."""
-    groups: list[tuple[float, int]] = []
-    for omega in omegas:
-        if groups and abs(omega - groups[-1][0]) <= SAME_FREQUENCY * omega:
-            groups[-1] = (groups[-1][0], groups[-1][1] + 1)
-        else:
-            groups.append((float(omega), 1))
-    return groups
-
-
-def _whole_last_eigenspace(finder, omegas: np.ndarray) -> np.ndarray:
-    """``omegas`` (rad/s, ascending) with the last root repeated up to its multiplicity.
-
-    The multiplicity is the finder's count of roots around it
-    (:meth:`~linmstmm.roots.RootFinder.multiplicity`), as the mpmath
-    refinement of a root cut by the count takes it; the roots before it are
-    left exactly as found.
-    """
-    last = omegas[-1]
-    present = int(np.count_nonzero(np.abs(omegas - last) <= SAME_FREQUENCY * last))
-    wanted = finder.multiplicity(last, sorted(set(omegas))) or present
-    return np.r_[omegas, np.full(max(wanted - present, 0), last)]
-
-
-def _null_basis(deduction: Deduction, omega: float, dimension: int) -> np.ndarray:
-    """(dimension, N) basis of the null space of Ū_all(omega), on all N unknowns.
-
-    Works on the equilibrated matrix S = ``rows · Ū · cols`` (the basis is
-    mapped back by ``cols``), whose scales come from Ū at ω(1 ± SCALE_PROBE):
-    at the root itself an entry that vanishes there (cos kL of a rod at
-    resonance) would be blown up to ~1 when alone in its row, hiding the
-    singularity. The SVD of S gives the left and right singular vectors u, v
-    of the ``dimension`` smallest singular values; the basis then solves the
-    bordered system [[S, u], [vᵀ, 0]] [x; λ] = [0; I]. The SVD alone mixes all
-    columns with errors eps ‖S‖ / σ_next, and σ_next is as small as
-    1/cosh(βL) for a beam; elimination keeps blocks that do not couple
-    (bending, torsion) exactly apart. Released (statically indeterminate)
-    unknowns are zero. Raises RuntimeError if any of the ``dimension``
-    singular values is not below NULL_TOLERANCE × the largest.
-    """
-    matrix, below, above = deduction.matrix(omega * np.array([1.0, 1 - SCALE_PROBE, 1 + SCALE_PROBE]))
-    rows, cols = equilibration(np.maximum(np.abs(below), np.abs(above)))
-    scaled = rows[:, None] * matrix * cols
-    u, sigma, vh = np.linalg.svd(scaled)
-    worst = sigma[sigma.size - dimension] / sigma[0]
-    if worst > NULL_TOLERANCE:
-        raise RuntimeError(f"ω = {omega:.12g} rad/s is not a natural frequency with a null space "
-                           f"of dimension {dimension}: relative singular value {worst:.3g}")
-    n = sigma.size
-    try:
-        basis = _bordered_null_vectors(scaled, u, vh, dimension)
-    except np.linalg.LinAlgError:  # other near-null directions than the root's: all of them, then the root's
-        near = int(np.sum(sigma < NULL_TOLERANCE * sigma[0]))
-        basis = _closest_null_vectors(_bordered_null_vectors(scaled, u, vh, near), u[:, n - near:], scaled,
-                                      rows[:, None] * (above - below) * cols, dimension)
-    full = np.zeros((dimension, deduction.full_order))
-    full[:, np.delete(np.arange(n + len(deduction.released_columns)), deduction.released_columns)] = (
-        np.linalg.qr(basis)[0].T * cols)
-    return full
-
-
-def _bordered_null_vectors(scaled: np.ndarray, u: np.ndarray, vh: np.ndarray, k: int) -> np.ndarray:
-    """(N, k) null vectors of ``scaled`` (N, N) from the bordered system [[S, u], [vᵀ, 0]]
-    on its last ``k`` left and right singular vectors (``u``, ``vh`` of its SVD).
-    Raises LinAlgError where that system is singular."""
-    n = scaled.shape[0]
-    bordered = np.block([[scaled, u[:, n - k:]], [vh[n - k:], np.zeros((k, k))]])
-    return np.linalg.solve(bordered, np.eye(n + k, k, -n))[:n]
-
-
-def _closest_null_vectors(candidates: np.ndarray, left: np.ndarray, scaled: np.ndarray,
-                          change: np.ndarray, dimension: int) -> np.ndarray:
-    """(N, dimension): the combinations of ``candidates`` (N, k), k > dimension near-null
-    vectors of the equilibrated Ū_all ``scaled`` (N, N), that belong to the root itself.
-
-    Far above a beam's first modes the blocks of Ū_all of its other deformations are
-    nearly singular too (a bending block's smallest singular value is about 1/cosh βL
-    of its largest), below NULL_TOLERANCE, so the SVD offers their directions with
-    the root's own. Newton's offsets tell them apart: on the candidates (projected on
-    the near-null left vectors ``left`` (N, k)), the generalized eigenvalues μ of
-    (Ū_all, ``change``) are the steps to the nearest root along each (``change``: the
-    equilibrated Ū_all(ω(1 + p)) − Ū_all(ω(1 − p)), proportional to dŪ/dω). The
-    root's own have μ ≈ 0; a nearly singular block's μ is the distance to its own
-    root, or infinite. The ``dimension`` smallest are taken.
-    """
-    pencil = left.conj().T @ scaled @ candidates, left.conj().T @ change @ candidates
-    mu, vectors = scipy.linalg.eig(*pencil)
-    mu = np.where(np.isfinite(mu), np.abs(mu), np.inf)
-    chosen = vectors[:, np.argsort(mu)[:dimension]]
-    # (a real pencil's eigenvectors of real μ are real: LAPACK's, packed as complex)
-    return candidates @ (chosen.real if np.isrealobj(scaled) else chosen)
-
-
 def _mass_orthonormal(gram: np.ndarray, directional: np.ndarray, sizes) -> np.ndarray:
     """(n, n) block-diagonal combinations of the raw modes, mass-orthonormal per eigenspace.
 
@@ -511,207 +410,3 @@ def _normalisation(fields, normalization: str, model: Model) -> np.ndarray:
     reference = np.where(moves[:, None], translation, rotation)
     largest = reference[np.arange(reference.shape[0]), np.abs(reference).argmax(axis=1)]
     return 1 / largest if normalization == "max" else np.sign(largest)
-
-
-# --- states and fields ------------------------------------------------------
-
-@dataclass(frozen=True, eq=False)
-class _Fields:
-    """Everything linear in z̄ for a set of modes; ``apply`` recombines modes.
-
-    element_states : per transfer element (n, ports, 12), topology convention.
-    station_states, quadrature_states : beam -> (n, s, 12), traversal convention.
-    """
-
-    names: tuple
-    points: tuple
-    element_states: list
-    station_states: dict
-    quadrature_states: dict
-    zbar: np.ndarray
-    topology: object
-    stations: dict
-    quadrature: dict
-
-    @classmethod
-    def of(cls, model, deduction, omega, zbar, n_stations):
-        topology = deduction.topology
-        states = _element_states(deduction, omega, zbar)
-        index = {el.name: e for e, el in enumerate(topology.elements)}
-        stations, quadrature, at_stations, at_nodes = {}, {}, {}, {}
-        for beam in model.beams:
-            e = index[beam.name]
-            stations[beam.name] = np.linspace(0.0, beam.length, n_stations)
-            quadrature[beam.name] = _quadrature(beam, omega.max(initial=0.0))
-            at_stations[beam.name] = _beam_states(beam, topology.elements[e], omega, states[e],
-                                                  stations[beam.name])
-            at_nodes[beam.name] = _beam_states(beam, topology.elements[e], omega, states[e],
-                                               quadrature[beam.name][0])
-        return cls(tuple(index), tuple(model.points), states, at_stations, at_nodes, zbar, topology, stations, quadrature)
-
-    def apply(self, transform: np.ndarray) -> _Fields:
-        """The fields of the modes ``transform.T @ raw modes`` (transform (n_raw, n))."""
-        def combine(array):
-            return np.einsum("rk,r...->k...", transform, array)
-        return _Fields(self.names, self.points, [combine(s) for s in self.element_states],
-                       {b: combine(s) for b, s in self.station_states.items()},
-                       {b: combine(s) for b, s in self.quadrature_states.items()},
-                       combine(self.zbar), self.topology, self.stations, self.quadrature)
-
-    # -- by point and by body -------------------------------------------------
-    @property
-    def port_states(self) -> dict[str, np.ndarray]:
-        return {f"{element.name}@{port.point}": self.element_states[e][:, p]
-                for e, element in enumerate(self.topology.elements)
-                for p, port in enumerate(element.ports)}
-
-    @property
-    def point_displacements(self) -> dict[str, np.ndarray]:
-        """model point -> (n, 6), from the first port found at the point, in model order."""
-        found = {}
-        for e, element in enumerate(self.topology.elements):
-            for p, port in enumerate(element.ports):
-                found.setdefault(port.point, self.element_states[e][:, p, :6])
-        return {point: found[point] for point in self.points}
-
-    @property
-    def com_displacements(self) -> dict[str, np.ndarray]:
-        """rigid body -> (n, 6) translation and rotation of its mass centre."""
-        return {el.name: self._com(el.record) for el in self.topology.elements if el.kind == "rigid"}
-
-    def displacement_samples(self) -> np.ndarray:
-        """(n, s, 6) displacements at every point and beam quadrature node."""
-        at_points = np.stack(list(self.point_displacements.values()), axis=1)
-        at_nodes = [s[..., :6] for s in self.quadrature_states.values()]
-        return np.concatenate([at_points, *at_nodes], axis=1)
-
-    # -- the body operators ---------------------------------------------------
-    def mass_gram(self, axis_weights=np.ones(3)) -> np.ndarray:
-        """(n, n) ⟨M V^k, V^p⟩; ``axis_weights`` (3,) scale the translational mass along x, y, z."""
-        return _gram(self._mass_measures(np.asarray(axis_weights, float)))
-
-    def stiffness_gram(self) -> np.ndarray:
-        """(n, n) ⟨K V^k, V^p⟩ from the strain energy of springs and beams."""
-        return _gram(self._stiffness_measures())
-
-    def _mass_measures(self, axis_weights):
-        for element in self.topology.elements:
-            if element.kind != "rigid":
-                continue
-            rigid = element.record
-            com = self._com(rigid)
-            principal, axes = np.linalg.eigh(np.asarray(rigid.inertia, float))
-            yield com[:, :3], rigid.mass * axis_weights
-            yield com[:, 3:] @ axes, principal
-        for beam, (nodes, weights) in self._beams():
-            states = self.quadrature_states[beam.name]
-            yield (states[..., :3].reshape(len(states), -1),
-                   np.outer(beam.rho * beam.A * weights, axis_weights).ravel())
-            torsion = states[..., 3:6] @ np.asarray(beam.axes, float)[0]
-            yield torsion, beam.rho * beam.Ip * weights
-
-    def _stiffness_measures(self):
-        for e, element in enumerate(self.topology.elements):
-            if element.kind != "spring":
-                continue
-            spring = element.record
-            ends = [next(p for p, port in enumerate(element.ports) if port.point == end)
-                    for end in spring.ends]
-            delta = self.element_states[e][:, ends[1], :6] - self.element_states[e][:, ends[0], :6]
-            axes = np.asarray(spring.axes, float)
-            local = np.concatenate([delta[:, :3] @ axes.T, delta[:, 3:] @ axes.T], axis=1)
-            finite = np.isfinite(spring.k)
-            yield local[:, finite], np.asarray(spring.k, float)[finite]
-        for beam, (nodes, weights) in self._beams():
-            states = self.quadrature_states[beam.name]
-            axes = np.asarray(beam.axes, float)
-            moment = states[..., 6:9] @ axes.T  # local mx, my, mz
-            force = states[..., 9:12] @ axes.T
-            terms = [(moment[..., 1], beam.E * beam.Iy), (moment[..., 2], beam.E * beam.Iz)]
-            if beam.axial:
-                terms.append((force[..., 0], beam.E * beam.A))
-            if beam.torsion:
-                terms.append((moment[..., 0], beam.G * beam.J))
-            for values, rigidity in terms:
-                yield values, weights / rigidity
-
-    def _com(self, rigid) -> np.ndarray:
-        """(n, 6) mass-centre displacement u_c = u_p + θ × (c − p) from the body's first port."""
-        e = self.names.index(rigid.name)
-        element = self.topology.elements[e]
-        port = self.element_states[e][:, 0]
-        arm = np.asarray(rigid.com, float) - np.asarray(element.ports[0].position, float)
-        return np.concatenate([port[:, :3] + np.cross(port[:, 3:6], arm), port[:, 3:6]], axis=1)
-
-    def _beams(self):
-        for element in self.topology.elements:
-            if element.kind == "beam":
-                yield element.record, self.quadrature[element.name]
-
-
-def _gram(measures) -> np.ndarray:
-    """Σ X diag(w) Xᵀ over the (X (n, d), w (d,)) measures."""
-    return sum(np.einsum("kd,pd,d->kp", X, X, w) for X, w in measures)
-
-
-def _element_states(deduction: Deduction, omega: np.ndarray, zbar: np.ndarray) -> list:
-    """Per transfer element, (n, ports, 12): the state at each of its ports.
-
-    Output ports come from ``Deduction.port_states``; an input port is linked
-    to the output of its upstream element or to a tip (boundary or cut side).
-    """
-    outputs, _ = deduction.port_states(omega)
-    n = omega.size
-
-    def evaluate(state):
-        return np.einsum("nik,nk->ni", state.matrix, zbar[:, state.columns])
-
-    states = []
-    for e, element in enumerate(deduction.topology.elements):
-        ports = []
-        for p, port in enumerate(element.ports):
-            if p == element.output:
-                ports.append(evaluate(outputs[e]))
-            elif port.link[0] == "element":
-                ports.append(evaluate(outputs[port.link[1]]))
-            else:
-                ports.append(evaluate(deduction.tip_state(port.link, n)))
-        states.append(np.stack(ports, axis=1))
-    return states
-
-
-def _beam_states(beam, element, omega, port_states, stations) -> np.ndarray:
-    """(n, s, 12) states at ``stations`` (m from ends[0]) by transfer from the input end.
-
-    States are in the traversal convention of the topology (forces: what the
-    part nearer the input exerts on the part beyond).
-    """
-    reverse = element.inputs[0] == 1
-    z_in = port_states[:, element.inputs[0]]
-    distances = beam.length - stations if reverse else stations
-    out = np.empty((omega.size, stations.size, 12))
-    for s, distance in enumerate(distances):
-        if distance > 0:
-            out[:, s] = np.einsum("nij,nj->ni", beam_transfer(beam, omega, reverse=reverse,
-                                                              length=distance), z_in)
-        else:
-            out[:, s] = z_in
-    return out
-
-
-def _quadrature(beam, omega_max: float):
-    """Gauss–Legendre (nodes (q,), weights (q,)) on [0, L], enough for the highest mode.
-
-    q = (largest wavenumber at omega_max) × L + EXTRA_QUADRATURE_POINTS, where
-    the wavenumbers are bending (ρAω²/EI)^¼, axial ω√(ρ/E), torsion ω√(ρIp/GJ).
-    """
-    count = int(np.ceil(max(beam.wavenumbers(omega_max).values()) * beam.length)) + EXTRA_QUADRATURE_POINTS
-    nodes, weights = np.polynomial.legendre.leggauss(count)
-    half = beam.length / 2
-    return half * (nodes + 1), half * weights
-
-
-def _station_positions(model: Model, beam, fields: _Fields) -> np.ndarray:
-    """(s, 3) positions of a beam's stations, m."""
-    start = np.asarray(model.points[beam.ends[0]], float)
-    return start + fields.stations[beam.name][:, None] * np.asarray(beam.axes, float)[0]

@@ -81,7 +81,7 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2) -> 
     Returns (m,) ascending, m <= count (fewer if the model has fewer); none for
     a model of more than MAX_UNKNOWNS unknowns.
     """
-    from linmstmm.fe import assemble
+    from linmstmm.fe.assembly import assemble
 
     nodes = len(model.points) + len(model.rigids) + (elements_per_beam - 1) * len(model.beams)
     if 6 * nodes > MAX_UNKNOWNS:  # a dense solve would cost more than the search it saves
@@ -265,7 +265,7 @@ def _secant_polished(finder, predictions: np.ndarray, start: int, stop: int,
     CERTIFIED_STEP for the others (a secant that stalled above it on a noisy det,
     1.3e-9 on a ring's 10th root, goes to the pencil).
     """
-    from linmstmm.roots import CERTIFIED_STEP  # roots imports this module
+    from linmstmm.roots.settings import CERTIFIED_STEP  # the root search imports this module
 
     found, steps = secant_roots(finder.log_det, predictions[start:stop], finder.xtol, finder.UNCERTAIN)
     in_cluster = np.zeros(predictions.size, dtype=bool)

@@ -28,9 +28,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from linmstmm.eigenspaces import SAME_FREQUENCY
 from linmstmm.elements.beam import beam_transfer
+from linmstmm.mode_fields import EXTRA_QUADRATURE_POINTS
 from linmstmm.model import Model, ModelError
-from linmstmm.modes import EXTRA_QUADRATURE_POINTS, SAME_FREQUENCY, ModalResult
+from linmstmm.modes import ModalResult
 from linmstmm.parameters import Key, parse_key
 
 

@@ -24,7 +24,8 @@ import numpy as np
 
 from linmstmm.forced import direct_frf, has_dashpots
 from linmstmm.mode_bound import check_range_request
-from linmstmm.model import COMPONENTS, Model, ModelError, _did_you_mean
+from linmstmm.model import COMPONENTS, Model, ModelError
+from linmstmm.model_file import _did_you_mean
 from linmstmm.modes import ModalResult, mode_shapes
 from linmstmm.response import (
     FRFResult,

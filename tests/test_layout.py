@@ -9,7 +9,9 @@ and numpydoc docstrings on every public name.
   classes (and every public function of a public module there) has a
   docstring with a numpydoc ``Parameters`` section when it takes parameters
   and a ``Returns`` section when it returns a value, as python-control's
-  docstring test asks.
+  docstring test asks;
+* no module of linmstmm is over LONG_MODULE (500) lines unless its docstring
+  has a paragraph starting "Kept whole:" that says why it is not split.
 """
 from __future__ import annotations
 
@@ -217,3 +219,45 @@ def test_the_section_reader_reads_numpydoc():
     """
     assert _sections(doc) == {"Parameters", "Returns"}
     assert _sections("Summary.\n\nx : float, the value") == set()
+
+
+# --- module length -----------------------------------------------------------------
+
+#: Modules longer than this many lines must say why they are not split.
+LONG_MODULE = 500
+#: The start of the module docstring's paragraph that says so.
+KEPT_WHOLE = "Kept whole:"
+
+
+def kept_whole_reason(source: str) -> str:
+    """The paragraph of ``source``'s module docstring that starts with KEPT_WHOLE and
+    gives a reason after it, or ""."""
+    doc = ast.get_docstring(ast.parse(source)) or ""
+    for paragraph in doc.split("\n\n"):
+        paragraph = paragraph.strip()
+        if paragraph.startswith(KEPT_WHOLE) and paragraph[len(KEPT_WHOLE):].strip():
+            return paragraph
+    return ""
+
+
+def unexplained_long_modules(paths) -> list[str]:
+    """Those of ``paths`` over LONG_MODULE lines without a kept-whole reason."""
+    return [str(path) for path in paths
+            if len(path.read_text().splitlines()) > LONG_MODULE and not kept_whole_reason(path.read_text())]
+
+
+def test_no_long_module_without_a_reason_to_stay_whole():
+    long = unexplained_long_modules(MODULES.values())
+    assert not long, f"over {LONG_MODULE} lines, no '{KEPT_WHOLE}' paragraph at the top: {long}"
+
+
+def test_the_length_check_sees_a_long_module(tmp_path):
+    body = "x = 1\n" * LONG_MODULE
+    files = {"short.py": '"""Short."""\n' + "x = 1\n" * (LONG_MODULE - 1),
+             "long.py": '"""Long."""\n' + body,
+             "empty_reason.py": '"""Long.\n\nKept whole:\n"""\n' + body,
+             "kept.py": '"""Long.\n\nKept whole: one idea, one loop.\n"""\n' + body}
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    found = unexplained_long_modules(sorted(tmp_path / name for name in files))
+    assert found == [str(tmp_path / "empty_reason.py"), str(tmp_path / "long.py")]

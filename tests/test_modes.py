@@ -215,7 +215,7 @@ def test_result_serialises_to_json():
 
 def test_quadrature_is_converged():
     """The Gram matrices do not change when the quadrature is refined."""
-    import linmstmm.modes as modes_module
+    import linmstmm.mode_fields as modes_module
 
     model = tree()
     coarse = mode_shapes(model, count=8)

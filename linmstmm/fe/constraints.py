@@ -1,0 +1,88 @@
+"""Exact constraints: the sparse master–slave elimination ``q = T q_r`` of linear
+homogeneous constraint rows, and the rounding debris dropped before it."""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+#: A substituted constraint row whose entries all fall below this fraction of
+#: the largest term that entered it is redundant (implied by earlier rows).
+REDUNDANT_CONSTRAINT = 1e-10
+#: Entries below this fraction of their row's largest are rounding debris.
+NEGLIGIBLE_ENTRY = 1e-14
+
+
+def _eliminate(constraints: sp.csr_matrix) -> sp.csr_matrix:
+    """Master–slave null-space basis of the rows of ``constraints``.
+
+    Rows are taken one at a time, written in the current masters, and one
+    master becomes a slave: among the entries within a factor 2 of the
+    largest (threshold pivoting), the one fewest slaves depend on, so chains
+    of constraints do not fill in. Redundant rows (closed loops of rigid
+    links) are recognised and skipped.
+
+    Returns
+    -------
+    T1 : (n, n_masters) sparse; the masters' rows are identity rows.
+    masters : (n_masters,) their indices, ascending.
+    """
+    n = constraints.shape[1]
+    expression = {}                     # slave -> {master: coefficient}
+    users = {}                          # master -> slaves that use it
+    indptr, indices, data = constraints.indptr, constraints.indices, constraints.data
+    for r in range(constraints.shape[0]):
+        row, scale = {}, 0.0
+        for j, c in zip(indices[indptr[r]:indptr[r + 1]].tolist(),
+                        data[indptr[r]:indptr[r + 1]].tolist()):
+            for master, e in expression.get(j, {j: 1.0}).items():
+                term = c * e
+                row[master] = row.get(master, 0.0) + term
+                scale = max(scale, abs(term))
+        largest = max((abs(v) for v in row.values()), default=0.0)
+        if largest <= REDUNDANT_CONSTRAINT * scale:
+            continue
+        row = {m: v for m, v in row.items() if abs(v) > NEGLIGIBLE_ENTRY * largest}
+        slave = min((m for m, v in row.items() if abs(v) >= 0.5 * largest),
+                    key=lambda m: (len(users.get(m, ())), -abs(row[m])))
+        pivot = row.pop(slave)
+        solved = {m: -v / pivot for m, v in row.items()}
+        for dependent in users.pop(slave, ()):
+            _substitute(expression[dependent], dependent, slave, solved, users)
+        expression[slave] = solved
+        for master in solved:
+            users.setdefault(master, set()).add(slave)
+    masters = np.array(sorted(set(range(n)) - set(expression)), dtype=int)
+    column = {m: i for i, m in enumerate(masters.tolist())}
+    rows, cols, values = [masters], [np.arange(len(masters))], [np.ones(len(masters))]
+    for slave, terms in expression.items():
+        rows.append(np.full(len(terms), slave))
+        cols.append(np.array([column[m] for m in terms], dtype=int))
+        values.append(np.array(list(terms.values()), float))
+    rows, cols, values = map(np.concatenate, (rows, cols, values))
+    return sp.csr_matrix((values, (rows, cols)), shape=(n, len(masters))), masters
+
+
+def _substitute(terms, owner, slave, solved, users):
+    """Replace ``slave`` by its expression ``solved`` inside ``terms`` (in place)."""
+    c = terms.pop(slave)
+    for master, v in solved.items():
+        terms[master] = terms.get(master, 0.0) + c * v
+    largest = max((abs(v) for v in terms.values()), default=0.0)
+    for master in [m for m, v in terms.items() if abs(v) <= NEGLIGIBLE_ENTRY * largest]:
+        del terms[master]
+        users.get(master, set()).discard(owner)
+    for master in terms:
+        users.setdefault(master, set()).add(owner)
+
+
+def _drop_debris(matrix) -> sp.csr_matrix:
+    """``matrix`` without entries below NEGLIGIBLE_ENTRY of their row's largest."""
+    matrix = sp.csr_matrix(matrix)
+    matrix.sum_duplicates()
+    magnitude = np.abs(matrix.data)
+    row_of = np.repeat(np.arange(matrix.shape[0]), np.diff(matrix.indptr))
+    row_max = np.zeros(matrix.shape[0])
+    np.maximum.at(row_max, row_of, magnitude)
+    matrix.data[magnitude <= NEGLIGIBLE_ENTRY * row_max[row_of]] = 0.0
+    matrix.eliminate_zeros()
+    return matrix

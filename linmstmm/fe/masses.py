@@ -1,0 +1,55 @@
+"""Masses negligible against the model's own scale, removed before assembly so
+that a massless DOF has an exactly zero row and column in M."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import scipy.linalg as la
+
+from linmstmm.model import Model, Rigid
+
+#: A mass (kg), inertia (kg m²) or kinetic energy below this fraction of the
+#: model's own scale of the same units is rounding, not mass: a body's mass or
+#: principal inertia, a beam, or a rigid motion below it carries none.
+MASSLESS = 1e-13
+
+
+def _negligible_mass_removed(model: Model) -> Model:
+    """``model`` with every mass below MASSLESS of the model's own scale set to zero.
+
+    The scales are the total mass m of bodies and beams (kg) and m d² plus the
+    traces of the bodies' inertia tensors (kg m²), d the largest distance of a
+    point or mass centre from their centroid (m). Each body's mass and principal
+    inertias and each beam's mass are compared with the scale of their units, so
+    the decision does not depend on the units a model is written in; a mass that
+    is kept is exactly as given. A DOF without mass then has an exactly zero row
+    and column in the assembled M.
+    """
+    places = np.array([*model.points.values(), *(body.com for body in model.rigids)], float)
+    extent = np.linalg.norm(places - places.mean(axis=0), axis=1).max()
+    total = sum(body.mass for body in model.rigids) + sum(beam.mass for beam in model.beams)
+    inertia = total * extent ** 2 + sum(np.trace(body.inertia) for body in model.rigids)
+    rigids = tuple(_body_mass_kept(body, MASSLESS * total, MASSLESS * inertia) for body in model.rigids)
+    beams = tuple(beam if beam.mass > MASSLESS * total else replace(beam, rho=0.0) for beam in model.beams)
+    if all(a is b for a, b in zip(rigids + beams, model.rigids + model.beams)):
+        return model  # nothing negligible: no copy (a copy validates the whole model again)
+    return replace(model, rigids=rigids, beams=beams)
+
+
+def _body_mass_kept(body: Rigid, least_mass: float, least_inertia: float) -> Rigid:
+    """``body`` with its mass (kg) made zero unless above ``least_mass``, and its
+    principal inertias (kg m²) unless above ``least_inertia``; the same record when
+    nothing changes."""
+    mass = body.mass if body.mass > least_mass else 0.0
+    inertia, diagonal = body.inertia, body.inertia.diagonal()
+    # Gershgorin: the least of these is at most the smallest principal inertia
+    gershgorin = diagonal - (np.abs(inertia).sum(axis=1) - np.abs(diagonal))
+    if diagonal.any() and gershgorin.min() <= least_inertia:
+        principal, axes = la.eigh(inertia)
+        kept = principal > least_inertia
+        if not np.all(kept | (principal == 0.0)):
+            inertia = (axes * np.where(kept, principal, 0.0)) @ axes.T
+    if mass == body.mass and inertia is body.inertia:
+        return body
+    return replace(body, mass=mass, inertia=inertia)

@@ -1,0 +1,221 @@
+"""The states and fields of a set of modes, and their inner products.
+
+From the boundary unknowns z̄ the element transfer equations give the state
+at every port and the beam transfer matrix the field inside each beam (at
+stations and at Gauss–Legendre points); the mass and stiffness Gram matrices
+of the augmented eigenvectors are integrated from them (:class:`_Fields`).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from linmstmm.deduction import Deduction
+from linmstmm.elements.beam import beam_transfer
+from linmstmm.model import Model
+
+#: Gauss–Legendre points along a beam beyond its largest wavenumber × length.
+EXTRA_QUADRATURE_POINTS = 20
+
+
+@dataclass(frozen=True, eq=False)
+class _Fields:
+    """Everything linear in z̄ for a set of modes; ``apply`` recombines modes.
+
+    element_states : per transfer element (n, ports, 12), topology convention.
+    station_states, quadrature_states : beam -> (n, s, 12), traversal convention.
+    """
+
+    names: tuple
+    points: tuple
+    element_states: list
+    station_states: dict
+    quadrature_states: dict
+    zbar: np.ndarray
+    topology: object
+    stations: dict
+    quadrature: dict
+
+    @classmethod
+    def of(cls, model, deduction, omega, zbar, n_stations):
+        topology = deduction.topology
+        states = _element_states(deduction, omega, zbar)
+        index = {el.name: e for e, el in enumerate(topology.elements)}
+        stations, quadrature, at_stations, at_nodes = {}, {}, {}, {}
+        for beam in model.beams:
+            e = index[beam.name]
+            stations[beam.name] = np.linspace(0.0, beam.length, n_stations)
+            quadrature[beam.name] = _quadrature(beam, omega.max(initial=0.0))
+            at_stations[beam.name] = _beam_states(beam, topology.elements[e], omega, states[e],
+                                                  stations[beam.name])
+            at_nodes[beam.name] = _beam_states(beam, topology.elements[e], omega, states[e],
+                                               quadrature[beam.name][0])
+        return cls(tuple(index), tuple(model.points), states, at_stations, at_nodes, zbar, topology, stations, quadrature)
+
+    def apply(self, transform: np.ndarray) -> _Fields:
+        """The fields of the modes ``transform.T @ raw modes`` (transform (n_raw, n))."""
+        def combine(array):
+            return np.einsum("rk,r...->k...", transform, array)
+        return _Fields(self.names, self.points, [combine(s) for s in self.element_states],
+                       {b: combine(s) for b, s in self.station_states.items()},
+                       {b: combine(s) for b, s in self.quadrature_states.items()},
+                       combine(self.zbar), self.topology, self.stations, self.quadrature)
+
+    # -- by point and by body -------------------------------------------------
+    @property
+    def port_states(self) -> dict[str, np.ndarray]:
+        return {f"{element.name}@{port.point}": self.element_states[e][:, p]
+                for e, element in enumerate(self.topology.elements)
+                for p, port in enumerate(element.ports)}
+
+    @property
+    def point_displacements(self) -> dict[str, np.ndarray]:
+        """model point -> (n, 6), from the first port found at the point, in model order."""
+        found = {}
+        for e, element in enumerate(self.topology.elements):
+            for p, port in enumerate(element.ports):
+                found.setdefault(port.point, self.element_states[e][:, p, :6])
+        return {point: found[point] for point in self.points}
+
+    @property
+    def com_displacements(self) -> dict[str, np.ndarray]:
+        """rigid body -> (n, 6) translation and rotation of its mass centre."""
+        return {el.name: self._com(el.record) for el in self.topology.elements if el.kind == "rigid"}
+
+    def displacement_samples(self) -> np.ndarray:
+        """(n, s, 6) displacements at every point and beam quadrature node."""
+        at_points = np.stack(list(self.point_displacements.values()), axis=1)
+        at_nodes = [s[..., :6] for s in self.quadrature_states.values()]
+        return np.concatenate([at_points, *at_nodes], axis=1)
+
+    # -- the body operators ---------------------------------------------------
+    def mass_gram(self, axis_weights=np.ones(3)) -> np.ndarray:
+        """(n, n) ⟨M V^k, V^p⟩; ``axis_weights`` (3,) scale the translational mass along x, y, z."""
+        return _gram(self._mass_measures(np.asarray(axis_weights, float)))
+
+    def stiffness_gram(self) -> np.ndarray:
+        """(n, n) ⟨K V^k, V^p⟩ from the strain energy of springs and beams."""
+        return _gram(self._stiffness_measures())
+
+    def _mass_measures(self, axis_weights):
+        for element in self.topology.elements:
+            if element.kind != "rigid":
+                continue
+            rigid = element.record
+            com = self._com(rigid)
+            principal, axes = np.linalg.eigh(np.asarray(rigid.inertia, float))
+            yield com[:, :3], rigid.mass * axis_weights
+            yield com[:, 3:] @ axes, principal
+        for beam, (nodes, weights) in self._beams():
+            states = self.quadrature_states[beam.name]
+            yield (states[..., :3].reshape(len(states), -1),
+                   np.outer(beam.rho * beam.A * weights, axis_weights).ravel())
+            torsion = states[..., 3:6] @ np.asarray(beam.axes, float)[0]
+            yield torsion, beam.rho * beam.Ip * weights
+
+    def _stiffness_measures(self):
+        for e, element in enumerate(self.topology.elements):
+            if element.kind != "spring":
+                continue
+            spring = element.record
+            ends = [next(p for p, port in enumerate(element.ports) if port.point == end)
+                    for end in spring.ends]
+            delta = self.element_states[e][:, ends[1], :6] - self.element_states[e][:, ends[0], :6]
+            axes = np.asarray(spring.axes, float)
+            local = np.concatenate([delta[:, :3] @ axes.T, delta[:, 3:] @ axes.T], axis=1)
+            finite = np.isfinite(spring.k)
+            yield local[:, finite], np.asarray(spring.k, float)[finite]
+        for beam, (nodes, weights) in self._beams():
+            states = self.quadrature_states[beam.name]
+            axes = np.asarray(beam.axes, float)
+            moment = states[..., 6:9] @ axes.T  # local mx, my, mz
+            force = states[..., 9:12] @ axes.T
+            terms = [(moment[..., 1], beam.E * beam.Iy), (moment[..., 2], beam.E * beam.Iz)]
+            if beam.axial:
+                terms.append((force[..., 0], beam.E * beam.A))
+            if beam.torsion:
+                terms.append((moment[..., 0], beam.G * beam.J))
+            for values, rigidity in terms:
+                yield values, weights / rigidity
+
+    def _com(self, rigid) -> np.ndarray:
+        """(n, 6) mass-centre displacement u_c = u_p + θ × (c − p) from the body's first port."""
+        e = self.names.index(rigid.name)
+        element = self.topology.elements[e]
+        port = self.element_states[e][:, 0]
+        arm = np.asarray(rigid.com, float) - np.asarray(element.ports[0].position, float)
+        return np.concatenate([port[:, :3] + np.cross(port[:, 3:6], arm), port[:, 3:6]], axis=1)
+
+    def _beams(self):
+        for element in self.topology.elements:
+            if element.kind == "beam":
+                yield element.record, self.quadrature[element.name]
+
+
+def _gram(measures) -> np.ndarray:
+    """Σ X diag(w) Xᵀ over the (X (n, d), w (d,)) measures."""
+    return sum(np.einsum("kd,pd,d->kp", X, X, w) for X, w in measures)
+
+
+def _element_states(deduction: Deduction, omega: np.ndarray, zbar: np.ndarray) -> list:
+    """Per transfer element, (n, ports, 12): the state at each of its ports.
+
+    Output ports come from ``Deduction.port_states``; an input port is linked
+    to the output of its upstream element or to a tip (boundary or cut side).
+    """
+    outputs, _ = deduction.port_states(omega)
+    n = omega.size
+
+    def evaluate(state):
+        return np.einsum("nik,nk->ni", state.matrix, zbar[:, state.columns])
+
+    states = []
+    for e, element in enumerate(deduction.topology.elements):
+        ports = []
+        for p, port in enumerate(element.ports):
+            if p == element.output:
+                ports.append(evaluate(outputs[e]))
+            elif port.link[0] == "element":
+                ports.append(evaluate(outputs[port.link[1]]))
+            else:
+                ports.append(evaluate(deduction.tip_state(port.link, n)))
+        states.append(np.stack(ports, axis=1))
+    return states
+
+
+def _beam_states(beam, element, omega, port_states, stations) -> np.ndarray:
+    """(n, s, 12) states at ``stations`` (m from ends[0]) by transfer from the input end.
+
+    States are in the traversal convention of the topology (forces: what the
+    part nearer the input exerts on the part beyond).
+    """
+    reverse = element.inputs[0] == 1
+    z_in = port_states[:, element.inputs[0]]
+    distances = beam.length - stations if reverse else stations
+    out = np.empty((omega.size, stations.size, 12))
+    for s, distance in enumerate(distances):
+        if distance > 0:
+            out[:, s] = np.einsum("nij,nj->ni", beam_transfer(beam, omega, reverse=reverse,
+                                                              length=distance), z_in)
+        else:
+            out[:, s] = z_in
+    return out
+
+
+def _quadrature(beam, omega_max: float):
+    """Gauss–Legendre (nodes (q,), weights (q,)) on [0, L], enough for the highest mode.
+
+    q = (largest wavenumber at omega_max) × L + EXTRA_QUADRATURE_POINTS, where
+    the wavenumbers are bending (ρAω²/EI)^¼, axial ω√(ρ/E), torsion ω√(ρIp/GJ).
+    """
+    count = int(np.ceil(max(beam.wavenumbers(omega_max).values()) * beam.length)) + EXTRA_QUADRATURE_POINTS
+    nodes, weights = np.polynomial.legendre.leggauss(count)
+    half = beam.length / 2
+    return half * (nodes + 1), half * weights
+
+
+def _station_positions(model: Model, beam, fields: _Fields) -> np.ndarray:
+    """(s, 3) positions of a beam's stations, m."""
+    start = np.asarray(model.points[beam.ends[0]], float)
+    return start + fields.stations[beam.name][:, None] * np.asarray(beam.axes, float)[0]

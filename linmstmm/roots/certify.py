@@ -1,0 +1,138 @@
+"""Certification by the argument principle: the closing count that the roots found
+are all there are (det with them divided out has no zero left), and the recovery
+of those a count says are missing."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from linmstmm.counting import count_zeros, count_zeros_many, deflated
+from linmstmm.roots.settings import DEFLATED_MAX_POINTS, DEFLATED_POINTS
+
+
+def confirmed(finder, found: list[float], count: int | None, omega_max: float | None = None,
+               cap: float = np.inf):
+    """The lowest ``count`` of ``found`` (or all up to omega_max) if one count from
+    the floor says there are no others below them; None otherwise.
+    ``cap``: the count stops there at the latest (rad/s; above the count-th root).
+    Multiplicities above one inside the count are counted over circles first
+    (:meth:`_settled`)."""
+    found = finder._settled(found, count, omega_max, cap)
+    upper = finder._count_top(found, count, omega_max)
+    if upper is None or (count is not None and len(found) >= count and found[count - 1] >= cap):
+        return None
+    upper = min(upper, cap)
+    below = [r for r in found if r < upper]
+    return below[:count] if finder.confirm_no_other_zeros(found, upper) else None
+
+
+def settled(finder, found: list[float], count: int | None, omega_max: float | None,
+             cap: float = np.inf) -> list[float]:
+    """``found`` with every multiplicity above one below the closing count's top (and
+    ``cap``) counted over a circle (:meth:`_recounted`), again while that moves the
+    top up. The closing count sees zeros less the roots divided out: a simple root
+    read as double from a spurious near-zero pencil offset would cancel a missing
+    root (a random tree at 40 modes read one as fivefold, with four missing, and
+    passed; MLRS above 400 Hz read 53 of 78 roots as double)."""
+    while True:
+        found = finder._as_counted(found)
+        top = min(finder._count_top(found, count, omega_max) or np.inf, cap)
+        doubtful = sorted({r for r in found if r < top and r not in finder._counted and found.count(r) > 1})
+        if not doubtful:
+            return found
+        found = finder._recounted(found, doubtful)
+
+
+def count_top(finder, found: list[float], count: int | None, omega_max: float | None):
+    """Top of the closing count: midway between the count-th root and the next one
+    found (1 % above it if none), or omega_max, whichever is lower; omega_max with
+    fewer than ``count`` found, None without it."""
+    if count is None or len(found) < count:
+        return omega_max
+    top = found[count - 1]
+    above = [r for r in found if r > top * (1 + finder.SAME_ROOT)]
+    by_count = (top + above[0]) / 2 if above else top * 1.01
+    return by_count if omega_max is None else min(by_count, omega_max)
+
+
+def recovered(finder, found: list[float], upper: float, count: int | None = None):
+    """(``found`` with the roots below ``upper`` that the closing count says are
+    missing, the cap for the closing count that follows (rad/s)).
+
+    They are located by geometric bisection from :attr:`root_free_below` up,
+    down to eighths of an octave, on counts of det with the ``found`` roots
+    divided out (:func:`~linmstmm.counting.deflated`; all intervals of one
+    level in one batched count). With ``count``, an
+    interval with at least ``count`` roots (found or missing) below it is
+    not split further: its roots are above the count-th, and the closing
+    count is capped at its lower end. The intervals that
+    hold some are scanned densely, and det on that scan with the found roots
+    divided out has sign changes and quiet minima of the missing roots alone,
+    again with each pass's roots divided out (:meth:`_rescanned`: of a close pair
+    missing in one scan step, one shows only once the other is found; random
+    floating_loops 3 at 80 modes fell back to the segment search, 1.4 s more).
+    ``found`` as it was if a count cannot be made.
+    """
+    reduced = deflated(finder.log_det, [r for r in found if r < upper])
+    try:
+        missing = count_zeros(reduced, finder.floor, upper, max_points=DEFLATED_MAX_POINTS)
+    except RuntimeError:
+        return found, upper
+    floor = min(finder.root_free_below, upper)  # the bisection starts above what a count found empty
+    pending, leaves, cap = [(floor, upper, missing)] if missing else [], [], upper
+    while pending:
+        kept, level_cap = finder._below_count(leaves + pending, found, count, upper)
+        cap = min(cap, level_cap)
+        leaves, pending = [part for part in leaves if part in kept], [part for part in pending if part in kept]
+        leaves += [part for part in pending if part[1] / part[0] <= 2 ** 0.125]
+        wide = [part for part in pending if part[1] / part[0] > 2 ** 0.125]
+        middles = [np.sqrt(lo * hi) for lo, hi, _ in wide]
+        lower = (count_zeros_many(reduced, [(lo, mid) for (lo, _, _), mid in zip(wide, middles)],
+                                  max_points=DEFLATED_MAX_POINTS) if wide else [])
+        if any(isinstance(c, RuntimeError) for c in lower):
+            return found, upper
+        pending = [part for (lo, hi, k), mid, c in zip(wide, middles, lower)
+                   for part in ((lo, mid, c), (mid, hi, k - c)) if part[2] > 0]
+    if not leaves:
+        return found, cap
+    grid = np.concatenate([np.geomspace(lo, hi, 16 * k + 17) for lo, hi, k in leaves])
+    return finder._rescanned(found, [(grid, *finder.log_det(grid))], upper), cap
+
+
+def below_count(parts, found: list[float], count: int | None, upper: float):
+    """(the (lo, hi, missing) ``parts`` that may hold one of the lowest ``count``
+    roots, the lower end of the first that cannot, else ``upper``): a part
+    with ``count`` roots below it, found or missing, cannot."""
+    kept, missing_below = [], 0
+    for lo, hi, missing in sorted(parts):
+        if count is not None and sum(r < lo for r in found) + missing_below >= count:
+            return kept, lo
+        kept.append((lo, hi, missing))
+        missing_below += missing
+    return kept, upper
+
+
+def confirm_no_other_zeros(finder, known: list[float], upper: float) -> bool:
+    """True if (floor, upper) holds no zeros of det Ū_all but ``known``.
+
+    The count runs on det with the known roots divided out (:func:`~linmstmm.counting.deflated`),
+    so its phase turns only for zeros not in ``known`` (or by −π for a
+    ``known`` one that is not a zero) and DEFLATED_POINTS starting points
+    suffice where counting them all took four times as many. Known
+    roots above ``upper`` are divided out too: outside the contour they
+    change nothing, and the next root just above ``upper`` no longer turns
+    the phase fast near the contour's end (MLRS 20 modes: three refinement
+    rounds fewer). False also where it cannot count: the segment search then
+    decides (and says so if it cannot either).
+    """
+    return finder.other_zeros(known, None, upper) == 0
+
+
+def other_zeros(finder, known: list[float], lo: float | None, hi: float) -> int | None:
+    """Zeros of det Ū_all in (lo, hi) less those in ``known`` (negative where a known
+    one is not a zero); lo None: the floor. None where the count cannot be made."""
+    try:
+        return count_zeros(deflated(finder.log_det, known), finder.floor if lo is None else lo, hi,
+                           max_points=DEFLATED_MAX_POINTS, initial_points=DEFLATED_POINTS)
+    except RuntimeError:
+        return None

@@ -1,0 +1,181 @@
+"""Clusters of close roots and multiplicities: every root Newton reaches around
+one, how many roots sit at each (the pencil's near-zero offsets, confirmed by a
+count over a small circle), and multiple roots split into the distinct ones of a cluster."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from linmstmm.counting import count_zeros_many
+from linmstmm.roots.settings import CIRCLE_MAX_POINTS, CIRCLE_POINTS
+
+
+def clusters(finder, starts, confirm: bool = True) -> list[list[float]]:
+    """For each start, every root in the cluster around the root nearest it, ascending.
+
+    The multiplicity of a polished root comes from :meth:`_multiplicities`
+    (the offsets μ of the linearised pencil, confirmed by a root count;
+    the singular values of a 60×60 Ū_all are too spread to count on);
+    the other small real offsets are polished in turn and kept when they
+    reach another root (farther than SPLIT: closer ones are the same,
+    possibly multiple, root, and their offsets seen from it may show a
+    higher multiplicity than the first arrival's did: a double root of a
+    loop rigid in five directions showed its second offset only within
+    1e-13 of the root). Without ``confirm`` the multiplicities are read
+    from the offsets alone (see :meth:`_multiplicities`) and the member
+    starts go to :attr:`deferred_members` (a simple root's pencil can show
+    a spurious near offset: polishing every one cost MLRS 6 ms).
+    """
+    polished = finder.polish(starts, early=not confirm)
+    groups, members_from = [], []
+    for (centre, mu), multiplicity in zip(polished, finder._multiplicities(polished, confirm)):
+        if centre is None:
+            groups.append([])
+            continue
+        groups.append([centre] * multiplicity)
+        real = mu[np.abs(mu.imag) <= 1e-6 * np.abs(mu)].real
+        outside = np.abs(real) >= finder.SPLIT * centre
+        if confirm:
+            near = real[outside & (np.abs(real) < finder.CLUSTER_WINDOW * centre)]
+            members_from += [(len(groups) - 1, centre - offset) for offset in near]
+        else:  # polished only if the caller's closing count finds one missing
+            near = real[outside & (np.abs(real) < finder.DEFERRED_WINDOW * centre)]
+            finder.deferred_members += [(centre - offset, centre) for offset in near]
+    if members_from:
+        returned = []  # members that came back to a root of their group: more evidence
+        for (g, _), result in zip(members_from, finder.polish([s for _, s in members_from])):
+            member = result[0]
+            if member is None:
+                continue
+            if all(abs(member - r) > finder.SPLIT * r for r in groups[g]):
+                groups[g].append(member)
+            else:
+                returned.append((g, min(groups[g], key=lambda r: abs(r - member)), result))
+        for (g, root, _), multiplicity in zip(returned, finder._multiplicities([r for *_, r in returned],
+                                                                            confirm)):
+            groups[g] += [root] * (multiplicity - groups[g].count(root))
+    return [sorted(group) for group in groups]
+
+
+def centre_multiplicities(finder, polished, confirm: bool = True) -> list[int]:
+    """How many roots sit at each polished centre, given its pencil offsets mu.
+
+    A root of multiplicity m leaves m offsets near zero, split by rounding
+    to about √eps and not always real (7 arms of NAFEMS FV2: up to 6e-5).
+    Where more than one offset is below SPLIT·ω, a root count over a circle
+    of radius SPLIT·ω (less, if another root is nearer) decides; all those
+    counts share one evaluation per refinement round. The circle holds one
+    root (of some multiplicity m) at its centre and no other within twice
+    its radius, so the phase turns smoothly by mπ over the half circle and
+    CIRCLE_POINTS starting points (refined where log det changes fast) suffice.
+    Without ``confirm`` the number of offsets below SPLIT·ω is taken as it
+    is: for a caller that counts all its roots at the end anyway.
+    """
+    if not confirm:
+        return [1 if centre is None else max(int(np.sum(np.abs(mu) < finder.SPLIT * centre)), 1)
+                for centre, mu in polished]
+    multiplicities = [1] * len(polished)
+    asked, intervals = [], []
+    for i, (centre, mu) in enumerate(polished):
+        size = np.abs(mu)
+        if centre is None or np.sum(size < finder.SPLIT * centre) <= 1:
+            continue
+        farther = size[size >= finder.SPLIT * centre]
+        radius = min(finder.SPLIT * centre, farther.min() / 2 if farther.size else np.inf)
+        asked.append(i)
+        intervals.append((centre - radius, centre + radius))
+    counts = (count_zeros_many(finder.log_det, intervals, max_points=CIRCLE_MAX_POINTS, initial_points=CIRCLE_POINTS)
+              if asked else [])
+    for i, count in zip(asked, counts):
+        multiplicities[i] = 1 if isinstance(count, RuntimeError) else max(count, 1)
+    finder._counted.update((polished[i][0], multiplicities[i]) for i in asked)
+    return multiplicities
+
+
+def cluster(finder, omega: float) -> list[float]:
+    """Every root in the cluster around the root nearest ``omega`` (see :meth:`clusters`)."""
+    return finder.clusters([omega])[0]
+
+
+def recounted(finder, found: list[float], roots) -> list[float]:
+    """``found`` with the multiplicity of each of ``roots`` (distinct, in ``found``)
+    counted over a small circle (all circles in one count; see :meth:`_multiplicities`)
+    instead of read from its pencil offsets, which can show spurious near-zero ones
+    or (a Newton stopped early) miss a double root's second one. Where a circle
+    cannot be counted the root is taken as simple: an unconfirmed multiplicity could
+    hide a missing root from the closing count, a missing one cannot."""
+    finder._counted.update((r, count or 1) for r, count in zip(roots, finder.multiplicities(roots, sorted(set(found)))))
+    return finder._as_counted(found)
+
+
+def as_counted(finder, found: list[float]) -> list[float]:
+    """``found`` with each root repeated as often as a circle count gave it (:attr:`_counted`),
+    the others as often as they are."""
+    return sorted(r for r in set(found) for _ in range(finder._counted.get(r, found.count(r))))
+
+
+def circle_radius(finder, root: float, others) -> float:
+    """Radius (rad/s) of the circle that counts the multiplicity of ``root``: SPLIT·ω,
+    less where a root of ``others`` is nearer (half the distance)."""
+    return min([finder.SPLIT * root] + [abs(root - other) / 2 for other in others if other != root])
+
+
+def multiplicities(finder, roots, others=()) -> list:
+    """How many roots sit at each of ``roots`` (rad/s, roots found), counted over a
+    circle of radius SPLIT·ω, less where a root of ``others`` is nearer (all
+    circles in one count; see :meth:`_multiplicities`); None where the count
+    cannot be made."""
+    if not len(roots):
+        return []
+    radii = [finder._circle_radius(r, others) for r in roots]
+    counts = count_zeros_many(finder.log_det, [(r - radius, r + radius) for r, radius in zip(roots, radii)],
+                              max_points=CIRCLE_MAX_POINTS, initial_points=CIRCLE_POINTS)
+    return [None if isinstance(c, RuntimeError) else max(c, 1) for c in counts]
+
+
+def unseparated_among(finder, roots) -> dict:
+    """The :attr:`unseparated` entries of ``roots`` (rad/s), ascending."""
+    return {r: finder.unseparated[r] for r in sorted(set(roots)) if r in finder.unseparated}
+
+
+def multiplicity(finder, root: float, others=()) -> int | None:
+    """How many roots sit at ``root``: the circle count already made for it while
+    finding the roots, else one made now (:meth:`multiplicities`)."""
+    return finder._counted.get(root) or finder.multiplicities([root], others)[0]
+
+
+def separated(finder, roots: list[float]) -> list[float]:
+    """``roots`` with each multiple one that is a cluster of distinct roots split into them.
+
+    Roots closer than SPLIT are counted as one multiple root (a circle of that
+    radius holds them all). Each multiple root is counted again over a circle
+    100 times smaller (all in one count): a multiple root keeps its count, a
+    cluster does not, and its members are then isolated by bisection on the
+    count within the first circle (:meth:`_isolate`). A random loop's double
+    root and the simple one 1.9e-5 above it had come back as one triple root.
+    Where float64 cannot separate them they stay together, and
+    :attr:`unseparated` says so (root -> (multiplicity, radius, rad/s)):
+    ``natural_frequencies`` then separates them in mpmath
+    (:func:`~linmstmm.precision.separated_cluster`), or names them in its note.
+    """
+    distinct = sorted(set(roots))
+    # (a list cut at a count may hold one copy of a root counted as multiple)
+    multiple = [r for r in distinct if max(roots.count(r), finder._counted.get(r, 1)) > 1]
+    if not multiple:
+        return roots
+    radii = [finder._circle_radius(r, distinct) for r in multiple]
+    tight = count_zeros_many(finder.log_det, [(r - radius / 100, r + radius / 100)
+                                            for r, radius in zip(multiple, radii)],
+                             max_points=CIRCLE_MAX_POINTS, initial_points=CIRCLE_POINTS)
+    separated = list(roots)
+    for r, radius, count in zip(multiple, radii, tight):
+        m = finder._counted.get(r, roots.count(r))  # (``roots`` may end inside a multiple root)
+        if count == m or (r == distinct[-1] and count > roots.count(r)):
+            continue
+        try:
+            members = finder._isolate(r - radius, r + radius, m, [r])
+        except RuntimeError:
+            finder.unseparated[r] = (m, radius)
+            continue
+        separated = [x for x in separated if x != r] + members[:roots.count(r)]
+    return sorted(separated)

@@ -1,0 +1,252 @@
+"""The coordinating class of the root search (:class:`RootFinder`): its state, its
+entry points :meth:`~RootFinder.find` and :meth:`~RootFinder.find_near`, and the
+steps it delegates to the modules of :mod:`linmstmm.roots`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from linmstmm.counting import count_in_disc, deflated
+from linmstmm.predicted import predicted_roots
+from linmstmm.roots import brackets, certify, fast_path, floor, pencil, segments
+from linmstmm.roots import clusters as close_roots
+from linmstmm.roots.settings import (
+    CEILING_RATIO,
+    DEFAULT_SCALE,
+    FLOOR_RATIO,
+    MAX_XTOL,
+    MIN_POINTS_PER_OCTAVE,
+    POINTS_PER_OCTAVE,
+    PREDICTION_MARGIN,
+)
+
+
+class RootFinder:
+    """Finds the natural frequencies of a deduced model.
+
+    log_det : callable omega (n,) -> (sign (n,), log|det| (n,)).
+    matrix : callable omega (n,) -> Ū_all stack (n, N, N).
+    xtol : Newton's relative tolerance. points_per_octave : scan density, at
+    least POINTS_PER_OCTAVE (a denser scan leaves fewer close roots to the
+    repairs; a coarser one is refused, see MIN_POINTS_PER_OCTAVE).
+    points_per_root : the segment search's scan density per counted root.
+    rigid_body_modes : number of zero-frequency modes, from the model's
+    kinematics (:func:`linmstmm.rigid_motion.rigid_body_mode_count`); their
+    zeros of det Ū_all at ω = 0 are divided out once they are confirmed
+    (:meth:`divide_out_rigid_body_zeros`).
+    predictor : callable n -> (m,) rad/s, the lowest n elastic roots predicted
+    (e.g. :func:`linmstmm.predicted.predict_frequencies` of the model), or None.
+    scale : rad/s, the model's own frequency scale; the floor, ceiling and scan
+    chunks are multiples of it (see DEFAULT_SCALE).
+
+    Candidates come from the scan; each is polished by local linearisation
+    (Newton for the nonlinear eigenproblem Ū(ω) v = 0): with A = Ū(ω) and
+    B = dŪ/dω the generalized eigenvalues μ of A v = μ B v are the offsets
+    to the nearby roots, ω ← ω − μ. It converges to machine precision for
+    simple and for semisimple multiple roots alike (unlike minimising |det|,
+    which stalls at √eps for a double root), and a root of multiplicity m
+    shows m eigenvalues μ ≈ 0 at convergence.
+    """
+
+    #: Offsets |μ|/ω below this are the same root (multiplicity).
+    SAME_ROOT = 1e-9
+    #: Newton steps |μ|/ω that stop shrinking below this have reached the rounding
+    #: floor of Ū_all: the root is accepted, with that step as its uncertainty
+    #: (:attr:`last_step`; the caller refines uncertain roots in mpmath).
+    UNCERTAIN = 1e-7
+    #: log|det| must rise by this much either side of a root without a sign change (a
+    #: double root's rises by 2 ln 10 at ten times the distance to it).
+    DIP = 1.0
+    #: Offsets |μ|/ω below this may be a multiple root split by rounding (a count decides);
+    #: roots closer than this are reported as one multiple root.
+    SPLIT = 1e-4
+    #: An interval this narrow (relative) that a count says holds roots float64 cannot find
+    #: is their enclosure: :meth:`_isolate` reports them at its middle, for
+    #: ``natural_frequencies`` to separate in mpmath (:attr:`unseparated`).
+    CERTIFIED_WIDTH = 1e-9
+    #: Offsets |μ|/ω below this are polished as members of the same cluster.
+    CLUSTER_WINDOW = 2e-3
+    #: :meth:`_narrowed` evaluates this many − 1 equally spaced points per bracket and round.
+    NARROWING_SECTIONS = 8
+    #: The same for the fast path's deferred members (:attr:`deferred_members`).
+    DEFERRED_WINDOW = 6e-2
+    #: A deferred member this close to another root found or start, relative to its
+    #: offset from the root that gave it, is that root again (linearisation error).
+    MEMBER_OVERLAP = 0.25
+    #: Passes of :meth:`_rescanned` over the stored scan, each with the roots the last found.
+    RESCANS = 3
+    #: After a Newton step below this (relative), the next one is likely the last:
+    #: compute all the offsets there, not only the smallest.
+    LAST_STEPS = 1e-8
+    #: The same where Newton may stop early (:meth:`_quadratic`): one round sooner.
+    LAST_STEPS_EARLY = 1e-4
+    #: A Newton step below this (relative) that shows quadratic convergence to a
+    #: simple root may be the last one (:meth:`_quadratic`).
+    EARLY = 1e-9
+
+    def __init__(self, log_det, matrix, xtol: float = 1e-14,
+                 points_per_octave: int = POINTS_PER_OCTAVE, points_per_root: int = 6,
+                 rigid_body_modes: int = 0, predictor=None, scale: float = DEFAULT_SCALE):
+        if not 0 < xtol <= MAX_XTOL:
+            raise ValueError(f"xtol must be in (0, {MAX_XTOL:g}], got {xtol:g}: looser Newton "
+                             "tolerances blur distinct roots into one")
+        if points_per_octave < MIN_POINTS_PER_OCTAVE:
+            raise ValueError(f"points_per_octave must be at least {MIN_POINTS_PER_OCTAVE}, got "
+                             f"{points_per_octave:g}: a coarser scan is slower, not faster (the roots "
+                             "it misses cost more to recover than it saves; reports/speed_accuracy.md)")
+        if not (np.isfinite(scale) and scale > 0):
+            raise ValueError(f"scale must be a positive frequency (rad/s), got {scale!r}")
+        self.log_det = log_det
+        self.matrix = matrix
+        #: rad/s: the model's frequency scale, where every count starts, and where a
+        #: search for ``count`` roots gives up
+        self.scale, self.floor, self.ceiling = scale, FLOOR_RATIO * scale, CEILING_RATIO * scale
+        self.xtol = xtol
+        self.points_per_octave = points_per_octave
+        self.points_per_root = points_per_root
+        #: root -> relative size of the last Newton step that reached it
+        self.last_step: dict[float, float] = {}
+        #: why the search ended early, if it did
+        self.note = ""
+        self._rigid = rigid_body_modes
+        self._divided = False  # the rigid-body zeros divided out of log_det
+        #: callable n -> (m,) predicted lowest elastic roots, rad/s, or None
+        self.predictor = predictor
+        #: the compiled determinant behind ``log_det`` and ``matrix``, where the
+        #: caller gives one (:mod:`linmstmm.determinant`: it counts evaluations)
+        self.determinant = None
+        #: starts of cluster members not yet polished (see :meth:`clusters`)
+        self.deferred_members: list[tuple[float, float]] = []  # (start, the root whose pencil gave it)
+        #: sign-change brackets (lo, hi) Newton missed that :meth:`_needed` left out
+        self.left_out: list[tuple[float, float]] = []
+        #: rad/s: a count found no root from the floor up to here (see :meth:`_scanned`)
+        self.root_free_below = self.floor
+        #: root -> (multiplicity, radius rad/s): roots float64 could not tell apart (:meth:`_separated`),
+        #: or could not find where a count encloses them (:meth:`_isolate`)
+        self.unseparated: dict[float, tuple[int, float]] = {}
+        #: root -> multiplicity a circle count gave it (1 where it could not be made; :meth:`_settled`)
+        self._counted: dict[float, int] = {}
+
+    def divide_out_rigid_body_zeros(self, rigid: int) -> None:
+        """Count and scan det Ū_all / ω^2r instead of det Ū_all.
+
+        With r rigid-body modes det ∝ ω^2r at ω = 0: a contour that passes a
+        few floors from the origin sees the phase turn 2r times faster
+        than ω's own angle, and its sampling aliases (false counts of 2, 4,
+        6 roots below the first elastic one). Dividing by ω^2r removes that
+        known factor exactly; the roots elsewhere are unchanged. Checked
+        first: the disc |ω| < floor must hold exactly 2r zeros.
+        """
+        if rigid and count_in_disc(self.log_det, self.floor) == 2 * rigid:
+            self.log_det = deflated(self.log_det, np.zeros(rigid))
+            self._divided = True
+
+    def rigid_body_modes(self) -> int:
+        """Number of zero-frequency (rigid-body) modes, as given at construction."""
+        return self._rigid
+
+    def find_near(self, guesses, count: int) -> list[float]:
+        """The lowest ``count`` roots, warm-started from ``guesses`` (rad/s).
+
+        Guesses (e.g. the roots of a neighbouring scene of the same model) are
+        taken as predictions (:func:`~linmstmm.predicted.predicted_roots`: the
+        secant on det, one certifying count); where that cannot certify them,
+        they are polished on the pencil and one count over (floor, just above
+        the count-th root) must confirm that none was missed. Otherwise the
+        full search runs.
+        """
+        guesses = np.sort(np.asarray(guesses, dtype=float))
+        found = predicted_roots(self, guesses, count) if guesses.size >= count else None
+        if found is not None:
+            return self._separated_above_floor(found)[:count]
+        found = self._confirmed(self._polished(guesses, []), count)
+        return found if found is not None else self._search(count, None)
+
+    def find(self, count: int | None, omega_max: float | None) -> list[float]:
+        """Elastic roots (rad/s) ascending, each repeated per multiplicity.
+
+        The lowest ``count``, or all up to ``omega_max``, with none missed:
+        from the predictor's frequencies when one count confirms them
+        (:func:`~linmstmm.predicted.predicted_roots`, with ``count``), else the
+        fast path (:meth:`_scan_ahead`) when one count confirms it, else the
+        segment search (:meth:`_search`).
+        """
+        if count is not None and self.predictor is not None:
+            predictions = self.predictor(count + PREDICTION_MARGIN + count // 10)
+            found = predicted_roots(self, predictions, count) if self._usable(predictions) else None
+            if found is not None:  # certified up to above the count-th: complete below omega_max too
+                found = self._separated_above_floor(found)
+                return [w for w in found[:count] if omega_max is None or w <= omega_max]
+        found = self._scan_ahead(count, omega_max) if count is not None or omega_max is not None else None
+        if found is None:
+            found = self._search(count, omega_max)
+        found = self._separated_above_floor(found)
+        return found[:count] if count is not None else found
+
+    # The steps of the search, each a function of the finder in its own module; called
+    # through these attributes, so that one can be timed or replaced on the class.
+
+    # refinement: Newton on the pencil (Ū, dŪ/dω) (:mod:`linmstmm.roots.pencil`)
+    _pencil = pencil.pencil
+    _offsets = pencil.offsets
+    polish = pencil.polish
+    _checked = pencil.checked
+    _quadratic = pencil.quadratic
+
+    # clusters of close roots and multiplicities (:mod:`linmstmm.roots.clusters`, imported as close_roots)
+    clusters = close_roots.clusters
+    _multiplicities = close_roots.centre_multiplicities
+    cluster = close_roots.cluster
+    _recounted = close_roots.recounted
+    _as_counted = close_roots.as_counted
+    _circle_radius = close_roots.circle_radius
+    multiplicities = close_roots.multiplicities
+    unseparated_among = close_roots.unseparated_among
+    multiplicity = close_roots.multiplicity
+    _separated = close_roots.separated
+
+    # the floor: nothing hides below it (:mod:`linmstmm.roots.floor`)
+    _separated_above_floor = floor.separated_above_floor
+    _usable = floor.usable
+    _check_floor = floor.check_floor
+
+    # sign-change brackets and the roots Newton reaches from them (:mod:`linmstmm.roots.brackets`)
+    shrink_brackets = brackets.shrink_brackets
+    _narrowed = brackets.narrowed
+    _bracketed = brackets.bracketed
+    _narrowed_groups = brackets.narrowed_groups
+    _needed = brackets.needed
+    _bracket_roots = brackets.bracket_roots
+    _merge = brackets.merge
+    _polished = brackets.polished
+    _with_groups = brackets.with_groups
+
+    # the segment search: count, scan, bisect (:mod:`linmstmm.roots.segments`)
+    _roots_in = segments.roots_in
+    _split_point = segments.split_point
+    _isolate = segments.isolate
+    segment = segments.segment
+    _lowest = segments.lowest
+    _next_top = staticmethod(segments.next_top)
+    _search = segments.search
+
+    # certification by argument-principle counts (:mod:`linmstmm.roots.certify`)
+    _confirmed = certify.confirmed
+    _settled = certify.settled
+    _count_top = certify.count_top
+    _recovered = certify.recovered
+    _below_count = staticmethod(certify.below_count)
+    confirm_no_other_zeros = certify.confirm_no_other_zeros
+    other_zeros = certify.other_zeros
+
+    # the fast path: scan ahead, polish, close by one count (:mod:`linmstmm.roots.fast_path`)
+    _scan_ahead = fast_path.scan_ahead
+    _closed = fast_path.closed
+    _with_members = fast_path.with_members
+    _with_left_out = fast_path.with_left_out
+    _member_starts = fast_path.member_starts
+    _rescanned = fast_path.rescanned
+    _deflated_candidates = fast_path.deflated_candidates
+    _scanned = fast_path.scanned
+    _holds_no_roots = fast_path.holds_no_roots
+    _quick_grid = fast_path.quick_grid

@@ -77,13 +77,13 @@ def _rigid_motions(model, layout) -> np.ndarray:
     """
     labels = _components(model, layout)
     segments = _components(model, layout, through_joints=False)
-    held = [sp.csr_matrix((np.ones(1), ([0], [dof])), shape=(1, 6 * layout.n_nodes))
-            for point, components in model.boundary.items()
-            for dof in layout.index.point(point)[np.asarray(components, bool)]]
-    held += [sp.csr_matrix((values, (np.zeros(6, int), cols)), shape=(1, 6 * layout.n_nodes))
-             for spring in model.springs if spring.released.size and _across_segments(spring, layout, segments)
-             for _, cols, values in _spring_directions(spring, layout.index, kept_only=True)]
-    held = sp.vstack(held).tocsc() if held else sp.csc_matrix((0, 6 * layout.n_nodes))
+    directions = [(np.array([dof]), np.ones(1))  # (columns, values) of each held direction
+                  for point, components in model.boundary.items()
+                  for dof in layout.index.point(point)[np.asarray(components, bool)]]
+    directions += [(cols, values)
+                   for spring in model.springs if spring.released.size and _across_segments(spring, layout, segments)
+                   for _, cols, values in _spring_directions(spring, layout.index, kept_only=True)]
+    held = _rows_matrix(directions, 6 * layout.n_nodes)
     motions = []
     for label in np.unique(labels):
         nodes = np.flatnonzero(labels == label)
@@ -100,6 +100,17 @@ def _rigid_motions(model, layout) -> np.ndarray:
             motion[dofs] = la.orth(field @ allowed)
             motions.append(motion)
     return np.hstack(motions) if motions else np.zeros((6 * layout.n_nodes, 0))
+
+
+def _rows_matrix(rows, width: int) -> sp.csc_matrix:
+    """(len(rows), width) sparse matrix of ``rows``, each (columns, values): built at once,
+    not stacked from a matrix per row (which took most of an assembly of the launcher)."""
+    if not rows:
+        return sp.csc_matrix((0, width))
+    columns = np.concatenate([cols for cols, _ in rows])
+    values = np.concatenate([vals for _, vals in rows])
+    row_of = np.repeat(np.arange(len(rows)), [cols.size for cols, _ in rows])
+    return sp.csc_matrix((values, (row_of, columns)), shape=(len(rows), width))
 
 
 def _rigid_basis(motions, M):

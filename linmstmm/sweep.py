@@ -54,6 +54,9 @@ from linmstmm.parameters import get_value, parse_key, with_values
 #: new process. Not "auto" (which follows what this process has loaded), so that a step
 #: gives the same bits in this process, in a fresh worker process and on a cluster.
 ENGINE = "numpy"
+#: Stations along each beam for the mode shapes of a step: its ends (a step's shapes are
+#: read at the points; the points' displacements do not depend on the stations).
+SHAPE_STATIONS = 2
 #: Seconds to wait for a dask scheduler given by address before giving up.
 SCHEDULER_TIMEOUT = 10
 
@@ -210,7 +213,7 @@ def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGI
     """
     from linmstmm.modes import mode_shapes
 
-    modes = mode_shapes(model, count=count, engine=engine,
+    modes = mode_shapes(model, count=count, stations=SHAPE_STATIONS, engine=engine,
                         guess_hz=None if start is None else start.frequencies_hz)
     rigid = modes.rigid_body_modes
     elastic = slice(rigid, rigid + min(count, modes.omega.size - rigid))

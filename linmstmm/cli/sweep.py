@@ -20,8 +20,8 @@ from linmstmm.cli.common import (
     positive_int,
     writing,
 )
-from linmstmm.parameters import parse_key, unit
 from linmstmm.determinant import ENGINES
+from linmstmm.parameters import parse_key, unit
 from linmstmm.sweep import ENGINE, Vary, grid, sweep
 
 #: Elastic frequencies per step unless --count says otherwise.

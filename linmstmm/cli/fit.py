@@ -7,10 +7,14 @@ file exits with status 2 (one line naming the file and the key).
 """
 from __future__ import annotations
 
-import argparse
-
 from linmstmm import load_model
-from linmstmm.cli.common import add_model_argument, add_output_options, emit, stages
+from linmstmm.cli.common import (
+    add_model_argument,
+    add_output_options,
+    emit,
+    parsed_by,
+    stages,
+)
 from linmstmm.determinant import ENGINES
 from linmstmm.fit import Bounds, fit, read_measured
 from linmstmm.sweep import ENGINE
@@ -23,21 +27,14 @@ def add_fit_command(subparsers) -> None:
     add_model_argument(command)
     command.add_argument("measured", help="CSV: a column 'frequency [Hz]', one row per measured mode, "
                                           "optionally shape columns POINT.DIR (DIR x, y, z, rx, ry, rz)")
-    command.add_argument("--vary", type=_bounds, action="append", required=True, metavar="KEY=START:STOP",
+    command.add_argument("--vary", type=parsed_by(Bounds.parse), action="append", required=True,
+                         metavar="KEY=START:STOP",
                          help="a value of the model to fit (e.g. spring.k1.k[2], rigid.m2.mass), "
                               "bounded by START and STOP; the model's value is the starting point")
     command.add_argument("--engine", choices=ENGINES, default=ENGINE,
                          help=f"how det Ubar_all is evaluated (default {ENGINE})")
     add_output_options(command)
     command.set_defaults(run=run_fit)
-
-
-def _bounds(text):
-    """argparse type of --vary: a :class:`linmstmm.fit.Bounds`."""
-    try:
-        return Bounds.parse(text)
-    except ValueError as error:
-        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def run_fit(args) -> int:

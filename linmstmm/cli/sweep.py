@@ -7,8 +7,6 @@ exits with status 2 (one line naming the file and the key).
 """
 from __future__ import annotations
 
-import argparse
-
 import numpy as np
 
 from linmstmm import load_model
@@ -17,6 +15,7 @@ from linmstmm.cli.common import (
     add_model_argument,
     add_output_options,
     emit,
+    parsed_by,
     positive_int,
     writing,
 )
@@ -33,7 +32,8 @@ def add_sweep_command(subparsers) -> None:
     command = subparsers.add_parser("sweep", help="natural frequencies over a grid of model values, "
                                                   "modes tracked by shape")
     add_model_argument(command)
-    command.add_argument("--vary", type=_vary, action="append", required=True, metavar="KEY=START:STOP:N[:log]",
+    command.add_argument("--vary", type=parsed_by(Vary.parse), action="append", required=True,
+                         metavar="KEY=START:STOP:N[:log]",
                          help="a value of the model (e.g. spring.k1.k[2], beam.arm.E, rigid.m2.mass, "
                               "points.tip[0]) from START to STOP in N steps (:log geometric); several form a grid")
     command.add_argument("--zip", action="store_true", help="pair the --vary ranges (same N) instead of a grid")
@@ -53,14 +53,6 @@ def add_sweep_command(subparsers) -> None:
                          help="start each step's root search from its neighbouring step's frequencies")
     add_output_options(command, csv_layout="one row per step (values, tracked frequencies, ranks, sensitivities)")
     command.set_defaults(run=run_sweep)
-
-
-def _vary(text):
-    """argparse type of --vary: a :class:`linmstmm.sweep.Vary`."""
-    try:
-        return Vary.parse(text)
-    except ValueError as error:
-        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def run_sweep(args) -> int:

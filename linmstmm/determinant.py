@@ -43,11 +43,35 @@ def load_kernels() -> None:
     import linmstmm._kernels  # noqa: F401
 
 
-def determinant(deduction: Deduction, engine: str = "auto"):
-    """The determinant of ``deduction`` by ``engine`` ("auto", "numpy" or "compiled")."""
+def resolved_engine(engine: str) -> str:
+    """The engine ``engine`` stands for in this process now.
+
+    Parameters
+    ----------
+    engine : str
+        "auto", "numpy" or "compiled".
+
+    Returns
+    -------
+    str
+        "numpy" or "compiled": "auto" is "compiled" once the kernels are loaded
+        here (:func:`load_kernels`), "numpy" before.
+
+    Raises
+    ------
+    ValueError
+        For an engine not in ENGINES.
+    """
     if engine not in ENGINES:
         raise ValueError(f"engine must be one of {ENGINES}, got {engine!r}")
-    if engine == "compiled" or (engine == "auto" and kernels_loaded()):
+    if engine == "auto":
+        return "compiled" if kernels_loaded() else "numpy"
+    return engine
+
+
+def determinant(deduction: Deduction, engine: str = "auto"):
+    """The determinant of ``deduction`` by ``engine`` ("auto", "numpy" or "compiled")."""
+    if resolved_engine(engine) == "compiled":
         return CompiledDeterminant(deduction)
     return NumpyDeterminant(deduction)
 

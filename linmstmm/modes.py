@@ -271,7 +271,7 @@ def mac_matrix(a, b) -> np.ndarray:
 @single_blas_thread
 def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = None,
                 stations: int = 21, normalization: str = DEFAULT_NORMALIZATION, rigid_body: bool = True,
-                root: str | None = None, engine: str = "auto") -> ModalResult:
+                root: str | None = None, guess_hz=None, engine: str = "auto") -> ModalResult:
     """Natural modes of ``model`` by the transfer matrix method.
 
     The frequencies come from the pipeline of
@@ -300,6 +300,10 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         Include the zero-frequency modes first.
     root : str or None
         Boundary end to use as the root of the transfer tree.
+    guess_hz : array_like or None
+        Frequencies (Hz) of a similar model (a neighbouring step of a sweep)
+        to start the root search from, as for
+        :func:`linmstmm.solve.natural_frequencies` (with ``count`` only).
     engine : str
         How the root search evaluates det Ū_all, as for
         :func:`linmstmm.solve.natural_frequencies` ("auto", "numpy" or "compiled");
@@ -319,7 +323,7 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         raise ValueError(f"normalization must be one of {NORMALIZATIONS}, got {normalization!r}")
     if stations < 2:
         raise ValueError(f"stations must be >= 2, got {stations}")
-    solution = solve_roots(model, count, fmax, root=root, engine=engine)
+    solution = solve_roots(model, count, fmax, root=root, guess_hz=guess_hz, engine=engine)
     deduction, finder = solution.deduction, solution.finder
     omegas = solution.omegas
     if count and omegas.size == count:  # the count may cut the last eigenspace

@@ -157,7 +157,7 @@ def unknown_key(model: Model, text: str) -> ModelError:
     keys = parameter_keys(model)
     close = [k for k in keys if k.lower() == text.lower()] or difflib.get_close_matches(text, keys, n=1, cutoff=0.5)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
-    return ModelError(_file(model), f"names no number of the model{hint}; keys look like "
+    return ModelError(model_file(model), f"names no number of the model{hint}; keys look like "
                                     "rigid.NAME.mass, spring.NAME.k[2], beam.NAME.E, points.NAME[0]",
                       key=text)
 
@@ -290,6 +290,17 @@ def _beam_on(beam, points):
     return dataclasses.replace(beam, length=length, axes=axes)
 
 
-def _file(model: Model) -> str:
-    """The model's file for messages, or ``model 'name'`` for one built in code."""
+def model_file(model: Model) -> str:
+    """Where ``model`` comes from, for the messages of a ModelError.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+
+    Returns
+    -------
+    str
+        Its file, or ``model 'name'`` for a model built in code.
+    """
     return model.source if isinstance(model.source, str) else f"model {model.name!r}"

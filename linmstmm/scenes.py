@@ -13,6 +13,12 @@ their tubes lighter in the same sums.
 the slot of the model file's own flexible tube, the names of the cradle and
 of the flexible tube's elements, the empty cradle frame and the rocket mass
 (smeared over the tube beams in the model file).
+
+A scene is a set of edits of the model file's values (:func:`scene_values`,
+keys of :mod:`linmstmm.parameters`), so a sequence of scenes is a parameter
+study: :func:`scene_study` solves it with :func:`linmstmm.sweep.sweep` (warm
+starts from the previous scene, modes tracked by MAC, local processes or a
+dask cluster), and :func:`scene_model` is the model of one scene.
 """
 from __future__ import annotations
 
@@ -24,7 +30,8 @@ from pathlib import Path
 import numpy as np
 
 from linmstmm.model import Model, load_model
-from linmstmm.solve import natural_frequencies
+from linmstmm.parameters import parse_key, with_values
+from linmstmm.sweep import SweepResult, sweep
 
 
 @dataclass(frozen=True)
@@ -192,14 +199,35 @@ def cradle_props(model: Model, bundle: Bundle, tube: int,
     return total
 
 
-def scene_model(base, tube: int, rockets_fired=frozenset(), bundle: Bundle | None = None) -> Model:
-    """The model of the scene where tube ``tube`` fires.
+def scene_values(model: Model, tube: int, rockets_fired=frozenset(),
+                 bundle: Bundle | None = None) -> dict[str, float]:
+    """The scene where tube ``tube`` fires, as edits of ``model``.
 
-    base : a Model or a model file path (``bundle.toml`` is read beside it
-    unless ``bundle`` is given). rockets_fired : slots whose rockets are gone
-    (not ``tube`` itself: the firing tube is loaded).
+    Parameters
+    ----------
+    model : Model
+        The launcher model (its flexible tube in the bundle's base slot).
+    tube : int
+        The firing tube's slot, 1 … rows · columns.
+    rockets_fired : iterable of int
+        Slots whose rockets are gone (not ``tube`` itself: the firing tube is loaded).
+    bundle : Bundle or None
+        Default the ``bundle.toml`` beside the model file.
+
+    Returns
+    -------
+    dict of str to float
+        Key (:mod:`linmstmm.parameters`) -> value, SI: every coordinate of the
+        flexible tube's points and mass centres, moved to slot ``tube`` (m),
+        and the cradle's mass (kg), mass centre (m) and inertia tensor (kg m²,
+        each symmetric pair once). Every scene sets the same keys, so a list
+        of scenes is a list of steps for :func:`linmstmm.sweep.sweep`.
+
+    Raises
+    ------
+    ValueError
+        For a slot that is not in the bundle, or a firing tube listed as fired.
     """
-    model = base if isinstance(base, Model) else load_model(base)
     bundle = bundle or bundle_beside(model)
     fired = frozenset(rockets_fired)
     if tube in fired:
@@ -211,21 +239,48 @@ def scene_model(base, tube: int, rockets_fired=frozenset(), bundle: Bundle | Non
     moving = set()
     for element in map(model.element, bundle.tube):
         moving.update(element.ports if element.kind == "rigid" else element.ends)
-    points = {name: _frozen(p + offset) if name in moving else p
-              for name, p in model.points.items()}
+    values = {}
+    for name in (p for p in model.points if p in moving):
+        values.update(_vector(f"points.{name}", model.points[name] + offset))
     cradle = cradle_props(model, bundle, tube, fired)
-    rigids = []
-    for rigid in model.rigids:
-        if rigid.name == bundle.cradle:
-            rigid = dataclasses.replace(rigid, mass=cradle.mass, com=_frozen(cradle.com),
-                                        inertia=_frozen(cradle.inertia))
-        elif rigid.name in bundle.tube:
-            rigid = dataclasses.replace(rigid, com=_frozen(rigid.com + offset))
-        rigids.append(rigid)
+    values[f"rigid.{bundle.cradle}.mass"] = float(cradle.mass)
+    values.update(_vector(f"rigid.{bundle.cradle}.com", cradle.com))
+    values.update({f"rigid.{bundle.cradle}.inertia[{i}][{j}]": float(cradle.inertia[i, j])
+                   for i in range(3) for j in range(i, 3)})
+    for rigid in (r for r in model.rigids if r.name in bundle.tube):
+        values.update(_vector(f"rigid.{rigid.name}.com", rigid.com + offset))
+    return values
+
+
+def scene_model(base, tube: int, rockets_fired=frozenset(), bundle: Bundle | None = None) -> Model:
+    """The model of the scene where tube ``tube`` fires.
+
+    Parameters
+    ----------
+    base : Model or path
+        The launcher model or its file (``bundle.toml`` is read beside it
+        unless ``bundle`` is given).
+    tube : int
+        The firing tube's slot.
+    rockets_fired : iterable of int
+        Slots whose rockets are gone (not ``tube`` itself: the firing tube is loaded).
+    bundle : Bundle or None
+        The tube bundle.
+
+    Returns
+    -------
+    Model
+        ``base`` with the edits of :func:`scene_values` (the beams whose ends
+        moved take their length and axes from the moved points), named after the scene.
+    """
+    model = base if isinstance(base, Model) else load_model(base)
+    fired = frozenset(rockets_fired)
+    values = scene_values(model, tube, fired, bundle)
     name = f"{model.name}, tube {tube} firing"
     if fired:
         name += f", rockets {', '.join(map(str, sorted(fired)))} fired"
-    return dataclasses.replace(model, name=name, points=points, rigids=tuple(rigids))
+    edited = with_values(model, {parse_key(model, key): value for key, value in values.items()})
+    return dataclasses.replace(edited, name=name)
 
 
 def salvo(tube: int) -> frozenset:
@@ -233,34 +288,65 @@ def salvo(tube: int) -> frozenset:
     return frozenset(range(1, tube))
 
 
-def scene_sweep(base, count: int = 6, tubes=range(1, 19), fired=None,
-                bundle: Bundle | None = None, warm_start: bool = True) -> list:
-    """[(tube, frequencies in Hz)] of the scenes of ``tubes``.
+def scene_study(base, count: int = 6, tubes=range(1, 19), fired=None, bundle: Bundle | None = None,
+                warm_start: bool = True, engine: str = "auto", **options) -> SweepResult:
+    """The scenes of ``tubes`` as a parameter study: one step of :func:`linmstmm.sweep.sweep` each.
 
-    warm_start : start each scene's root search from the previous scene's
-    frequencies (polished, then confirmed by one root count; a full search
-    if the count disagrees). Scenes differ only in one tube's position and
-    the cradle's inertia, so the roots move little.
+    Parameters
+    ----------
+    base : Model or path
+        The launcher model or its file; read and validated once, each scene
+        only moves the tube and rebuilds the cradle (:func:`scene_values`).
+    count : int
+        Elastic frequencies per scene.
+    tubes : iterable of int
+        The firing tubes, in the order of the steps.
+    fired : callable or None
+        tube -> slots already fired (e.g. :func:`salvo`); default none.
+    bundle : Bundle or None
+        Default the ``bundle.toml`` beside the model file.
+    warm_start : bool
+        Start each scene's root search from the previous scene's frequencies
+        (certified by a root count as a cold search is). Scenes differ only in
+        one tube's position and the cradle's inertia, so the roots move little.
+    engine : str
+        How det Ū_all is evaluated (default "auto": the compiled kernels if
+        this process has loaded them, as ``natural_frequencies`` does).
+    **options
+        Passed to :func:`linmstmm.sweep.sweep`: ``workers``, ``dask``,
+        ``sensitivity``, ``progress``.
 
-    base : a Model or a model file path. The file and its bundle are read
-    and validated once; each scene only moves the tube and rebuilds the
-    cradle. fired : callable tube -> slots already fired (e.g. :func:`salvo`),
-    default none. bundle : default the ``bundle.toml`` beside the model file.
+    Returns
+    -------
+    SweepResult
+        One step per tube, modes tracked by MAC from scene to scene.
     """
     model = base if isinstance(base, Model) else load_model(base)
     bundle = bundle or bundle_beside(model)
-    results = []
-    guess = None
-    for tube in tubes:
-        scene = scene_model(model, tube, fired(tube) if fired else frozenset(), bundle)
-        frequencies = natural_frequencies(scene, count=count, guess_hz=guess).frequencies_hz
-        results.append((tube, frequencies))
-        guess = frequencies if warm_start else None
-    return results
+    steps = [scene_values(model, tube, fired(tube) if fired else frozenset(), bundle) for tube in tubes]
+    return sweep(model, steps, count=count, warm_start=warm_start, engine=engine, **options)
 
 
-def _frozen(array) -> np.ndarray:
-    """A read-only float copy, like the records of :func:`linmstmm.model.load_model`."""
-    array = np.array(array, dtype=float)
-    array.flags.writeable = False
-    return array
+def scene_sweep(base, count: int = 6, tubes=range(1, 19), fired=None,
+                bundle: Bundle | None = None, warm_start: bool = True, engine: str = "auto",
+                **options) -> list:
+    """[(tube, frequencies in Hz)] of the scenes of ``tubes``, from :func:`scene_study`.
+
+    Parameters
+    ----------
+    base, count, tubes, fired, bundle, warm_start, engine, **options
+        As for :func:`scene_study`.
+
+    Returns
+    -------
+    list of (int, ndarray)
+        Per tube its elastic natural frequencies (Hz, ascending, at most ``count``).
+    """
+    tubes = list(tubes)
+    study = scene_study(base, count, tubes, fired, bundle, warm_start, engine, **options)
+    return [(tube, row[~np.isnan(row)]) for tube, row in zip(tubes, study.frequencies_hz_by_rank)]
+
+
+def _vector(key: str, values) -> dict[str, float]:
+    """``key[i]`` -> ``values[i]`` for each coordinate of a (3,) vector."""
+    return {f"{key}[{i}]": float(v) for i, v in enumerate(values)}

@@ -2,13 +2,22 @@
 
 A sweep is a list of steps, each a dict key -> value (keys:
 :mod:`linmstmm.parameters`). :func:`grid` builds it from :class:`Vary`
-ranges, as their outer product or (``zipped``) side by side. Each step is an
-edited copy of the model, solved afresh by
-:func:`~linmstmm.solve.natural_frequencies` with the numpy engine (:data:`ENGINE`;
-so every row is exactly what ``linmstmm freqs`` gives on the edited model,
-whatever runs the steps and whatever this process has loaded) and
-:func:`~linmstmm.modes.mode_shapes` (for tracking; and for the sensitivities
-of :mod:`linmstmm.sensitivity`).
+ranges, as their outer product or (``zipped``) side by side; the firing
+scenes of :mod:`linmstmm.scenes` are another list of steps. Each step is an
+edited copy of the model, solved once by :func:`~linmstmm.modes.mode_shapes`
+(its frequencies are those of :func:`~linmstmm.solve.natural_frequencies` to
+the last digit; its shapes serve the tracking and the sensitivities of
+:mod:`linmstmm.sensitivity`). By default with the numpy engine
+(:data:`ENGINE`) and from a cold start, so that every row is exactly what
+``linmstmm freqs`` gives on the edited model, whatever runs the steps.
+
+Options that trade those bits (the roots agree to rounding) for speed:
+``engine="compiled"`` evaluates det Ū_all by the compiled kernels in every
+process that runs steps ("auto" is resolved once, in the calling process, so
+every runner uses the same engine); ``warm_start`` starts each step's root
+search from the frequencies of its neighbour in the grid (below), so a step
+waits for its neighbour and the parallelism is that of the grid's tracking
+tree (a single line runs in order).
 
 Tracking: frequencies by rank swap places where two modes veer or cross. Each
 step is compared with its neighbour in the grid (the step one before it along
@@ -25,25 +34,26 @@ cluster (``dask``); the results are the same.
 from __future__ import annotations
 
 import itertools
-import logging
 import math
-import sys
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
+from functools import partial
 
 import numpy as np
 
+from linmstmm.determinant import resolved_engine
 from linmstmm.model import Model, ModelError
 from linmstmm.parameters import get_value, parse_key, with_values
 from linmstmm.results import Result, decode_array, decode_arrays
+from linmstmm.sweep_runners import run_steps
 
-#: How every step evaluates det Ū_all: the engine ``linmstmm freqs`` uses in a new process.
-#: Fixed, not "auto" (which follows what this process has loaded), so that a step gives
-#: the same bits in this process, in a fresh worker process and on a cluster.
+#: How every step evaluates det Ū_all unless told: the engine ``linmstmm freqs`` uses in a
+#: new process. Not "auto" (which follows what this process has loaded), so that a step
+#: gives the same bits in this process, in a fresh worker process and on a cluster.
 ENGINE = "numpy"
-#: Seconds to wait for a dask scheduler given by address before giving up.
-SCHEDULER_TIMEOUT = 10
+#: Stations along each beam for the mode shapes of a step: its ends (a step's shapes are
+#: read at the points; the points' displacements do not depend on the stations).
+SHAPE_STATIONS = 2
 
 
 @dataclass(frozen=True)
@@ -172,8 +182,9 @@ class StepSolution:
     note: str = ""
 
 
-def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGINE) -> StepSolution:
-    """Frequencies, mode shapes and sensitivities of one step.
+def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGINE,
+               start: StepSolution | None = None) -> StepSolution:
+    """Frequencies, mode shapes and sensitivities of one step, from one solve.
 
     Parameters
     ----------
@@ -185,29 +196,30 @@ def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGI
         Keys whose ∂f/∂value is wanted (none: no mode-shape derivatives).
     engine : str
         How det Ū_all is evaluated, as for :func:`~linmstmm.solve.natural_frequencies`.
+    start : StepSolution or None
+        A neighbouring step whose frequencies start the root search (None: a cold start).
 
     Returns
     -------
     StepSolution
         The frequencies as :func:`~linmstmm.solve.natural_frequencies` with
-        ``engine`` gives them, the mass-normalised shapes at the points and
-        the sensitivities.
+        ``engine`` (and ``guess_hz`` the frequencies of ``start``) gives them,
+        the mass-normalised shapes at the points and the sensitivities.
     """
     from linmstmm.modes import mode_shapes
-    from linmstmm.solve import natural_frequencies
 
-    result = natural_frequencies(model, count=count, engine=engine)
-    modes = mode_shapes(model, count=count, rigid_body=False, engine=engine)
-    found = min(result.frequencies_hz.size, modes.omega.size)
-    shapes = np.stack([modes.point_displacements[p][:found] for p in model.points], axis=1)
+    modes = mode_shapes(model, count=count, stations=SHAPE_STATIONS, engine=engine,
+                        guess_hz=None if start is None else start.frequencies_hz)
+    rigid = modes.rigid_body_modes
+    elastic = slice(rigid, rigid + min(count, modes.omega.size - rigid))
+    shapes = np.stack([modes.point_displacements[p][elastic] for p in model.points], axis=1)
     sensitivities = {}
     if sensitivity_keys:
         from linmstmm.sensitivity import frequency_sensitivities
 
-        sensitivities = {key: values[:found] for key, values in
+        sensitivities = {key: values[elastic] for key, values in
                          frequency_sensitivities(model, modes, sensitivity_keys).items()}
-    return StepSolution(result.frequencies_hz[:found], result.rigid_body_modes, shapes,
-                        sensitivities, result.note)
+    return StepSolution(modes.frequencies_hz[elastic], rigid, shapes, sensitivities, modes.note)
 
 
 @dataclass(frozen=True, eq=False)
@@ -224,6 +236,8 @@ class SweepResult(Result):
     in tracked order (empty without sensitivities).
     rigid_body_modes : (steps,) int. notes : step index -> note of its solve.
     seconds : wall time. workers : what ran the steps ("serial", "2 processes", ...).
+    engine : "numpy" or "compiled", how every step evaluated det Ū_all.
+    warm_start : whether each step started from its neighbour's frequencies.
     """
 
     model: str
@@ -238,6 +252,8 @@ class SweepResult(Result):
     notes: dict
     seconds: float
     workers: str
+    engine: str = ENGINE
+    warm_start: bool = False
 
     kind = "sweep"
 
@@ -259,6 +275,7 @@ class SweepResult(Result):
                if self.sensitivities else {}),
             "notes": {str(step): note for step, note in self.notes.items()},
             "solves": len(self.values), "seconds": self.seconds, "workers": self.workers,
+            "engine": self.engine, "warm_start": self.warm_start,
         }
 
     @classmethod
@@ -291,7 +308,8 @@ class SweepResult(Result):
 
 
 def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = False,
-          workers: int = 1, dask=None, progress: bool = False) -> SweepResult:
+          workers: int = 1, dask=None, progress: bool = False, engine: str = ENGINE,
+          warm_start: bool = False) -> SweepResult:
     """Natural frequencies of ``model`` at every step, modes tracked by MAC.
 
     Parameters
@@ -316,6 +334,13 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
         worker processes, closed at the end) or a ``distributed.Client``.
     progress : bool
         A tqdm bar on stderr (only when stderr is a terminal).
+    engine : str
+        How every step evaluates det Ū_all: "numpy", "compiled", or "auto"
+        (what this process has loaded, :func:`linmstmm.determinant.resolved_engine`;
+        the runners all use that engine).
+    warm_start : bool
+        Start each step's root search from the frequencies of its neighbour
+        (:func:`neighbours`; found, then certified by a count as from a cold start).
 
     Returns
     -------
@@ -330,18 +355,23 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
     steps = list(steps)
     shape = tuple(shape) if shape is not None else (len(steps),)
     _check_steps(steps, shape)
+    engine = resolved_engine(engine)
     keys = [parse_key(model, text) for text in steps[0]]
     models = [_edited(model, keys, step) for step in steps]
     names = tuple(key.text for key in keys)
-    solutions, label = _run(models, count, names if sensitivity else (), workers, dask, progress)
-    order, mac = track([s.shapes for s in solutions], neighbours(shape), count, _length_scale(model))
+    previous = neighbours(shape)
+    solve = partial(solve_step, count=count, sensitivity_keys=names if sensitivity else (), engine=engine)
+    solutions, label = run_steps(models, solve, previous if warm_start else [None] * len(models),
+                            workers, dask, progress)
+    order, mac = track([s.shapes for s in solutions], previous, count, _length_scale(model))
     return SweepResult(
         model.name, names, np.array([[get_value(m, key) for key in keys] for m in models]).reshape(-1, len(keys)),
         shape, _padded([s.frequencies_hz for s in solutions], count), order, mac,
         {name: _tracked(_padded([s.sensitivities[name] for s in solutions], count), order)
          for name in (names if sensitivity else ())},
         np.array([s.rigid_body_modes for s in solutions], dtype=int),
-        {i: s.note for i, s in enumerate(solutions) if s.note}, time.perf_counter() - start, label)
+        {i: s.note for i, s in enumerate(solutions) if s.note}, time.perf_counter() - start, label,
+        engine, warm_start)
 
 
 def track(shapes, previous, count: int, length: float) -> tuple[np.ndarray, np.ndarray]:
@@ -365,7 +395,8 @@ def track(shapes, previous, count: int, length: float) -> tuple[np.ndarray, np.n
     mac : ndarray
         (steps, count): MAC of each column against the same column at the previous step.
     """
-    from scipy.optimize import linear_sum_assignment  # scipy.optimize costs every command 0.1 s to import
+    # here, not at the top: importing scipy.optimize costs every command 0.1 s
+    from scipy.optimize import linear_sum_assignment
 
     steps = len(shapes)
     order = np.full((steps, count), -1, dtype=int)
@@ -405,65 +436,6 @@ def _edited(model: Model, keys, step: dict) -> Model:
         where = ", ".join(f"{key.text} = {step[key.text]:g}" for key in keys)
         raise ModelError(error.file, f"{error.message} (in the step {where})",
                          element=error.element, key=error.key) from None
-
-
-def _run(models, count, keys, workers, dask, progress):
-    """[StepSolution] of every model in order, and what ran them."""
-    bar = _progress(len(models), progress)
-    try:
-        if dask is not None:
-            return _on_dask(models, count, keys, dask, workers, bar)
-        if workers > 1:
-            with ProcessPoolExecutor(max_workers=workers) as pool:
-                futures = {pool.submit(solve_step, m, count, keys): i for i, m in enumerate(models)}
-                return _collected(as_completed(futures), futures, bar), f"{workers} processes"
-        solutions = []
-        for m in models:
-            solutions.append(solve_step(m, count, keys))
-            bar.update()
-        return solutions, "serial"
-    finally:
-        bar.close()
-
-
-def _on_dask(models, count, keys, dask, workers, bar):
-    """Run the steps on a dask.distributed cluster (see :func:`sweep`)."""
-    from distributed import Client, LocalCluster
-
-    if isinstance(dask, Client):
-        return _dask_map(dask, models, count, keys, bar), f"dask {dask.scheduler.address}"
-    if dask == "local":
-        with LocalCluster(n_workers=max(workers, 2), threads_per_worker=1, dashboard_address=None,
-                          silence_logs=logging.ERROR) as cluster, Client(cluster) as client:
-            return _dask_map(client, models, count, keys, bar), f"dask LocalCluster ({max(workers, 2)} workers)"
-    with Client(dask, timeout=SCHEDULER_TIMEOUT) as client:
-        return _dask_map(client, models, count, keys, bar), f"dask {dask}"
-
-
-def _dask_map(client, models, count, keys, bar):
-    """[StepSolution] of every model in order, solved on the cluster of ``client``."""
-    from distributed import as_completed as dask_completed
-
-    futures = client.map(solve_step, models, count=count, sensitivity_keys=keys, pure=False)
-    index = {future.key: i for i, future in enumerate(futures)}
-    return _collected(dask_completed(futures), {f: index[f.key] for f in futures}, bar)
-
-
-def _collected(done, index_of, bar) -> list:
-    """Results of futures in step order, ``done`` yielding them as they finish."""
-    solutions = [None] * len(index_of)
-    for future in done:
-        solutions[index_of[future]] = future.result()
-        bar.update()
-    return solutions
-
-
-def _progress(total: int, wanted: bool):
-    """A tqdm bar on stderr, silent unless ``wanted`` and stderr is a terminal."""
-    from tqdm import tqdm
-
-    return tqdm(total=total, unit="step", file=sys.stderr,
-                disable=not (wanted and sys.stderr.isatty()))
 
 
 def _length_scale(model: Model) -> float:

@@ -289,3 +289,23 @@ def test_cli_bad_requests_exit_2_with_one_line(argv, message):
     status, out, err = run_cli("sweep", CHAIN, *argv)
     assert status == 2 and out == ""
     assert err.count("\n") == 1 and message in err and "Traceback" not in err
+
+
+def test_compiled_engine_and_warm_starts_give_freqs_to_rounding_whoever_runs_the_steps(tmp_path):
+    """--engine compiled --warm-start: every step started from its neighbour's roots, det
+    by the kernels in every process. Serial and two processes give the same bits (each
+    step starts from the same neighbour), and both what freqs gives on the edited files
+    from a cold start with numpy, to rounding."""
+    varies = ["--vary", "rigid.m2.mass=1.5:3:3", "--vary", "spring.k3.k[1]=600:1500:3:log"]
+    steps, _ = grid([Vary.parse(varies[1]), Vary.parse(varies[3])])
+    outputs = []
+    for runner in (["--workers", "1"], ["--workers", "2"]):
+        status, out, err = run_cli("sweep", CHAIN, *varies, "--count", 4, "--json", "--engine", "compiled",
+                                   "--warm-start", *runner)
+        assert status == 0, err
+        outputs.append(json.loads(out))
+    assert outputs[0]["engine"] == "compiled" and outputs[0]["warm_start"] is True
+    assert {k: v for k, v in outputs[0].items() if k not in ("seconds", "workers")} == \
+        {k: v for k, v in outputs[1].items() if k not in ("seconds", "workers")}
+    np.testing.assert_allclose(outputs[0]["frequencies_hz_by_rank"], reference(CHAIN, steps, 4, tmp_path),
+                               rtol=1e-12)

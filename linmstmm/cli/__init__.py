@@ -20,6 +20,7 @@ from linmstmm import ModelError, __version__
 from linmstmm.cli.check import add_check_command
 from linmstmm.cli.common import ComputationError, UsageError
 from linmstmm.cli.fe import add_fe_command
+from linmstmm.cli.fit import add_fit_command
 from linmstmm.cli.freqs import add_freqs_command
 from linmstmm.cli.frf import add_frf_command
 from linmstmm.cli.modes import add_modes_command
@@ -37,6 +38,7 @@ COMMANDS = [
     add_response_command,
     add_frf_command,
     add_sweep_command,
+    add_fit_command,
 ]
 
 #: Every command with one example on the bundled models (shown by ``linmstmm -h``).
@@ -49,6 +51,7 @@ COMMAND_EXAMPLES = {
     "response": "linmstmm response models/cantilever_tip_mass.toml models/loads/cantilever_step.toml",
     "frf": "linmstmm frf models/cantilever_tip_mass.toml --point tip --direction z --fmax 100",
     "sweep": "linmstmm sweep models/spring_mass_chain.toml --vary spring.k2.k[0]=500:2000:4:log --count 3",
+    "fit": "linmstmm fit models/spring_mass_chain.toml models/measured/spring_mass_chain.csv --vary rigid.m2.mass=1:4",
 }
 
 class _Parser(argparse.ArgumentParser):

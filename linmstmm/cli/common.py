@@ -60,6 +60,28 @@ def damping_ratios(text: str) -> list[float]:
     return ratios
 
 
+def parsed_by(parse):
+    """An argparse ``type`` calling ``parse(text)``, its ValueError the option's one-line error.
+
+    Parameters
+    ----------
+    parse : callable
+        str -> value, raising ValueError for a malformed text (e.g. ``Vary.parse``).
+
+    Returns
+    -------
+    callable
+        The ``type`` for ``add_argument``.
+    """
+    def convert(text):
+        try:
+            return parse(text)
+        except ValueError as error:
+            raise argparse.ArgumentTypeError(str(error)) from None
+
+    return convert
+
+
 def add_model_argument(parser) -> None:
     """The positional MODEL of every command."""
     parser.add_argument("model", help="model file (TOML, see model-format.md)")

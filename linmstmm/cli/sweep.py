@@ -7,8 +7,6 @@ exits with status 2 (one line naming the file and the key).
 """
 from __future__ import annotations
 
-import argparse
-
 import numpy as np
 
 from linmstmm import load_model
@@ -17,11 +15,13 @@ from linmstmm.cli.common import (
     add_model_argument,
     add_output_options,
     emit,
+    parsed_by,
     positive_int,
     writing,
 )
+from linmstmm.determinant import ENGINES
 from linmstmm.parameters import parse_key, unit
-from linmstmm.sweep import Vary, grid, sweep
+from linmstmm.sweep import ENGINE, Vary, grid, sweep
 
 #: Elastic frequencies per step unless --count says otherwise.
 DEFAULT_COUNT = 5
@@ -32,7 +32,8 @@ def add_sweep_command(subparsers) -> None:
     command = subparsers.add_parser("sweep", help="natural frequencies over a grid of model values, "
                                                   "modes tracked by shape")
     add_model_argument(command)
-    command.add_argument("--vary", type=_vary, action="append", required=True, metavar="KEY=START:STOP:N[:log]",
+    command.add_argument("--vary", type=parsed_by(Vary.parse), action="append", required=True,
+                         metavar="KEY=START:STOP:N[:log]",
                          help="a value of the model (e.g. spring.k1.k[2], beam.arm.E, rigid.m2.mass, "
                               "points.tip[0]) from START to STOP in N steps (:log geometric); several form a grid")
     command.add_argument("--zip", action="store_true", help="pair the --vary ranges (same N) instead of a grid")
@@ -45,16 +46,13 @@ def add_sweep_command(subparsers) -> None:
                          help="local processes running the steps (default 1)")
     command.add_argument("--dask", metavar="ADDRESS",
                          help="run the steps on a dask.distributed scheduler; 'local' starts a LocalCluster")
+    command.add_argument("--engine", choices=ENGINES, default=ENGINE,
+                         help=f"how every step evaluates det Ubar_all (default {ENGINE}: the bits of "
+                              "'linmstmm freqs'; compiled: numba kernels in every process, faster on long sweeps)")
+    command.add_argument("--warm-start", action="store_true",
+                         help="start each step's root search from its neighbouring step's frequencies")
     add_output_options(command, csv_layout="one row per step (values, tracked frequencies, ranks, sensitivities)")
     command.set_defaults(run=run_sweep)
-
-
-def _vary(text):
-    """argparse type of --vary: a :class:`linmstmm.sweep.Vary`."""
-    try:
-        return Vary.parse(text)
-    except ValueError as error:
-        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def run_sweep(args) -> int:
@@ -66,7 +64,8 @@ def run_sweep(args) -> int:
         raise UsageError(f"linmstmm sweep: --vary: {error}") from None
     try:
         result = sweep(model, steps, count=args.count, shape=shape, sensitivity=args.sensitivity,
-                       workers=args.workers, dask=args.dask, progress=not args.quiet)
+                       workers=args.workers, dask=args.dask, progress=not args.quiet,
+                       engine=args.engine, warm_start=args.warm_start)
     except OSError as error:  # a scheduler that cannot be reached
         raise UsageError(f"linmstmm sweep: --dask {args.dask}: {error}") from None
     data = result.to_dict()
@@ -88,7 +87,8 @@ def print_table(result) -> None:
     """Print the sweep as a text table: values, then the tracked frequencies, per step."""
     count = result.order.shape[1]
     print(f"{result.model}: natural frequencies over {len(result.values)} steps "
-          f"({result.workers}, {result.seconds:.2f} s); columns follow mode shapes (MAC)")
+          f"({result.workers}, {result.engine} engine{', warm starts' if result.warm_start else ''}, "
+          f"{result.seconds:.2f} s); columns follow mode shapes (MAC)")
     head = [f"{key:>14}" for key in result.keys] + [f"{'mode ' + str(c + 1) + ' [Hz]':>14}" for c in range(count)]
     print("  " + "  ".join(head))
     for values, row in zip(result.values, result.frequencies_hz):

@@ -314,7 +314,7 @@ def scene_study(base, count: int = 6, tubes=range(1, 19), fired=None, bundle: Bu
         this process has loaded them, as ``natural_frequencies`` does).
     **options
         Passed to :func:`linmstmm.sweep.sweep`: ``workers``, ``dask``,
-        ``sensitivity``, ``progress``.
+        ``sensitivity``, ``progress``, ``track_modes``.
 
     Returns
     -------
@@ -330,7 +330,9 @@ def scene_study(base, count: int = 6, tubes=range(1, 19), fired=None, bundle: Bu
 def scene_sweep(base, count: int = 6, tubes=range(1, 19), fired=None,
                 bundle: Bundle | None = None, warm_start: bool = True, engine: str = "auto",
                 **options) -> list:
-    """[(tube, frequencies in Hz)] of the scenes of ``tubes``, from :func:`scene_study`.
+    """[(tube, frequencies in Hz)] of the scenes of ``tubes``, from :func:`scene_study` without
+    mode shapes or tracking (the frequencies by rank, as the firing-scene tables show them:
+    half the cost of a tracked study).
 
     Parameters
     ----------
@@ -343,7 +345,7 @@ def scene_sweep(base, count: int = 6, tubes=range(1, 19), fired=None,
         Per tube its elastic natural frequencies (Hz, ascending, at most ``count``).
     """
     tubes = list(tubes)
-    study = scene_study(base, count, tubes, fired, bundle, warm_start, engine, **options)
+    study = scene_study(base, count, tubes, fired, bundle, warm_start, engine, track_modes=False, **options)
     return [(tube, row[~np.isnan(row)]) for tube, row in zip(tubes, study.frequencies_hz_by_rank)]
 
 

@@ -183,7 +183,7 @@ class StepSolution:
 
 
 def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGINE,
-               start: StepSolution | None = None) -> StepSolution:
+               start: StepSolution | None = None, with_shapes: bool = True) -> StepSolution:
     """Frequencies, mode shapes and sensitivities of one step, from one solve.
 
     Parameters
@@ -198,6 +198,9 @@ def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGI
         How det Ū_all is evaluated, as for :func:`~linmstmm.solve.natural_frequencies`.
     start : StepSolution or None
         A neighbouring step whose frequencies start the root search (None: a cold start).
+    with_shapes : bool
+        False: the frequencies alone (by :func:`~linmstmm.solve.natural_frequencies`,
+        the same roots), shapes (m, 0, 6); not with ``sensitivity_keys``.
 
     Returns
     -------
@@ -207,9 +210,14 @@ def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGI
         the mass-normalised shapes at the points and the sensitivities.
     """
     from linmstmm.modes import mode_shapes
+    from linmstmm.solve import natural_frequencies
 
-    modes = mode_shapes(model, count=count, stations=SHAPE_STATIONS, engine=engine,
-                        guess_hz=None if start is None else start.frequencies_hz)
+    guess_hz = None if start is None else start.frequencies_hz
+    if not with_shapes and not sensitivity_keys:  # the shapes cost a launcher step as much as its roots
+        result = natural_frequencies(model, count, engine=engine, guess_hz=guess_hz)
+        found = result.frequencies_hz
+        return StepSolution(found, result.rigid_body_modes, np.zeros((found.size, 0, 6)), note=result.note)
+    modes = mode_shapes(model, count=count, stations=SHAPE_STATIONS, engine=engine, guess_hz=guess_hz)
     rigid = modes.rigid_body_modes
     elastic = slice(rigid, rigid + min(count, modes.omega.size - rigid))
     shapes = np.stack([modes.point_displacements[p][elastic] for p in model.points], axis=1)
@@ -309,7 +317,7 @@ class SweepResult(Result):
 
 def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = False,
           workers: int = 1, dask=None, progress: bool = False, engine: str = ENGINE,
-          warm_start: bool = False) -> SweepResult:
+          warm_start: bool = False, track_modes: bool = True) -> SweepResult:
     """Natural frequencies of ``model`` at every step, modes tracked by MAC.
 
     Parameters
@@ -341,6 +349,10 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
     warm_start : bool
         Start each step's root search from the frequencies of its neighbour
         (:func:`neighbours`; found, then certified by a count as from a cold start).
+    track_modes : bool
+        False: no mode shapes (about half of a launcher step's cost) and no
+        tracking: every column follows the rank (``order`` the ranks, ``tracking_mac``
+        NaN); not with ``sensitivity``.
 
     Returns
     -------
@@ -360,10 +372,18 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
     models = [_edited(model, keys, step) for step in steps]
     names = tuple(key.text for key in keys)
     previous = neighbours(shape)
-    solve = partial(solve_step, count=count, sensitivity_keys=names if sensitivity else (), engine=engine)
+    if sensitivity and not track_modes:
+        raise ValueError("sensitivities need the mode shapes: track_modes must be True")
+    solve = partial(solve_step, count=count, sensitivity_keys=names if sensitivity else (), engine=engine,
+                    with_shapes=track_modes)
     solutions, label = run_steps(models, solve, previous if warm_start else [None] * len(models),
-                            workers, dask, progress)
-    order, mac = track([s.shapes for s in solutions], previous, count, _length_scale(model))
+                                 workers, dask, progress)
+    if track_modes:
+        order, mac = track([s.shapes for s in solutions], previous, count, _length_scale(model))
+    else:  # every column its rank
+        found = np.array([s.frequencies_hz.size for s in solutions])[:, None]
+        order = np.where(np.arange(count) < found, np.arange(count), -1)
+        mac = np.full(order.shape, np.nan)
     return SweepResult(
         model.name, names, np.array([[get_value(m, key) for key in keys] for m in models]).reshape(-1, len(keys)),
         shape, _padded([s.frequencies_hz for s in solutions], count), order, mac,

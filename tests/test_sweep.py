@@ -309,3 +309,17 @@ def test_compiled_engine_and_warm_starts_give_freqs_to_rounding_whoever_runs_the
         {k: v for k, v in outputs[1].items() if k not in ("seconds", "workers")}
     np.testing.assert_allclose(outputs[0]["frequencies_hz_by_rank"], reference(CHAIN, steps, 4, tmp_path),
                                rtol=1e-12)
+
+
+def test_a_study_without_tracking_gives_the_same_frequencies_by_rank():
+    """track_modes=False skips the mode shapes (natural_frequencies per step): the same
+    roots, bit for bit, each column its rank; sensitivities are refused without shapes."""
+    chain = load_model(CHAIN)
+    steps = grid([Vary("spring.k2.k[0]", 500.0, 2000.0, 4, log=True)])[0]
+    tracked = sweep(chain, steps, count=3)
+    by_rank = sweep(chain, steps, count=3, track_modes=False)
+    assert np.array_equal(by_rank.frequencies_hz_by_rank, tracked.frequencies_hz_by_rank)
+    assert np.array_equal(by_rank.order, np.tile(np.arange(3), (4, 1)))
+    assert np.all(np.isnan(by_rank.tracking_mac))
+    with pytest.raises(ValueError, match="track_modes"):
+        sweep(chain, steps, count=3, sensitivity=True, track_modes=False)

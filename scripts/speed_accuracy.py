@@ -736,8 +736,8 @@ def write_report(args, command, facts, loads, elapsed, beam_model, beam_referenc
     w(f"* BLAS: {facts['blas']}. Environment: "
       + (", ".join(f"`{k}={v}`" for k, v in facts["env"].items()) or "no OPENBLAS_/OMP_ variables") + ". "
       "These are the machine's settings (OPENBLAS_CORETYPE pins OpenBLAS to its Haswell kernels on this CPU, "
-      "which has AVX-512); this script does not change them. The MSTMM work is on small (≤ 60×60) matrices in "
-      "Python loops, effectively one core; BLAS threads matter little to it.")
+      "which has AVX-512); this script does not change them. The MSTMM work is on small (≤ 60×60) matrices, "
+      "one core; BLAS threads matter little to it.")
     w(f"* Code: `git` {git_state()}.")
     w("* Load average (1 / 5 / 15 min) during the run: "
       + "; ".join(f"{label}: {value}" for label, value in loads) + ". "

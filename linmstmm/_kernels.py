@@ -23,9 +23,13 @@ import math
 import numpy as np
 from numba import njit
 
-from linmstmm.elements.beam import BENDING_PIECE, ROD_PIECE
 from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, STATE_BLOCK, TIP
 
+#: See linmstmm.elements.beam: beam pieces. Copies, not imports: numba's cache keeps the
+#: values a global had when this file was compiled (tests/test_compiled_core.py
+#: checks them against the originals).
+BENDING_PIECE = 4.0
+ROD_PIECE = 1.0
 #: See linmstmm.deduction: growth between orthonormalisations, far scale.
 GROWTH = 1e2
 FAR = 1e100

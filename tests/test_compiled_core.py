@@ -19,6 +19,8 @@ from linmstmm.precision import mp_determinant, working_digits
 from linmstmm.solve import natural_frequencies
 from linmstmm.determinant import CompiledDeterminant
 from linmstmm.topology import build_topology
+from linmstmm import _kernels
+from linmstmm.elements import beam as beam_element
 from linmstmm.elements.beam import rod_growth
 from random_models import KINDS, random_model
 from test_joints import beam_on_joint, four_bar, hinged_chain, pinned_bars, sliding_carts, with_random_joints
@@ -132,3 +134,18 @@ def test_torsion_growing_off_the_real_axis_beneath_the_largest_entries():
             exact = float(mpmath.log(abs(mp_determinant(deduction, mpmath.mpmathify(omega)))))
         for engine in (deduction, compiled):
             assert abs(engine.log_det(np.array([omega]))[1][0] - exact) <= 1e-11 * abs(exact), (omega, engine)
+
+
+def test_the_kernels_cut_beams_as_the_numpy_carry_does():
+    """The kernels' copies of the piece limits are the carry's (numba's cache would
+    keep stale imported values), and the same beams give the same pieces."""
+    assert (_kernels.BENDING_PIECE, _kernels.ROD_PIECE) == (beam_element.BENDING_PIECE, beam_element.ROD_PIECE)
+    model = varied_model(4)[0]
+    deduction, compiled = both(model)
+    topology = deduction.topology
+    beams = [topology.elements[e].record for e in topology.order if topology.elements[e].kind == "beam"]
+    assert len(beams) == len(compiled.program.beams)
+    for row, beam in zip(compiled.program.beams, beams):
+        for omega in (0.5, 0.5 + 0.01j, 0.5 + 0.5j, 40.0 + 3j):
+            assert _kernels._beam_pieces(row, abs(omega), abs(omega.imag)) == \
+                beam_element.beam_pieces(beam, np.array([omega]))

@@ -99,8 +99,19 @@ ROD_PIECE = 1.0
 
 
 def rod_growth(beam, off_axis: float) -> float:
-    """Largest |Im kL| of the beam's axial (k = ω √(ρ/E)) and torsional (k = ω √(ρIp/GJ))
-    waves over its length at |Im ω| = ``off_axis`` rad/s; rigid directions do not grow."""
+    """How much the beam's axial and torsional waves grow over its length off the real axis.
+
+    Parameters
+    ----------
+    beam : Beam record.
+    off_axis : float, |Im ω|, rad/s.
+
+    Returns
+    -------
+    float
+        The larger |Im kL| (dimensionless) of the axial (k = ω √(ρ/E)) and torsional
+        (k = ω √(ρIp/GJ)) waves; a rigid direction does not grow.
+    """
     growth = 0.0
     if beam.axial:
         growth = off_axis * beam.length * math.sqrt(beam.rho / beam.E)
@@ -110,12 +121,21 @@ def rod_growth(beam, off_axis: float) -> float:
 
 
 def beam_pieces(beam, omega) -> tuple[int, bool]:
-    """(pieces, by_rods): how many equal pieces the stable carry cuts ``beam`` into for
-    the frequencies ``omega`` (rad/s, real or complex, (n,)), and whether the axial or
-    torsional waves off the real axis decided it (every piece is then orthonormalised).
+    """How many equal pieces the stable carry cuts a beam into.
 
     Pieces of βL ≤ :data:`BENDING_PIECE` (:func:`bending_wavenumber` at the largest
     |ω|) and of |Im kL| ≤ :data:`ROD_PIECE` (:func:`rod_growth` at the largest |Im ω|).
+
+    Parameters
+    ----------
+    beam : Beam record.
+    omega : (n,) frequencies of one stack, rad/s, real or complex.
+
+    Returns
+    -------
+    pieces : int >= 1.
+    by_rods : bool, the axial or torsional waves off the real axis decided ``pieces``
+        (every piece is then orthonormalised).
     """
     omega = np.asarray(omega)
     bending = bending_wavenumber(beam, float(np.max(np.abs(omega)))) * beam.length / BENDING_PIECE

@@ -9,7 +9,7 @@ counterpart that stays the readable reference and the test oracle:
 * :func:`evaluate` — :meth:`linmstmm.deduction.Deduction.matrix` and
   :meth:`~linmstmm.deduction.Deduction.log_det` with ``stable=True``: the carry
   with Godunov orthonormalisation (:class:`linmstmm.godunov._Orthonormaliser`),
-  beams cut into pieces (:func:`_beam_pieces`), Ū_all assembled, LU.
+  beams cut into pieces of βL ≤ 4, Ū_all assembled, LU.
 
 Frequencies are evaluated in groups of consecutive entries that take the
 same decisions (pieces per beam, orthonormalisations skipped), as one numpy
@@ -25,12 +25,8 @@ from numba import njit
 
 from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, STATE_BLOCK, TIP
 
-#: See linmstmm.elements.beam: beam pieces. Copies, not imports: numba's cache keeps the
-#: values a global had when this file was compiled (tests/test_compiled_core.py
-#: checks them against the originals).
-BENDING_PIECE = 4.0
-ROD_PIECE = 1.0
-#: See linmstmm.deduction: growth between orthonormalisations, far scale.
+#: See linmstmm.deduction: beam pieces, growth between orthonormalisations, far scale.
+BEAM_PIECE_BETA_L = 4.0
 GROWTH = 1e2
 FAR = 1e100
 _SERIES_LIMIT4 = 16.0  # |w| below 2**4: Krylov functions by their power series
@@ -91,22 +87,6 @@ def _rod(stiffness, inertia, L, omega, rigid, local, a, b):
     local[b, b] = np.cos(kL)
     local[a, b] = -L / stiffness * sinc
     local[b, a] = stiffness / L * kL * kL * sinc
-
-
-@njit(cache=True)
-def _beam_pieces(beam, largest, off_axis):
-    """:func:`linmstmm.elements.beam.beam_pieces` of ``beam`` (10,) for frequencies of
-    largest |ω| ``largest`` and largest |Im ω| ``off_axis``: (pieces, by_rods)."""
-    E, G, rho, A, Iy, Iz, J, Ip, L = beam[0], beam[1], beam[2], beam[3], beam[4], beam[5], beam[6], beam[7], beam[8]
-    flags = int(beam[9])
-    bending = (rho * A * largest ** 2 / (E * min(Iy, Iz))) ** 0.25 * L / BENDING_PIECE
-    rods = 0.0
-    if flags & 1:
-        rods = off_axis * L * math.sqrt(rho / E)
-    if flags & 2:
-        rods = max(rods, off_axis * L * math.sqrt(rho * Ip / (G * J)))
-    rods /= ROD_PIECE
-    return max(int(math.ceil(max(bending, rods))), 1), rods > bending
 
 
 @njit(cache=True)
@@ -328,12 +308,10 @@ def _run(program, omegas, work, reference, log_scale):
      orthos, ortho_blocks, beams, beam_rotation) = program
     ortho_program = (slot_offset, slot_rows, slot_width, places, places_start, orthos, ortho_blocks)
     group = omegas.size
-    largest, off_axis = 0.0, 0.0
+    largest = 0.0
     for m in range(group):
         largest = max(largest, abs(omegas[m]))
-        off_axis = max(off_axis, abs(omegas[m].imag))
     pieces = np.ones(beams.shape[0], dtype=np.int64)
-    by_rods = np.zeros(beams.shape[0], dtype=np.bool_)
     piece = np.zeros((group, 12, 12), dtype=omegas.dtype)
     for op in range(operations.shape[0]):
         code, a, b, c, d = (operations[op, 0], operations[op, 1], operations[op, 2], operations[op, 3],
@@ -391,15 +369,15 @@ def _run(program, omegas, work, reference, log_scale):
         if code == BEAM:
             beam = beams[b]
             if c == 1:
-                pieces[b], by_rods[b] = _beam_pieces(beam, largest, off_axis)
+                softer = min(beam[4], beam[5])
+                beta_L = (beam[2] * beam[3] * largest ** 2 / (beam[0] * softer)) ** 0.25 * beam[8]
+                pieces[b] = max(int(math.ceil(beta_L / BEAM_PIECE_BETA_L)), 1)
             for m in range(group):
                 beam_piece(beam, beam_rotation[b], omegas[m], beam[8] / pieces[b], piece[m])
             for repeat in range(1 if c == 1 else pieces[b] - 1):
                 for m in range(group):
                     state = _view(work[m], slot_offset[a], 12, slot_width[a])
                     state[:, :] = piece[m] @ state.copy()
-                    if by_rods[b]:  # every piece orthonormalised (the ORTHO after the first too)
-                        reference[m, a] = np.nan
                 if c == 0 and d >= 0:
                     _orthonormalise(ortho_program, d, work, reference, log_scale, group)
 
@@ -456,7 +434,11 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
                               slot_width, slot_columns, slot_columns_start, slot_rows)
             if matrices_out.shape[0]:
                 matrices_out[start + m] = ubar
-            sign, log_abs = np.linalg.slogdet(ubar)
-            sign_out[start + m] = sign
-            log_abs_out[start + m] = log_abs + log_scale[m]
+            if np.all(np.isfinite(ubar)):
+                sign, log_abs = np.linalg.slogdet(ubar)
+                sign_out[start + m] = sign
+                log_abs_out[start + m] = log_abs + log_scale[m]
+            else:  # numpy's slogdet answers NaN, which the root counts step round; numba's raises
+                sign_out[start + m] = np.nan
+                log_abs_out[start + m] = np.nan
             log_scale_out[start + m] = log_scale[m]

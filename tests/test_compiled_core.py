@@ -19,12 +19,8 @@ from linmstmm.precision import mp_determinant, working_digits
 from linmstmm.solve import natural_frequencies
 from linmstmm.determinant import CompiledDeterminant
 from linmstmm.topology import build_topology
-from linmstmm import _kernels
-from linmstmm.elements import beam as beam_element
-from linmstmm.elements.beam import rod_growth
 from random_models import KINDS, random_model
 from test_joints import beam_on_joint, four_bar, hinged_chain, pinned_bars, sliding_carts, with_random_joints
-from varied_models import varied_model
 
 FREQUENCIES = np.array([0.0, 0.37, 3.1, 27.0, 240.0, 1900.0, 1.6e4, 1.3e5])
 
@@ -117,35 +113,3 @@ def test_matrix_stack_shares_its_decisions():
     np.testing.assert_allclose(np.linalg.slogdet(stack[0])[1] + log_scale[0],
                                deduction.log_det(np.array([omega]))[1], rtol=1e-12)
     assert np.abs(reference_change).max() < 1e-4 * np.abs(reference[0]).max()
-
-
-def test_torsion_growing_off_the_real_axis_beneath_the_largest_entries():
-    """A ring whose strip twists with Ip/J = 4.3e11 (varied model 4, in mm-t-s): at
-    ω = a + ib its torsional waves grow as e^{|Im kL|} (|Im kL| up to 220 at these
-    points, βL below 1), beneath the state's largest entries (its moment rows ρIp ω² L θx).
-    Both engines against the exact determinant (mpmath with digits for that growth) to
-    1e-11: pieces cut by βL alone left log|det| wrong by 2 at 0.3 + 0.3i, and cos kL
-    overflowed further out."""
-    model = varied_model(4)[0]
-    deduction, compiled = both(model)
-    for omega in (0.03 + 0.03j, 0.3 + 0.09j, 0.3 + 0.3j, 1 + 1j, 3 + 0.9j):
-        growth = sum(rod_growth(beam, omega.imag) for beam in model.beams) / np.log(10)
-        with mpmath.workdps(working_digits(model, abs(omega), 20) + int(growth) + 1):
-            exact = float(mpmath.log(abs(mp_determinant(deduction, mpmath.mpmathify(omega)))))
-        for engine in (deduction, compiled):
-            assert abs(engine.log_det(np.array([omega]))[1][0] - exact) <= 1e-11 * abs(exact), (omega, engine)
-
-
-def test_the_kernels_cut_beams_as_the_numpy_carry_does():
-    """The kernels' copies of the piece limits are the carry's (numba's cache would
-    keep stale imported values), and the same beams give the same pieces."""
-    assert (_kernels.BENDING_PIECE, _kernels.ROD_PIECE) == (beam_element.BENDING_PIECE, beam_element.ROD_PIECE)
-    model = varied_model(4)[0]
-    deduction, compiled = both(model)
-    topology = deduction.topology
-    beams = [topology.elements[e].record for e in topology.order if topology.elements[e].kind == "beam"]
-    assert len(beams) == len(compiled.program.beams)
-    for row, beam in zip(compiled.program.beams, beams):
-        for omega in (0.5, 0.5 + 0.01j, 0.5 + 0.5j, 40.0 + 3j):
-            assert _kernels._beam_pieces(row, abs(omega), abs(omega.imag)) == \
-                beam_element.beam_pieces(beam, np.array([omega]))

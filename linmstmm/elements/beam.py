@@ -84,65 +84,6 @@ def bending_wavenumber(beam, omega) -> float:
     return (beam.rho * beam.A * abs(omega) ** 2 / (beam.E * min(beam.Iy, beam.Iz))) ** 0.25
 
 
-#: Largest βL of one beam piece in the stable carry (:func:`beam_pieces`): the piece's
-#: own closed form is exact to rounding, and growth e^4 ≈ 55 between
-#: orthonormalisations costs under two digits of the decaying solutions.
-BENDING_PIECE = 4.0
-#: Largest |Im kL| of one piece for the axial and torsional waves off the real axis. On
-#: the real axis cos kL and sin kL stay bounded; at ω = a + ib they grow as
-#: e^{|b| L √(inertia/stiffness)}, and for a shaft whose Ip is far above J that growth
-#: lies below the largest entries of the state (its moment rows ρIp ω² L θx), where
-#: the carry's size test does not see it. A ring with Iy/Iz = 8.6e11 (|Im kL| up to
-#: 670 on a counting contour) kept log|det| to 1e-13 against mpmath with pieces of 1,
-#: each orthonormalised; pieces of 4 lost it entirely (and, uncut, cos kL overflowed).
-ROD_PIECE = 1.0
-
-
-def rod_growth(beam, off_axis: float) -> float:
-    """How much the beam's axial and torsional waves grow over its length off the real axis.
-
-    Parameters
-    ----------
-    beam : Beam record.
-    off_axis : float, |Im ω|, rad/s.
-
-    Returns
-    -------
-    float
-        The larger |Im kL| (dimensionless) of the axial (k = ω √(ρ/E)) and torsional
-        (k = ω √(ρIp/GJ)) waves; a rigid direction does not grow.
-    """
-    growth = 0.0
-    if beam.axial:
-        growth = off_axis * beam.length * math.sqrt(beam.rho / beam.E)
-    if beam.torsion:
-        growth = max(growth, off_axis * beam.length * math.sqrt(beam.rho * beam.Ip / (beam.G * beam.J)))
-    return growth
-
-
-def beam_pieces(beam, omega) -> tuple[int, bool]:
-    """How many equal pieces the stable carry cuts a beam into.
-
-    Pieces of βL ≤ :data:`BENDING_PIECE` (:func:`bending_wavenumber` at the largest
-    |ω|) and of |Im kL| ≤ :data:`ROD_PIECE` (:func:`rod_growth` at the largest |Im ω|).
-
-    Parameters
-    ----------
-    beam : Beam record.
-    omega : (n,) frequencies of one stack, rad/s, real or complex.
-
-    Returns
-    -------
-    pieces : int >= 1.
-    by_rods : bool, the axial or torsional waves off the real axis decided ``pieces``
-        (every piece is then orthonormalised).
-    """
-    omega = np.asarray(omega)
-    bending = bending_wavenumber(beam, float(np.max(np.abs(omega)))) * beam.length / BENDING_PIECE
-    rods = rod_growth(beam, float(np.max(np.abs(np.imag(omega))))) / ROD_PIECE
-    return max(math.ceil(max(bending, rods)), 1), rods > bending
-
-
 #: Entry (i, j) of the bending transfer of (v, θ, m, q) is
 #: SIGN · L^L_POWER · EI^EI_POWER · w^W_POWER · F_r(w) with r = KRYLOV_INDEX.
 _L_POWER = np.arange(4)[None, :] - np.arange(4)[:, None]

@@ -108,6 +108,29 @@ def unit_differences(model, units: str, frequencies, count: int) -> list[str]:
     return [f"{units} differs from SI by {off:.1e}"] if off > UNITS_AGREEMENT else []
 
 
+#: What is known of seeds that disagreed, found by hand after earlier runs (printed under
+#: the seed's line whenever it disagrees again), and what the check cannot see.
+DIAGNOSES = {
+    218: "FE's refinement does not converge here (its own estimate 5.8e-2; it withholds two "
+         "values). Fixed FE meshes converge on MSTMM as h² up to 256 elements per beam (16: 2.6e-2, "
+         "32: 6.4e-3, 64: 1.6e-3, 128: 4.0e-4 off MSTMM's first frequencies) and then diverge "
+         "(1024: 2.3e-2), while the same model written in SI gives MSTMM's values at 1024 elements "
+         "per beam (0.00390207 Hz both): the FE route is wrong in km, and depends on the units. Ruled "
+         "out: the scaling of its mixed static solve, and the mesh (24,594 unknowns in both units).",
+    248: "FE's own values move by 4.6e-9 between this model and its SI copy, so its error estimate "
+         "(3e-10 to 6e-10) is optimistic here; MSTMM gives the same frequencies in both units to 1e-9.",
+}
+#: Known limits the agreement check does not reach.
+KNOWN_LIMITS = ("Beams are cut into pieces by their bending waves (βL) alone, so off the real axis a "
+                "shaft whose polar inertia is far above its torsion constant (Ip/J = 4.3e11 in seed 4) "
+                "loses log|det| on the counting contours in both engines (2 in 60 at 0.3 + 0.3i rad/s "
+                "against mpmath). Cutting by the axial and torsional waves too (|Im kL| <= 1) restores "
+                "1e-13 there, but made the numpy carry's solve of that model take minutes (its contours "
+                "reach |Im ω| = 14: 3000 pieces), and was not kept. The counts still come out right on "
+                "every model here; far out on a contour, where cos kL overflows, both engines answer NaN "
+                "and the counts step round the point.")
+
+
 def report(rows: list[dict], command: str, seconds: float) -> str:
     """The Markdown report."""
     verdicts = Counter(row["verdict"] for row in rows)
@@ -134,7 +157,12 @@ def report(rows: list[dict], command: str, seconds: float) -> str:
               f"{sum(r['family'] == 'dangling only' for r in rows)} give no elastic frequency from either route.",
               "", "## Disagreements and errors", ""]
     failed = [row for row in rows if row["verdict"] != "agree"]
-    lines += [f"* seed {row['seed']} ({row['variety']}): " + "; ".join(row["problems"]) for row in failed] or ["None."]
+    for row in failed:
+        lines.append(f"* seed {row['seed']} ({row['variety']}): " + "; ".join(row["problems"]))
+        if row["seed"] in DIAGNOSES:
+            lines.append(f"  *Known:* {DIAGNOSES[row['seed']]}")
+    lines += [] if failed else ["None."]
+    lines += ["", "## Known limits", "", KNOWN_LIMITS]
     lines += ["", "## Timings (s per model)", "", "| route | median | 90 % | max |", "|---|---|---|---|"]
     for key, label in (("mstmm_s", "natural_frequencies"), ("fe_s", "fe_frequencies (refined)")):
         times = np.array([row[key] for row in rows if key in row])

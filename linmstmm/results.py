@@ -132,7 +132,7 @@ class Result:
 
     @classmethod
     def load(cls, path) -> Result:
-        """Read a result written by :meth:`save` of this class.
+        """Read a result written by :meth:`save` of this class (``Result.load``: of any class).
 
         Parameters
         ----------
@@ -156,6 +156,11 @@ class Result:
             raise ModelError(path, f"cannot be read as a saved result: {error}") from None
         if not isinstance(record, dict) or not set(FILE_KEYS) <= set(record):
             raise ModelError(path, f"is not a saved result: a JSON object with keys {', '.join(FILE_KEYS)} expected")
+        if cls is Result:  # any kind: the class that wrote it reads it
+            _import_result_classes()
+            if record["kind"] not in Result._kinds:
+                raise ModelError(path, f"is a result of unknown kind {record['kind']!r}", key="kind")
+            return Result._kinds[record["kind"]]._rebuilt(record["result"], str(path))
         if record["kind"] != cls.kind:
             other = Result._kinds.get(record["kind"])
             hint = f"; {other.__name__}.load reads it" if other else ""
@@ -239,3 +244,16 @@ def decode_arrays(data: dict, dtype=float, ndim: int = 1) -> dict:
         Name -> numpy.ndarray, in the order of ``data``.
     """
     return {name: decode_array(values, dtype, ndim) for name, values in data.items()}
+
+
+#: The modules that define the result classes (each registers its kind on import).
+RESULT_MODULES = ("linmstmm.solve", "linmstmm.modes", "linmstmm.fe.result", "linmstmm.damped",
+                  "linmstmm.response", "linmstmm.sweep", "linmstmm.studies")
+
+
+def _import_result_classes() -> None:
+    """Import every module of RESULT_MODULES, so that every kind is registered."""
+    import importlib
+
+    for name in RESULT_MODULES:
+        importlib.import_module(name)

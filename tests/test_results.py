@@ -196,6 +196,39 @@ def test_load_refuses_a_file_of_another_kind(results, name, tmp_path):
         assert f"{type(result).__name__}.load reads it" in str(error.value)
 
 
+@pytest.mark.parametrize("name", BUILDS)
+def test_the_base_class_loads_every_kind(results, name, tmp_path):
+    """``Result.load`` reads a file of any kind as the class that wrote it."""
+    result = results[name]
+    path = tmp_path / "result.json"
+    result.save(path)
+    again = Result.load(path)
+    assert type(again) is type(result)
+    same(again, result)
+
+
+def test_the_base_class_loads_a_kind_whose_module_is_not_imported_yet(tmp_path):
+    """In a new process ``Result.load`` imports the module of the kind it meets (here the FE route's)."""
+    path = tmp_path / "fe.json"
+    lm.fe_frequencies(lm.load_model(MODELS / "spring_mass_chain.toml"), count=2).save(path)
+    script = f"""
+import sys
+from linmstmm.results import Result
+print("linmstmm.fe.result" in sys.modules, type(Result.load({str(path)!r})).__name__)
+"""
+    output = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True,
+                            cwd=ROOT).stdout.split()
+    assert output == ["False", "FEResult"]
+
+
+def test_the_base_class_refuses_an_unknown_kind(tmp_path):
+    path = tmp_path / "result.json"
+    path.write_text(json.dumps({"kind": "nonsense", "version": lm.__version__, "result": {}}))
+    with pytest.raises(lm.ModelError, match="unknown kind 'nonsense'") as error:
+        Result.load(path)
+    assert error.value.key == "kind"
+
+
 @pytest.mark.parametrize("text", ["not json {", '{"frequencies_hz": [1.0]}', "[1, 2]"])
 def test_load_refuses_what_is_not_a_saved_result(tmp_path, text):
     path = tmp_path / "other.json"

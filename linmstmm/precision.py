@@ -29,6 +29,7 @@ import mpmath
 import numpy as np
 
 from linmstmm.elements.beam import bending_wavenumber
+from linmstmm.stages import report
 
 #: Guard digits on top of the growth estimate.
 GUARD_DIGITS = 12
@@ -121,6 +122,8 @@ def refine_roots(deduction, model, omegas, digits: int, multiplicities=None, log
         while i + repeats < len(omegas) and omegas[i + repeats] == omegas[i]:
             repeats += 1
         m = (multiplicities or {}).get(omegas[i], repeats)
+        which = f"root {i + 1}" if repeats == 1 else f"roots {i + 1}-{i + repeats}"
+        report(f"mpmath: {which} of {len(omegas)} ({omegas[i] / (2 * math.pi):.6g} Hz)")
         dps = working_digits(model, omegas[i], digits)
         for attempt in range(PRECISION_DOUBLINGS + 1):
             with mpmath.workdps(dps << attempt):

@@ -221,6 +221,14 @@ def test_the_solvers_report_their_stages_in_order():
     assert len(heard) == 5
 
 
+def test_the_mpmath_refinement_reports_each_root():
+    """--digits refines root after root, a double root once: each is a stage of its own."""
+    heard = []
+    with listening(heard.append):
+        natural_frequencies(load_model(CANTILEVER), count=3, digits=20)
+    assert heard[3:] == ["mpmath: roots 1-2 of 3 (6.75357 Hz)", "mpmath: root 3 of 3 (50.8992 Hz)"]
+
+
 def test_no_progress_off_a_terminal(run, tmp_path):
     status, _, err = run("modes", CANTILEVER, "--count", "2", "--plot", tmp_path)
     assert status == 0 and "mode figures" not in err

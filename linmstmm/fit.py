@@ -41,6 +41,8 @@ from linmstmm.sweep import ENGINE, solve_step
 DIRECTIONS = ("x", "y", "z", "rx", "ry", "rz")
 #: The header cell of the measured frequencies' column.
 FREQUENCY_COLUMN = "frequency [Hz]"
+#: A measured file with one of these suffixes is a universal file (dataset 55 modes).
+UFF_SUFFIXES = (".uff", ".unv")
 #: Shapes are paired among the model modes up to this multiple of the highest measured frequency.
 PAIRING_SPAN = 1.5
 #: Relative change of the cost, of the unknowns and gradient size at which the fit stops.
@@ -92,11 +94,14 @@ class Measured:
 
 
 def read_measured(path, model: Model) -> Measured:
-    """The measured modes of a CSV file.
+    """The measured modes of a CSV file, or of a universal file (``.uff``, ``.unv``).
 
-    One row per mode; a column ``frequency [Hz]``, and optionally one column
+    CSV: one row per mode; a column ``frequency [Hz]``, and optionally one column
     per measured shape component named ``POINT.DIR`` (a point of ``model``,
     DIR one of x, y, z, rx, ry, rz). Lines starting with ``#`` are comments.
+    Universal file: datasets 55 (normal modes) on nodes that are the model's
+    points in order (:func:`linmstmm.uff.read_uff_modes`), e.g. as ``modes --uff``
+    writes them.
 
     Parameters
     ----------
@@ -117,6 +122,8 @@ def read_measured(path, model: Model) -> Measured:
         unknown point or direction, or a cell that is not a number (or a
         frequency that is not positive).
     """
+    if str(path).lower().endswith(UFF_SUFFIXES):
+        return _measured_uff(path, model)
     try:
         with open(path, newline="") as stream:
             rows = [row for row in csv.reader(stream) if row and not row[0].lstrip().startswith("#")]
@@ -137,6 +144,17 @@ def read_measured(path, model: Model) -> Measured:
     order = np.argsort(frequencies, kind="stable")
     shapes = np.delete(table, header.index(FREQUENCY_COLUMN), axis=1)[order] if columns else None
     return Measured(frequencies[order], shapes, tuple(columns))
+
+
+def _measured_uff(path, model: Model) -> Measured:
+    """:class:`Measured` from a universal file, modes in ascending order of frequency."""
+    from linmstmm.uff import read_uff_modes
+
+    frequencies, shapes, columns = read_uff_modes(path, model)
+    if not np.all(frequencies > 0):
+        raise ModelError(str(path), "every measured frequency must be > 0", key="freq")
+    order = np.argsort(frequencies, kind="stable")
+    return Measured(frequencies[order], shapes[order], columns)
 
 
 def _shape_column(path, model: Model, cell: str) -> tuple[str, int]:

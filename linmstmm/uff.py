@@ -1,4 +1,5 @@
-"""Mode shapes as a universal file (UFF): geometry as dataset 15, modes as dataset 55.
+"""Mode shapes as a universal file (UFF): geometry as dataset 15, modes as dataset 55;
+written by :func:`write_uff`, read back (measured modes for a fit) by :func:`read_uff_modes`.
 
 The file opens with one dataset 15 (nodes) holding the model's connection
 points, numbered 1, 2, … in the model's point order, followed by one
@@ -34,7 +35,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.model import Model
+from linmstmm.model import Model, ModelError
 from linmstmm.modes import ModalResult
 from linmstmm.response import modal_damping
 
@@ -45,6 +46,9 @@ MODE_DEFINITION = (1, 2, 3, 8, 2, 6)
 NODE_COLOR = 1
 #: Values this small are written as 0: E13.5 has room for two exponent digits only.
 _SMALLEST = 1e-99
+#: A dataset-15 node is at its point where the two are this close, relative to the model's size
+#: (plus E13.5's rounding, six significant digits, of the coordinates themselves).
+SAME_PLACE = 1e-4
 
 
 def write_uff(result: ModalResult, model: Model, path) -> dict[str, int]:
@@ -104,3 +108,83 @@ def _reals(values) -> str:
     values = np.asarray(values, dtype=float)
     values = np.where(np.abs(values) < _SMALLEST, 0.0, values)
     return "".join(f"{value:13.5E}" for value in values)
+
+
+def read_uff_modes(path, model: Model) -> tuple[np.ndarray, np.ndarray, tuple]:
+    """Modes of a universal file (datasets 55, normal modes) on the points of ``model``.
+
+    Nodes are the model's points in order, labelled 1, 2, … as :func:`write_uff`
+    numbers them; a dataset 15 in the file must put each node it lists at its
+    point (to SAME_PLACE of the model's size, and the rounding of E13.5), so that a file of another model
+    is refused instead of misread. Each mode gives the components its dataset
+    holds per node: ux, uy, uz (and θx, θy, θz with six values per node).
+
+    Parameters
+    ----------
+    path : str or Path
+        The universal file.
+    model : Model
+        The model whose points the nodes are.
+
+    Returns
+    -------
+    tuple
+        (frequencies (m,) Hz in the file's order, shapes (m, c), columns: c pairs
+        (point, direction index 0-5)). E13.5 holds six significant digits.
+
+    Raises
+    ------
+    ModelError
+        Naming the file: not readable as UFF, no dataset 55, a node that is no point
+        of the model or lies elsewhere, modes with different nodes or components.
+    """
+    import pyuff
+
+    where = str(path)
+    try:
+        datasets = pyuff.UFF(where).read_sets()
+    except Exception as error:  # pyuff raises bare Exceptions for a file it cannot parse
+        raise ModelError(where, f"cannot be read as a universal file: {error}") from None
+    datasets = datasets if isinstance(datasets, list) else [datasets]
+    points = list(model.points)
+    for nodes in (d for d in datasets if d.get("type") == 15):
+        _check_nodes(where, model, points, nodes)
+    modes = [d for d in datasets if d.get("type") == 55]
+    if not modes:
+        raise ModelError(where, "holds no dataset 55 (modes at nodes)")
+    columns = _mode_columns(where, points, modes[0])
+    shapes = []
+    for mode in modes:
+        if _mode_columns(where, points, mode) != columns:
+            raise ModelError(where, f"mode {mode.get('mode_n')}: other nodes or components than the first mode's")
+        per_node = len({direction for _, direction in columns})
+        values = np.column_stack([mode[f"r{d + 1}"] for d in range(per_node)])  # (nodes, components)
+        shapes.append(values.ravel())
+    return np.array([float(mode["freq"]) for mode in modes]), np.array(shapes), columns
+
+
+def _check_nodes(where: str, model: Model, points: list, nodes: dict) -> None:
+    """ModelError unless every node of dataset 15 ``nodes`` is one of the points, at its place."""
+    places = np.array([*model.points.values()], dtype=float)
+    size = max(float(np.ptp(places, axis=0).max()) if len(places) else 0.0, np.finfo(float).tiny)
+    for label, *xyz in zip(nodes["node_nums"], nodes["x"], nodes["y"], nodes["z"]):
+        index = int(label) - 1
+        if not 0 <= index < len(points):
+            raise ModelError(where, f"node {int(label)} is no point of the model (nodes 1-{len(points)} are its "
+                                    "points in order)", key="node")
+        rounding = 1e-5 * np.abs(places[index]).max()
+        if np.abs(np.array(xyz) - places[index]).max() > SAME_PLACE * size + rounding:
+            raise ModelError(where, f"node {int(label)} is at {list(xyz)}, its point {points[index]!r} at "
+                                    f"{list(places[index])}: the file is of another model", key="node")
+
+
+def _mode_columns(where: str, points: list, mode: dict) -> tuple:
+    """(point, direction) of every value of dataset 55 ``mode``, node after node."""
+    per_node = int(mode.get("n_data_per_node", 3))
+    if per_node not in (3, 6):
+        raise ModelError(where, f"mode {mode.get('mode_n')}: {per_node} values per node (3 or 6 expected)")
+    labels = [int(label) for label in mode["node_nums"]]
+    if any(not 1 <= label <= len(points) for label in labels):
+        raise ModelError(where, f"mode {mode.get('mode_n')}: a node that is no point of the model "
+                                f"(nodes 1-{len(points)} are its points in order)", key="node")
+    return tuple((points[label - 1], d) for label in labels for d in range(per_node))

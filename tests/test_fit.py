@@ -17,6 +17,9 @@ from test_sweep import CHAIN, edited_file, run_cli
 
 from linmstmm.model import load_model
 from linmstmm.modes import mode_shapes
+from linmstmm.uff import write_uff
+
+MODELS = Path(__file__).resolve().parents[1] / "models"
 
 PERTURBED = {"rigid.m2.mass": 2.3, "spring.k2.k[0]": 1300.0}  # from 2 kg and 1000 N/m
 
@@ -73,6 +76,36 @@ def test_measured_shapes_pair_the_modes_by_mac(tmp_path):
     fitted = {p["key"]: p["fitted"] for p in data["parameters"]}
     for key, value in PERTURBED.items():
         assert fitted[key] == pytest.approx(value, rel=1e-6)
+
+
+def test_modes_from_a_universal_file(tmp_path):
+    """The perturbed chain's six modes written as a universal file (datasets 15 and 55, as
+    ``modes --uff`` writes them): MAC pairs them and both values are recovered. E13.5 keeps
+    six significant digits of each frequency (rounding up to 5e-6), so the values come back
+    to that order, not to the 1e-6 of the CSV tests."""
+    apart = {"spring.k2.k[1]": 700.0, "spring.k2.k[2]": 500.0}
+    start = edited_file(CHAIN, apart, tmp_path)
+    truth = load_model(edited_file(CHAIN, {**apart, **PERTURBED}, tmp_path))
+    uff_file = tmp_path / "measured.uff"
+    write_uff(mode_shapes(truth, count=6, rigid_body=False), truth, uff_file)
+    status, out, err = run_cli("fit", start, uff_file, "--vary", "rigid.m2.mass=1:4",
+                               "--vary", "spring.k2.k[0]=200:5000", "--json")
+    assert status == 0, err
+    data = json.loads(out)
+    assert sorted(data["ranks"]) == list(range(6)) and min(data["mac"]) > 0.999
+    fitted = {p["key"]: p["fitted"] for p in data["parameters"]}
+    for key, value in PERTURBED.items():
+        assert fitted[key] == pytest.approx(value, rel=1e-5)
+
+
+def test_a_universal_file_of_another_model_is_refused(tmp_path):
+    """Its nodes are not at the chain's points: exit status 2, one line naming the node."""
+    other = load_model(MODELS / "cantilever_tip_mass.toml")
+    uff_file = tmp_path / "other.uff"
+    write_uff(mode_shapes(other, count=2), other, uff_file)
+    status, out, err = run_cli("fit", CHAIN, uff_file, "--vary", "rigid.m2.mass=1:4")
+    assert status == 2 and out == ""
+    assert len(err.strip().splitlines()) == 1 and "node" in err and "another model" in err
 
 
 def test_intervals_are_those_of_the_linearised_problem(perturbed, tmp_path):

@@ -193,7 +193,8 @@ def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
     D = np.concatenate(stiffness) if stiffness else np.zeros(0)
     M = _symmetric(T.T @ mass.matrix(n_full, n_full) @ T)
     K = _symmetric(G.T @ sp.diags(D) @ G)
-    rigid_modes, supports = _rigid_basis(_rigid_motions(model, layout)[masters], M)
+    motions, weight = _rigid_motions(model, layout)
+    rigid_modes, supports = _rigid_basis(motions[masters], M, weight[masters])
     return FEModel(M=M, K=K, T=T, G=G, D=D, dof_index=layout.index,
                    n_dof=T.shape[1], n_full=n_full, elements_per_beam=n,
                    rigid_modes=rigid_modes, supports=supports, frames=layout.frames,

@@ -30,8 +30,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.optimize
-from scipy.optimize import linear_sum_assignment
 
 from linmstmm.model import Model, ModelError
 from linmstmm.parameters import get_value, model_file, parse_key, unit, with_values
@@ -248,10 +246,12 @@ def fit(model: Model, measured: Measured, bounds, engine: str = ENGINE) -> FitRe
         For an unknown key, a key varied twice or a model value outside its
         range, and for a key without an analytic sensitivity (points, spring axes).
     """
+    from scipy.optimize import least_squares  # here: importing scipy.optimize costs every command 0.1 s
+
     problem = _Problem(model, measured, list(bounds), engine)
-    solution = scipy.optimize.least_squares(problem.residuals, problem.start, jac=problem.jacobian,
-                                            bounds=(problem.lower, problem.upper), method="trf",
-                                            xtol=TOLERANCE, ftol=TOLERANCE, gtol=TOLERANCE)
+    solution = least_squares(problem.residuals, problem.start, jac=problem.jacobian,
+                             bounds=(problem.lower, problem.upper), method="trf",
+                             xtol=TOLERANCE, ftol=TOLERANCE, gtol=TOLERANCE)
     step, ranks = problem.solved(solution.x)
     return FitResult(model.name, tuple(b.key for b in problem.bounds), tuple(unit(k) for k in problem.keys),
                      problem.start * problem.scales, solution.x * problem.scales,
@@ -332,6 +332,8 @@ class _Problem:
                                                 f"fewer than the {m} measured")
         if self.measured.shapes is None:
             return np.arange(m)
+        from scipy.optimize import linear_sum_assignment  # as least_squares: kept off start-up
+
         rows, ranks = linear_sum_assignment(self._macs(step), maximize=True)
         return ranks[np.argsort(rows)]
 

@@ -18,6 +18,8 @@ from __future__ import annotations
 import ast
 import inspect
 import re
+import subprocess
+import sys
 import textwrap
 from pathlib import Path
 
@@ -261,3 +263,12 @@ def test_the_length_check_sees_a_long_module(tmp_path):
         (tmp_path / name).write_text(text)
     found = unexplained_long_modules(sorted(tmp_path / name for name in files))
     assert found == [str(tmp_path / "empty_reason.py"), str(tmp_path / "long.py")]
+
+
+def test_starting_the_command_line_leaves_the_heavy_modules_unimported():
+    """scipy.optimize (0.1 s), matplotlib, numba and python-flint are imported where a
+    command needs them, not by every command's start-up (``import linmstmm.cli``)."""
+    heavy = ("scipy.optimize", "matplotlib", "numba", "flint")
+    script = f"import sys, linmstmm.cli; print([m for m in {heavy!r} if m in sys.modules])"
+    output = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, check=True).stdout
+    assert output.strip() == "[]"

@@ -153,13 +153,11 @@ def read_uff_modes(path, model: Model) -> tuple[np.ndarray, np.ndarray, tuple]:
     if not modes:
         raise ModelError(where, "holds no dataset 55 (modes at nodes)")
     columns = _mode_columns(where, points, modes[0])
-    shapes = []
-    for mode in modes:
+    per_node = len(columns) // len(modes[0]["node_nums"])
+    for mode in modes[1:]:
         if _mode_columns(where, points, mode) != columns:
             raise ModelError(where, f"mode {mode.get('mode_n')}: other nodes or components than the first mode's")
-        per_node = len({direction for _, direction in columns})
-        values = np.column_stack([mode[f"r{d + 1}"] for d in range(per_node)])  # (nodes, components)
-        shapes.append(values.ravel())
+    shapes = [np.column_stack([mode[f"r{d + 1}"] for d in range(per_node)]).ravel() for mode in modes]  # node by node
     return np.array([float(mode["freq"]) for mode in modes]), np.array(shapes), columns
 
 

@@ -15,39 +15,62 @@ from linmstmm.fe.rigid_motions import _rigid_basis, _rigid_motions
 from linmstmm.model import Model
 
 
-def _add_beams(model, layout, n, strains, stiffness, mass, constraints):
+def beam_element_dofs(layout, beam, n):
+    """(n, 12) full DOFs of the elements of ``beam`` and (n, 12, 12) their maps from
+    those DOFs to the element's local ones (end nodes are inertial, interior ones local)."""
+    nodes = layout.index.beam_nodes[beam.name]
+    to_local = np.tile(np.eye(12), (n, 1, 1))
+    axes = np.asarray(beam.axes, float)
+    for block in (0, 3):
+        to_local[0, block:block + 3, block:block + 3] = axes
+        to_local[-1, 6 + block:9 + block, 6 + block:9 + block] = axes
+    dofs = np.concatenate([6 * nodes[:-1, None] + np.arange(6),
+                           6 * nodes[1:, None] + np.arange(6)], axis=1)
+    return dofs, to_local
+
+
+def _add_beams(model, layout, n, strains, stiffness, mass):
     """Scatter every beam element (vectorised over the elements of a beam)."""
     for beam in model.beams:
-        nodes = layout.index.beam_nodes[beam.name]
-        g, d, m, c = beam_element(beam, beam.length / n)
-        to_local = np.tile(np.eye(12), (n, 1, 1))    # interior nodes: local DOFs
-        axes = np.asarray(beam.axes, float)
-        for block in (0, 3):                         # ends are inertial nodes
-            to_local[0, block:block + 3, block:block + 3] = axes
-            to_local[-1, 6 + block:9 + block, 6 + block:9 + block] = axes
-        dofs = np.concatenate([6 * nodes[:-1, None] + np.arange(6),
-                               6 * nodes[1:, None] + np.arange(6)], axis=1)
+        g, d, m, _ = beam_element(beam, beam.length / n)
+        dofs, to_local = beam_element_dofs(layout, beam, n)
         g_elements = g @ to_local                              # (n, s, 12)
         rows = strains.new_rows(n * len(d)).reshape(n, len(d))
         strains.add(rows[:, :, None], dofs[:, None, :], g_elements)
         stiffness.append(np.tile(d, n))
         m_elements = np.swapaxes(to_local, 1, 2) @ m @ to_local
         mass.add(dofs[:, :, None], dofs[:, None, :], m_elements)
+
+
+def _add_beam_constraints(model, layout, n, constraints):
+    """Directions a beam declares rigid (``axial`` or ``torsion`` False) become constraints."""
+    for beam in model.beams:
+        c = beam_element(beam, beam.length / n)[3]
         if len(c):
+            dofs, to_local = beam_element_dofs(layout, beam, n)
             rows = constraints.new_rows(n * len(c)).reshape(n, len(c))
             constraints.add(rows[:, :, None], dofs[:, None, :], c @ to_local)
 
 
 def _add_springs(model, layout, strains, stiffness, constraints):
-    """Finite spring directions become strains, ``inf`` ones constraints, released ones nothing."""
+    """Finite spring directions become strains, ``inf`` ones constraints, released ones nothing
+    (each kind written as one block of rows, in the springs' order)."""
+    finite, rigid = ([], [], []), ([], [])
     for spring in model.springs:
         for component, cols, values in _spring_directions(spring, layout.index, kept_only=True):
             k = float(spring.k[component])
             if np.isinf(k):
-                constraints.add(constraints.new_rows(1), cols, values)
+                rigid[0].append(cols)
+                rigid[1].append(values)
             else:
-                strains.add(strains.new_rows(1), cols, values)
-                stiffness.append([k])
+                finite[0].append(cols)
+                finite[1].append(values)
+                finite[2].append(k)
+    if finite[0]:
+        strains.add(strains.new_rows(len(finite[0]))[:, None], np.array(finite[0]), np.array(finite[1]))
+        stiffness.append(np.array(finite[2]))
+    if rigid[0]:
+        constraints.add(constraints.new_rows(len(rigid[0]))[:, None], np.array(rigid[0]), np.array(rigid[1]))
 
 
 def _add_rigid_masses(model, layout, mass):
@@ -106,6 +129,52 @@ def _port_map(model, layout, constraints):
     values.append(np.ones(len(kept)))
     rows, cols, values = map(np.concatenate, (rows, cols, values))
     return sp.csr_matrix((values, (rows, column_of[cols])), shape=(n_full, len(kept))), kept
+
+
+@dataclass(frozen=True, eq=False)
+class ConstrainedParts:
+    """The nodes and exact constraints of a meshed model, with the parts that are
+    not beams: what the FE assembly and the exact dynamic stiffness share.
+
+    Attributes
+    ----------
+    layout : the node numbering, positions and frames.
+    T : (n_full, n_dof) sparse elimination of every constraint (boundaries,
+        rigid bodies' ports, infinite spring directions, beam directions declared
+        rigid); the full vector is ``T @ q``.
+    masters : (n_dof,) full DOFs kept as the reduced ones.
+    n_full : 6 per node.
+    spring_strains, spring_stiffness : the finite spring directions, as rows of
+        the strain operator on the full DOFs (growing :class:`_Triplets`) and
+        their stiffnesses (list of arrays, N/m or N m/rad).
+    rigid_mass : the bodies' 6 × 6 mass blocks on the full DOFs (triplets).
+    """
+
+    layout: object
+    T: sp.csr_matrix
+    masters: np.ndarray
+    n_full: int
+    spring_strains: _Triplets
+    spring_stiffness: list
+    rigid_mass: _Triplets
+
+
+def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
+    """Lay out ``model`` with ``elements_per_beam`` elements per beam, eliminate its
+    constraints, and collect its springs and rigid masses (the beams' own
+    stiffness and mass are left to the caller)."""
+    layout = _layout(model, elements_per_beam)
+    n_full = 6 * layout.n_nodes
+    strains, mass, constraints = _Triplets(), _Triplets(), _Triplets()
+    stiffness = []
+    _add_beam_constraints(model, layout, elements_per_beam, constraints)
+    _add_springs(model, layout, strains, stiffness, constraints)
+    _add_rigid_masses(model, layout, mass)
+    _add_boundaries(model, layout, constraints)
+    t0, q0_dofs = _port_map(model, layout, constraints)
+    reduced_constraints = _drop_debris(constraints.matrix(n_full) @ t0)
+    t1, masters = _eliminate(reduced_constraints)
+    return ConstrainedParts(layout, (t0 @ t1).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass)
 
 
 @dataclass(frozen=True, eq=False)
@@ -174,20 +243,12 @@ def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
     if n < 1:
         raise ValueError(f"elements_per_beam must be >= 1, got {elements_per_beam}")
     model = _negligible_mass_removed(model)
-    layout = _layout(model, n)
-    n_full = 6 * layout.n_nodes
-    strains, mass, constraints = _Triplets(), _Triplets(), _Triplets()
-    stiffness = []
-    _add_beams(model, layout, n, strains, stiffness, mass, constraints)
-    _add_springs(model, layout, strains, stiffness, constraints)
-    _add_rigid_masses(model, layout, mass)
-    _add_boundaries(model, layout, constraints)
-    t0, q0_dofs = _port_map(model, layout, constraints)
-
-    reduced_constraints = _drop_debris(constraints.matrix(n_full) @ t0)
-    t1, masters = _eliminate(reduced_constraints)
-    T = (t0 @ t1).tocsr()
-    masters = q0_dofs[masters]
+    parts = constrained_parts(model, n)
+    layout, T, masters, n_full = parts.layout, parts.T, parts.masters, parts.n_full
+    strains, mass, stiffness = _Triplets(), parts.rigid_mass, []
+    _add_beams(model, layout, n, strains, stiffness, mass)
+    strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
+    stiffness += parts.spring_stiffness
 
     G = (strains.matrix(n_full) @ T).tocsr()
     D = np.concatenate(stiffness) if stiffness else np.zeros(0)

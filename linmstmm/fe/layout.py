@@ -104,6 +104,12 @@ class _Triplets:
         self.n_rows += count
         return np.arange(first, first + count)
 
+    def extend(self, other: "_Triplets"):
+        """Append the rows of ``other`` after these (renumbered)."""
+        for rows, cols, values in zip(other.rows, other.cols, other.values):
+            self.add(rows + self.n_rows, cols, values)
+        self.n_rows += other.n_rows
+
     def matrix(self, n_cols, n_rows=None) -> sp.csr_matrix:
         n_rows = self.n_rows if n_rows is None else n_rows
         if not self.rows:
@@ -121,10 +127,10 @@ def _spring_directions(spring, index: DofIndex, kept_only: bool):
     (end b − end a along the spring's axis, m or rad) as a row on the full DOFs of ``index``.
     kept_only : leave out the released directions."""
     a, b = (_node_dofs(index.points[end]) for end in spring.ends)
+    cols = (np.concatenate([a[:3], b[:3]]), np.concatenate([a[3:], b[3:]]))
     axes = np.asarray(spring.axes, float)
+    values = np.concatenate([-axes, axes], axis=1)          # row i: direction i at a, then at b
+    skipped = set(spring.released.tolist()) if kept_only else set()
     for component in range(6):
-        if kept_only and component in spring.released:
-            continue
-        block = slice(0, 3) if component < 3 else slice(3, 6)
-        direction = axes[component % 3]
-        yield component, np.concatenate([a[block], b[block]]), np.concatenate([-direction, direction])
+        if component not in skipped:
+            yield component, cols[component // 3], values[component % 3]

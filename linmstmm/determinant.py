@@ -41,6 +41,7 @@ def load_kernels() -> None:
     """Import numba and the compiled kernels now (compiling them on the first run
     on this machine), so that ``engine="auto"`` uses them from here on."""
     import linmstmm._kernels  # noqa: F401
+    import linmstmm._stiffness_kernels  # noqa: F401  (the Wittrick–Williams count's)
 
 
 def resolved_engine(engine: str) -> str:

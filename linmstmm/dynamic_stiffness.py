@@ -1,0 +1,192 @@
+"""The exact dynamic stiffness of Euler–Bernoulli beams, and how many natural
+frequencies each beam has below ω with both ends clamped.
+
+A beam's dynamic stiffness D(ω) maps the harmonic displacements of its two ends
+to the forces that hold them, exactly (no mesh): for an axial or torsional rod
+of stiffness EA (GJ), wavenumber k = ω √(ρA/EA) (ω √(ρI_p/GJ)) and length L,
+
+    D = EA k / sin kL · [[cos kL, −1], [−1, cos kL]],
+
+and for bending in one plane, over (v₁, θ₁, v₂, θ₂) with θ = v′, β⁴ = ρAω²/EI,
+λ = βL, c, s = cos λ, sin λ, C, S = cosh λ, sinh λ and δ = 1 − cC:
+
+    D = EI/δ · [[β³(cS + sC),  β²sS,        −β³(s + S),   β²(C − c)],
+                [β²sS,         β(sC − cS),  −β²(C − c),   β(S − s)],
+                [−β³(s + S),   −β²(C − c),  β³(cS + sC),  −β²sS],
+                [β²(C − c),    β(S − s),    −β²sS,        β(sC − cS)]].
+
+Its static part is the Hermite element's stiffness and its ω² term the
+consistent mass (tests/test_dynamic_stiffness.py checks both). Evaluated stably
+for every λ: below SERIES_BELOW every combination by its power series (δ
+cancels to λ⁴/6), above it with numerator and denominator divided by cosh λ.
+
+The clamped–clamped frequencies, where D has poles, are counted exactly
+(Wittrick and Williams 1971): ⌊kL/π⌋ per rod, and per bending plane
+i − (1 − (−1)^i sgn δ)/2 with i = ⌊λ/π⌋. These are the J₀ of the
+Wittrick–Williams count (:mod:`linmstmm.wittrick_williams`).
+
+Local DOFs per end ``(u, v, w, θx, θy, θz)`` as in :mod:`linmstmm.fe.elements`:
+the x–y plane bends with EI_z over (v, θz), the x–z plane with EI_y over
+(w, −θy). A direction a beam declares rigid (``axial`` or ``torsion`` False)
+keeps only its inertia, the consistent mass, exact once the constraint that
+both ends move alike is applied.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from linmstmm.model import Beam
+
+#: Below this λ = βL the bending combinations are summed as power series (their
+#: closed forms cancel: δ = 1 − cos λ cosh λ ≈ λ⁴/6).
+SERIES_BELOW = 1.0
+#: Terms of those series: the first left out is below 1e-30 of the first at λ = 1.
+SERIES_TERMS = 8
+#: A frequency closer than this (relative, in δ/cosh λ or sin kL) to a beam's
+#: clamped–clamped one is a pole of D: the count there is left undecided.
+POLE = 1e-10
+
+_X_Y = np.array([1, 5, 7, 11])    # (v, θz) at both ends
+_X_Z = np.array([2, 4, 8, 10])    # (w, θy) at both ends, θy = −w′
+_FLIP = np.array([1.0, -1.0, 1.0, -1.0])
+_AXIAL = np.array([0, 6])
+_TORSION = np.array([3, 9])
+
+
+@dataclass(frozen=True, eq=False)
+class BeamTable:
+    """The beams of a model as arrays, one entry per beam (n_beams,).
+
+    EA, GJ : N, N m². EIy, EIz : N m². rhoA : kg/m. rhoIp : kg m. L : m.
+    axial, torsion : bool, False where the beam is rigid in that direction.
+    """
+
+    EA: np.ndarray
+    GJ: np.ndarray
+    EIy: np.ndarray
+    EIz: np.ndarray
+    rhoA: np.ndarray
+    rhoIp: np.ndarray
+    L: np.ndarray
+    axial: np.ndarray
+    torsion: np.ndarray
+
+    @classmethod
+    def of(cls, beams: tuple[Beam, ...]) -> BeamTable:
+        """The table of ``beams`` (records of :class:`linmstmm.model.Beam`)."""
+        def column(value):
+            return np.array([value(b) for b in beams], dtype=float)
+        return cls(EA=column(lambda b: b.E * b.A), GJ=column(lambda b: b.G * b.J),
+                   EIy=column(lambda b: b.E * b.Iy), EIz=column(lambda b: b.E * b.Iz),
+                   rhoA=column(lambda b: b.rho * b.A), rhoIp=column(lambda b: b.rho * b.Ip),
+                   L=column(lambda b: b.length),
+                   axial=np.array([b.axial for b in beams], bool),
+                   torsion=np.array([b.torsion for b in beams], bool))
+
+
+def dynamic_stiffness(beams: BeamTable, omega: float) -> np.ndarray:
+    """(n_beams, 12, 12) exact dynamic stiffness of each beam at ``omega`` (rad/s),
+    in its local DOFs (N/m, N, N m/rad). Infinite or NaN entries only at a
+    clamped–clamped frequency (see :func:`clamped_counts`)."""
+    d = np.zeros((beams.L.size, 12, 12))
+    _rod(d, _AXIAL, beams.EA, beams.rhoA, beams.L, omega, beams.axial)
+    _rod(d, _TORSION, beams.GJ, beams.rhoIp, beams.L, omega, beams.torsion)
+    d[:, _X_Y[:, None], _X_Y] = _bending(beams.EIz, beams.rhoA, beams.L, omega)
+    d[:, _X_Z[:, None], _X_Z] = _bending(beams.EIy, beams.rhoA, beams.L, omega) * np.outer(_FLIP, _FLIP)
+    return d
+
+
+def clamped_counts(beams: BeamTable, omega: float) -> int | None:
+    """J₀(ω): the natural frequencies of all beams with both ends clamped that lie
+    below ``omega`` (rad/s), exactly; None within POLE of one of them."""
+    total = 0
+    for stiffness, inertia, deformable in ((beams.EA, beams.rhoA, beams.axial),
+                                          (beams.GJ, beams.rhoIp, beams.torsion)):
+        phase = omega * beams.L[deformable] * np.sqrt(inertia / stiffness)[deformable] / math.pi
+        nearest = np.round(phase)
+        if np.any((nearest >= 1) & (np.abs(phase - nearest) < POLE * phase)):
+            return None
+        total += int(np.floor(phase).sum())
+    for stiffness in (beams.EIy, beams.EIz):
+        lam = beams.L * (beams.rhoA * omega ** 2 / stiffness) ** 0.25
+        lam = lam[lam >= SERIES_BELOW]            # none below 4.73
+        delta = _scaled(lam)[:, 0]                # (1 − cos λ cosh λ) / cosh λ
+        if np.any(np.abs(delta) < POLE):
+            return None
+        i = np.floor(lam / math.pi)
+        total += int((i - (1 - (-1.0) ** i * np.sign(delta)) / 2).sum())
+    return total
+
+
+def _rod(d, dofs, stiffness, inertia, length, omega, deformable):
+    """Write the rods' 2 × 2 blocks at ``dofs`` into ``d``: exact where deformable,
+    the consistent mass alone where rigid."""
+    k = omega * np.sqrt(inertia / stiffness)
+    kl = k * length
+    small = kl < 1e-8                             # the static limit, and massless rods
+    safe = np.where(small, 1.0, kl)
+    scale = np.where(small, stiffness / length, stiffness * k / np.where(small, 1.0, np.sin(safe)))
+    diagonal = np.where(small, 1.0 - kl ** 2 / 3, np.cos(safe))
+    off = np.where(small, -1.0 - kl ** 2 / 6, -1.0)
+    block = scale[:, None, None] * np.stack([np.stack([diagonal, off], -1), np.stack([off, diagonal], -1)], -2)
+    rigid = -omega ** 2 * (inertia * length)[:, None, None] / 6 * np.array([[2.0, 1.0], [1.0, 2.0]])
+    d[:, dofs[:, None], dofs] = np.where(deformable[:, None, None], block, rigid)
+
+
+def _bending(stiffness, inertia, length, omega):
+    """(n, 4, 4) exact bending dynamic stiffness over (v₁, θ₁, v₂, θ₂), θ = v′."""
+    beta = (inertia * omega ** 2 / stiffness) ** 0.25
+    lam = beta * length
+    series = lam < SERIES_BELOW
+    combos = np.empty((lam.size, 7))
+    combos[series], combos[~series] = _series(lam[series]), _scaled(lam[~series])
+    delta, cs_sc, ss, s_plus, c_minus, sc_cs, s_minus = combos.T
+    f = stiffness / delta
+    # In the series each combination is divided by the power of λ that leads it,
+    # so the powers of β become powers of 1/L (β^p λ^q / λ^4 = 1/L^p where q − 4 = −p).
+    b1 = np.where(series, 1 / length, beta)
+    b2 = np.where(series, 1 / length ** 2, beta ** 2)
+    b3 = np.where(series, 1 / length ** 3, beta ** 3)
+    k11, k12, k13, k14 = f * b3 * cs_sc, f * b2 * ss, -f * b3 * s_plus, f * b2 * c_minus
+    k22, k24 = f * b1 * sc_cs, f * b1 * s_minus
+    return np.stack([np.stack([k11, k12, k13, k14], -1),
+                     np.stack([k12, k22, -k14, k24], -1),
+                     np.stack([k13, -k14, k11, -k12], -1),
+                     np.stack([k14, k24, -k12, k22], -1)], -2)
+
+
+def _scaled(lam):
+    """(n, 7) the combinations δ, cS + sC, sS, s + S, C − c, sC − cS, S − s, each
+    divided by cosh λ (stable at any λ ≥ 0)."""
+    c, s = np.cos(lam), np.sin(lam)
+    decay = np.exp(-2 * lam)
+    inv_c, t = 2 * np.sqrt(decay) / (1 + decay), (1 - decay) / (1 + decay)
+    return np.stack([inv_c - c, c * t + s, s * t, s * inv_c + t, 1.0 - c * inv_c, s - c * t, t - s * inv_c], -1)
+
+
+def _series(lam):
+    """(n, 7) the same combinations as :func:`_scaled`, by their power series, each
+    divided by the power of λ that leads it (δ by λ⁴, cS + sC by λ, sS by λ², …),
+    for λ below SERIES_BELOW. Their ratios are then the entries' coefficients in
+    powers of 1/L (see :func:`_bending`)."""
+    x = lam[:, None] ** 4
+    k = np.arange(SERIES_TERMS)
+    alternating = (-4.0) ** k
+    powers = x ** k                                            # λ^(4k)
+
+    def series(shift, signs, scale=1.0):
+        # Σ_k signs_k λ^(4k+shift) / (4k+shift)!, divided by λ^shift
+        factorials = np.array([math.factorial(4 * j + shift) for j in k], float)
+        return scale * (powers * signs / factorials).sum(-1)
+
+    delta = -(-4.0) * series(4, (-4.0) ** k / 1.0)  # −Σ_{j≥1} (−4)^j λ^{4j}/(4j)!, divided by λ⁴
+    return np.stack([delta,
+                     series(1, alternating, 2.0),             # cS + sC, by λ
+                     series(2, alternating, 2.0),             # sS, by λ²
+                     series(1, 1.0, 2.0),                     # s + S, by λ
+                     series(2, 1.0, 2.0),                     # C − c, by λ²
+                     series(3, alternating, 4.0),             # sC − cS, by λ³
+                     series(3, 1.0, 2.0)], -1)                # S − s, by λ³

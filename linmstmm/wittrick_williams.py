@@ -1,0 +1,192 @@
+"""How many natural frequencies lie below ω, from one factorisation: the
+Wittrick–Williams count.
+
+Wittrick and Williams (1971): for a structure whose dynamic stiffness matrix
+D(ω) is exact, the number of natural frequencies below ω (counted with their
+multiplicity, zero-frequency modes included) is
+
+    J(ω) = J₀(ω) + s{D(ω)},
+
+where s{D} is the number of negative eigenvalues of D (Sylvester's law of
+inertia: the negative pivots of a symmetric LDLᵀ factorisation) and J₀ the
+natural frequencies below ω of the elements with their ends clamped
+(:func:`linmstmm.dynamic_stiffness.clamped_counts`). It needs no frequency
+scan, no contour and no roots: a real symmetric factorisation of the order of
+the model's nodes.
+
+D(ω) here is built on the nodes of the FE route with one element per beam
+(:func:`linmstmm.fe.assembly.constrained_parts`: the same points, ports,
+boundaries, springs, joints and constraint elimination): each beam's exact
+dynamic stiffness (:func:`linmstmm.dynamic_stiffness.dynamic_stiffness`)
+rotated to the inertial frame, plus the springs' stiffness, minus ω² times the
+rigid bodies' mass. No mesh: the count is exact for the same Euler–Bernoulli
+model that det Ū_all describes, and independent of the transfer matrices.
+
+Where float64 cannot decide it (ω within rounding of a natural frequency or of
+an element's clamped one, a degree of freedom with neither stiffness nor mass)
+the count answers None, and callers count another way.
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg.lapack as lapack
+
+from linmstmm.determinant import resolved_engine
+from linmstmm.dynamic_stiffness import BeamTable, clamped_counts, dynamic_stiffness
+from linmstmm.fe.assembly import beam_element_dofs, constrained_parts
+from linmstmm.model import Model
+
+#: A pivot of the equilibrated D(ω) below this, relative to the largest term that
+#: entered it, is rounding:
+#: ω is at a natural frequency to float64's eyes, and the count is left undecided.
+SINGULAR_PIVOT = 1e-11
+
+
+class ModeCounter:
+    """J(ω) of a model: ``counter(omega)`` is the number of natural frequencies
+    below ``omega`` (rad/s), zero-frequency modes included, or None where float64
+    cannot decide it.
+
+    Parameters
+    ----------
+    model : Model
+        The model (every element kind, joint and boundary the FE route takes).
+    engine : str
+        "numpy", "compiled" (numba kernels of :mod:`linmstmm._stiffness_kernels`)
+        or "auto", as for det Ū_all (:func:`linmstmm.determinant.resolved_engine`).
+
+    Attributes
+    ----------
+    n_dof : int
+        Order of the reduced D(ω) that each count factorises.
+    """
+
+    def __init__(self, model: Model, engine: str = "auto"):
+        self.engine = resolved_engine(engine)
+        parts = constrained_parts(model, 1)
+        T, n = parts.T, parts.T.shape[1]
+        springs = parts.spring_strains.matrix(parts.n_full) @ T
+        stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
+        self.n_dof = n
+        self._static = (springs.T @ (springs.multiply(stiffness[:, None]))).toarray()
+        self._mass = (T.T @ parts.rigid_mass.matrix(parts.n_full, parts.n_full) @ T).toarray()
+        self._beams = BeamTable.of(model.beams)
+        self._maps, self._columns = _beam_maps(model, parts.layout, T)
+        self._scatter = (self._columns[:, :, None] * (n + 1) + self._columns[:, None, :]).ravel()
+        self._buffers = np.empty((2, n + 1, n + 1))
+
+    def __call__(self, omega: float) -> int | None:
+        if self.engine == "compiled":
+            return self._compiled(float(omega))
+        clamped = clamped_counts(self._beams, omega)
+        if clamped is None:
+            return None
+        matrix, magnitude = self.matrix(omega)
+        if not np.all(np.isfinite(matrix)):
+            return None
+        negatives = _negative_eigenvalues(matrix, magnitude, _block_inertia)
+        return None if negatives is None else clamped + negatives
+
+    def _compiled(self, omega: float) -> int | None:
+        """:meth:`__call__` with J₀ and D(ω) assembled by the compiled kernel."""
+        from linmstmm import _stiffness_kernels as kernels
+
+        if not hasattr(self, "_table"):
+            self._table = kernels.beam_columns(self._beams)
+        matrix, magnitude = self._buffers
+        clamped = kernels.assembled(omega, self._table, self._maps, self._columns, self._static, self._mass,
+                                    matrix, magnitude)
+        n = self.n_dof
+        if clamped < 0 or not np.all(np.isfinite(matrix[:n, :n])):
+            return None
+        negatives = _negative_eigenvalues(matrix[:n, :n], magnitude[:n, :n],
+                                          lambda f, p, singular: _undecided(kernels.block_inertia(f, p, singular)))
+        return None if negatives is None else clamped + negatives
+
+    def matrix(self, omega: float) -> tuple[np.ndarray, np.ndarray]:
+        """(D(ω), |D|(ω)): the reduced exact dynamic stiffness (n_dof, n_dof), and the
+        same assembled from the absolute values of every term (the scale each entry's
+        rounding is relative to)."""
+        local = dynamic_stiffness(self._beams, omega)
+        parts = np.swapaxes(self._maps, 1, 2) @ local @ self._maps       # (n_beams, k, k)
+        size = self.n_dof + 1                                            # + a row for padding
+        beams = np.bincount(self._scatter, parts.ravel(), minlength=size * size).reshape(size, size)
+        magnitude = np.bincount(self._scatter, np.abs(parts).ravel(), minlength=size * size).reshape(size, size)
+        n = self.n_dof
+        matrix = beams[:n, :n] + self._static - omega ** 2 * self._mass
+        return matrix, magnitude[:n, :n] + np.abs(self._static) + omega ** 2 * np.abs(self._mass)
+
+
+def _beam_maps(model: Model, layout, T) -> tuple[np.ndarray, np.ndarray]:
+    """((n_beams, 12, k) maps from the reduced DOFs each beam touches to its local
+    ones, (n_beams, k) those DOFs). k: the most reduced DOFs one beam touches;
+    shorter lists are padded with the extra DOF n_dof and zero columns."""
+    n = T.shape[1]
+    columns, maps = [], []
+    for beam in model.beams:
+        dofs, to_local = beam_element_dofs(layout, beam, 1)
+        rows = T[dofs[0]].toarray()                                      # (12, n_dof)
+        touched = np.flatnonzero(np.any(rows != 0.0, axis=0))
+        columns.append(touched)
+        maps.append(to_local[0] @ rows[:, touched])
+    width = max((c.size for c in columns), default=0)
+    padded = np.full((len(columns), width), n)
+    stacked = np.zeros((len(columns), 12, width))
+    for i, (touched, block) in enumerate(zip(columns, maps)):
+        padded[i, :touched.size] = touched
+        stacked[i, :, :touched.size] = block
+    return stacked, padded
+
+
+def _undecided(count: int) -> int | None:
+    return None if count < 0 else count
+
+
+def _negative_eigenvalues(matrix: np.ndarray, magnitude: np.ndarray, inertia) -> int | None:
+    """Negative eigenvalues of the symmetric ``matrix`` (Bunch–Kaufman LDLᵀ), or None
+    where a pivot is rounding. Equilibrated first by the diagonal of ``magnitude``
+    (the scale of every term that entered), a congruence that a change of units
+    scales exactly as it scales the matrix: the pivots, and so the decision, are
+    the same in every unit system (scaling by the rows' largest entries is not)."""
+    if matrix.size == 0:
+        return 0
+    scale = magnitude.diagonal()
+    if not np.all(scale > 0):
+        return None                                   # a DOF with neither stiffness nor mass
+    weights = 1.0 / np.sqrt(scale)
+    equilibrated = matrix * weights[:, None] * weights[None, :]
+    # rounding is relative to the largest term that entered, which may lie off the diagonal
+    singular = SINGULAR_PIVOT * float((magnitude * weights[:, None] * weights[None, :]).max())
+    counts = [_factorised_inertia(ordered, inertia, singular)
+              for ordered in (equilibrated, equilibrated[::-1, ::-1])]
+    # the two orders pivot differently: where rounding decides a sign, they disagree
+    return counts[0] if counts[0] == counts[1] else None
+
+
+def _factorised_inertia(matrix: np.ndarray, inertia, singular: float) -> int | None:
+    factor, pivots, info = lapack.dsytrf(matrix, lower=1)
+    if info < 0:
+        raise ValueError(f"dsytrf: argument {-info} is invalid")
+    return None if info > 0 else inertia(factor, pivots, singular)
+
+
+def _block_inertia(factor: np.ndarray, pivots: np.ndarray, singular: float) -> int | None:
+    """Negative eigenvalues of the block-diagonal D of LAPACK's ``?sytrf`` (lower),
+    None where a 1 × 1 pivot or a 2 × 2 block's eigenvalue is below ``singular``."""
+    negatives, k, n = 0, 0, len(pivots)
+    diagonal = factor.diagonal()
+    while k < n:
+        if pivots[k] > 0:
+            if abs(diagonal[k]) < singular:
+                return None
+            negatives += diagonal[k] < 0
+            k += 1
+            continue
+        a, b, c = diagonal[k], factor[k + 1, k], diagonal[k + 1]
+        half_trace, root = (a + c) / 2, np.hypot((a - c) / 2, b)
+        eigenvalues = (half_trace - root, half_trace + root)
+        if min(abs(e) for e in eigenvalues) < singular:
+            return None
+        negatives += sum(e < 0 for e in eigenvalues)
+        k += 2
+    return negatives

@@ -9,7 +9,8 @@ figure is a ratio or a time from this one run; nothing is a unit test.
 Measured per model (the launcher-size files in models/):
 
 * one evaluation of det Ū_all, warm: the compiled kernels at a single ω and
-  per ω in a batch of 512, and the numpy carry likewise;
+  per ω in a batch of 512, and the numpy carry likewise; one Wittrick–Williams
+  count J(ω), which makes the closing counts;
 * the first N natural frequencies (N = 10, 20, 60, 100) by
   ``natural_frequencies(engine="compiled")``, warm: wall time, evaluations of
   det Ū_all per root, and the largest relative difference from the FE route's
@@ -49,6 +50,7 @@ from linmstmm.nullspace import release_indeterminate  # noqa: E402
 from linmstmm.solve import natural_frequencies  # noqa: E402
 from linmstmm.threads import one_blas_thread  # noqa: E402
 from linmstmm.topology import build_topology  # noqa: E402
+from linmstmm.wittrick_williams import ModeCounter  # noqa: E402
 from time_budget import time_budget  # noqa: E402
 
 #: Degrees of freedom above which the dense eigensolver is not timed (sparse eigsh wins there).
@@ -80,6 +82,16 @@ def evaluation_costs(model, rounds: int) -> dict:
         single = best_time(lambda: [engine.log_det(w) for w in singles], rounds)[0] / singles.size
         batch = best_time(lambda: engine.log_det(omegas), rounds)[0] / omegas.size
         costs[name] = (single, batch)
+    return costs
+
+
+def count_costs(model, rounds: int) -> dict:
+    """Seconds per Wittrick–Williams count J(ω) (the closing counts), compiled and numpy."""
+    omegas = np.geomspace(1.0, 2e4, 64)
+    costs = {}
+    for name in ("compiled", "numpy"):
+        counter = ModeCounter(model, name)
+        costs[name] = best_time(lambda: [counter(w) for w in omegas], rounds)[0] / omegas.size
     return costs
 
 
@@ -174,6 +186,9 @@ def main() -> None:
                       "| one evaluation of det Ū_all | single ω | per ω in a batch of 512 |", "|---|---:|---:|",
                       *[f"| {name} | {single * 1e6:.0f} µs | {batch * 1e6:.0f} µs |"
                         for name, (single, batch) in costs.items()], "",
+                      "| one Wittrick–Williams count J(ω) (one real LDLᵀ, twice) | single ω |", "|---|---:|",
+                      *[f"| {name} | {seconds * 1e6:.0f} µs |" for name, seconds in count_costs(model, rounds).items()],
+                      "",
                       "| first N | MSTMM (compiled) | evaluations / root | diff. from FE rtol 1e-10 | "
                       "FE mesh (el./beam, DOF) | its diff. from MSTMM | FE dense eigh | FE eigsh | "
                       "`fe` command | fastest FE eigensolver / MSTMM | `fe` / MSTMM |",

@@ -24,7 +24,8 @@ STAGES = (
     (predicted, "secant_roots", "polish (secant)"),
     (roots.RootFinder, "polish", "polish (pencil)"),
     (roots.RootFinder, "segment", "segment search"),
-    (roots.RootFinder, "other_zeros", "certify (argument-principle counts)"),
+    (solve, "ModeCounter", "Wittrick–Williams counter (build)"),
+    (roots.RootFinder, "other_zeros", "certify (counts)"),
     (solve, "_refined_in_mpmath", "mpmath refinement"),
 )
 EVALUATORS = ((determinant_module.CompiledDeterminant, "_evaluate"),

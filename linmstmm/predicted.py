@@ -244,6 +244,10 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
     found, troubled = _pencil_polished(finder, list(roots) + found, unsettled)
     found, troubled = _deflated_polished(finder, found, troubled, predictions)
     for lo, hi in _intervals_around(troubled, predictions, found):
+        counted = _completed_by_counts(finder, found, lo, hi)
+        if counted is not None:
+            found = counted
+            continue
         try:
             found = [r for r in found if not lo < r <= hi] + finder.segment(lo, hi)
         except RuntimeError:
@@ -282,6 +286,18 @@ def _secant_polished(finder, predictions: np.ndarray, start: int, stop: int,
     for root, step in zip(found[settled], steps[settled]):
         finder.last_step[root] = step
     return list(found[settled]), [float(p) for p in predictions[start:stop][~settled]]
+
+
+def _completed_by_counts(finder, found: list[float], lo: float, hi: float):
+    """``found`` (rad/s) complete in (lo, hi) by Wittrick–Williams counts alone: as it
+    is where they find nothing missing, with the multiplicities they count where
+    that makes it complete (:meth:`RootFinder.counted_multiplicities`); None where
+    they cannot decide or something else is missing (the segment search then runs)."""
+    if finder.stiffness_other_zeros(found, lo, hi) != 0:
+        found = finder.counted_multiplicities(found, lo, hi)
+        if finder.stiffness_other_zeros(found, lo, hi) != 0:
+            return None
+    return sorted(found)
 
 
 def _pencil_polished(finder, roots: list[float], starts: list[float]) -> tuple[list[float], list[float]]:
@@ -355,6 +371,12 @@ def _repaired(finder, roots: list[float], lo: float, hi: float, depth: int):
     extra = finder.other_zeros(roots, lo, hi)
     if extra is None:
         return None
+    if extra != 0:  # a member of a multiple root the pencil did not see, or a value that is no root
+        counted = finder.counted_multiplicities(roots, lo, hi)
+        if counted != roots:
+            roots, extra = counted, finder.other_zeros(counted, lo, hi)
+            if extra is None:
+                return None
     if extra == 0:
         return roots
     lo = finder.floor if lo is None else lo

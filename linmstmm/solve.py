@@ -20,6 +20,7 @@ from linmstmm.stages import report
 from linmstmm.roots import CERTIFIED_STEP, RootFinder
 from linmstmm.threads import single_blas_thread
 from linmstmm.topology import build_topology
+from linmstmm.wittrick_williams import ModeCounter
 
 
 #: Digits float64 delivers; more are computed in mpmath.
@@ -117,7 +118,9 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     The finder knows the rigid-body modes (counted from the model's kinematics,
     :func:`~linmstmm.rigid_motion.rigid_body_mode_count`) and divides their zeros out of
     det Ū_all (:meth:`~linmstmm.roots.RootFinder.divide_out_rigid_body_zeros`),
-    so every caller's counts see the elastic roots only. Its frequency scale (floor,
+    so every caller's counts see the elastic roots only. Its closing counts are
+    Wittrick–Williams counts where they can decide
+    (:class:`~linmstmm.wittrick_williams.ModeCounter`, by the same engine). Its frequency scale (floor,
     ceiling, scan chunks) is the lowest of the model's
     :func:`~linmstmm.nullspace.characteristic_frequencies`, so that no decision
     depends on the units the model is written in.
@@ -131,6 +134,7 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
                         predictor=lambda n: predict_frequencies(model, n),
                         scale=min(characteristic_frequencies(deduction.topology)), **options)
     finder.determinant = evaluator
+    finder.counter = ModeCounter(model, engine)
     finder.divide_out_rigid_body_zeros(finder.rigid_body_modes())
     return deduction, finder, released
 

@@ -336,25 +336,39 @@ def test_brackets_left_out_above_the_count_are_taken_before_scanning_on():
 
 def test_a_model_without_beams_asked_for_more_modes_than_it_has_says_how_many_were_found():
     """Random ring 5 (three bodies, three springs) has 11 elastic modes by the FE route,
-    exact for bodies and springs; 80 asked for: the 11, and a note that says so and why
-    the search stopped (it read "search stopped at 1.064e+08 rad/s (...)")."""
+    exact for bodies and springs; 80 asked for: the 11, and a note that says only 11
+    exist below the search's ceiling. The Wittrick–Williams count proves that at the
+    ceiling; before it, a scan up there stopped where det Ū_all could no longer be
+    counted, and the note said where ("the search stopped at 1.064e+08 rad/s")."""
     ring = model("ring", 5)
     assert not ring.beams
     result = natural_frequencies(ring, 80)
     reference = fe_frequencies(ring, count=80).frequencies_hz
     assert len(reference) == 11
     np.testing.assert_allclose(result.frequencies_hz, reference, rtol=1e-9)
-    assert result.note.startswith("only 11 elastic natural frequencies were found: the search stopped at")
-    assert "times the highest" in result.note
+    assert re.fullmatch(r"only 11 elastic natural frequencies exist below \S+ rad/s", result.note)
 
 
-def test_a_range_the_search_could_not_finish_says_where_it_stopped():
-    """Random ring 5 up to 2e7 Hz (1.26e8 rad/s): far above its last root det Ū_all
-    cannot be counted, where inertia swamps it (above 6.6e6 rad/s, where the derivative
-    of log det along the counting contour is rounding noise), so the search stops
-    there. The 11 found are the FE route's 11, and the note says where it stopped,
-    at least 100 times the highest root (it said nothing, as if the range had been
-    searched to its end)."""
+def test_a_range_above_the_last_root_is_certified_by_the_stiffness_count():
+    """Random ring 5 up to 2e7 Hz (1.26e8 rad/s): the Wittrick–Williams count at the top
+    finds the 11 (the FE route's, exact for bodies and springs) and no more, so the
+    range is searched to its end and the result has no note."""
+    result = natural_frequencies(model("ring", 5), count=None, fmax=2e7)
+    np.testing.assert_allclose(result.frequencies_hz, fe_frequencies(model("ring", 5), count=80).frequencies_hz,
+                               rtol=1e-9)
+    assert result.note == ""
+
+
+def test_a_range_the_search_could_not_finish_says_where_it_stopped(monkeypatch):
+    """The same range counted by the argument principle alone (as where the stiffness
+    count cannot decide): far above its last root det Ū_all cannot be counted, where
+    inertia swamps it (above 6.6e6 rad/s, where the derivative of log det along the
+    counting contour is rounding noise), so the search stops there. The 11 found are
+    the FE route's 11, and the note says where it stopped, at least 100 times the
+    highest root (it said nothing, as if the range had been searched to its end)."""
+    from linmstmm import solve
+
+    monkeypatch.setattr(solve, "ModeCounter", lambda model, engine: None)
     result = natural_frequencies(model("ring", 5), count=None, fmax=2e7)
     np.testing.assert_allclose(result.frequencies_hz, fe_frequencies(model("ring", 5), count=80).frequencies_hz,
                                rtol=1e-9)
@@ -365,28 +379,31 @@ def test_a_range_the_search_could_not_finish_says_where_it_stopped():
 
 def test_mode_shapes_say_what_the_frequencies_say():
     """The same ring 5, 80 modes asked for by mode_shapes: the 11, with the note
-    natural_frequencies gives (mode shapes came back with no word of the 69 missing;
-    where the search stopped depends on how many it looked for); 11 asked for: the 11
+    natural_frequencies gives (mode shapes came back with no word of the 69 missing);
+    11 asked for: the 11
     and no word of a search stopped short (the note says only that the highest shape,
     589.7 Hz, is off by 1.3e-3 in mass orthogonality)."""
     from linmstmm.modes import mode_shapes
 
     short = mode_shapes(model("ring", 5), 80)
     assert short.omega.size - short.rigid_body_modes == 11
-    assert short.note.startswith("only 11 elastic natural frequencies were found: the search stopped at")
+    assert short.note.startswith("only 11 elastic natural frequencies exist below ")
     assert short.to_dict()["note"] == short.note
     eleven = mode_shapes(model("ring", 5), 11)
     assert "elastic natural frequencies" not in eleven.note and eleven.mass_orthogonality_error > 1e-4
     assert eleven.note.startswith("the mode shapes from 589.69")
 
 
-def test_scan_says_where_its_search_stopped(tmp_path, capsys):
-    """``linmstmm scan`` of ring 5 up to 2e7 Hz: the 11 frequencies, and the note of the
-    search that stopped at 1.05e8 rad/s (it printed the 11 as if the range were done)."""
+def test_scan_says_where_its_search_stopped(tmp_path, capsys, monkeypatch):
+    """``linmstmm scan`` of ring 5 up to 2e7 Hz counted by the argument principle alone:
+    the 11 frequencies, and the note of the search that stopped at 1.05e8 rad/s (it
+    printed the 11 as if the range were done)."""
     import json
 
+    from linmstmm import solve
     from linmstmm.cli import main
 
+    monkeypatch.setattr(solve, "ModeCounter", lambda model, engine: None)
     path = tmp_path / "ring5.toml"
     path.write_text(to_toml(model("ring", 5)))
     assert main(["scan", str(path), "--fmax", "2e7", "--points", "50", "--plot", str(tmp_path / "s.png"),

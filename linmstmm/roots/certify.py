@@ -1,13 +1,19 @@
-"""Certification by the argument principle: the closing count that the roots found
-are all there are (det with them divided out has no zero left), and the recovery
-of those a count says are missing."""
+"""Certification: the closing count that the roots found are all there are (the
+Wittrick–Williams count, else the argument principle on det with them divided
+out), and the recovery of those a count says are missing."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from linmstmm.counting import count_zeros, count_zeros_many, deflated
-from linmstmm.roots.settings import DEFLATED_MAX_POINTS, DEFLATED_POINTS
+from linmstmm.roots.settings import CERTIFIED_STEP, DEFLATED_MAX_POINTS, DEFLATED_POINTS
+
+#: Relative half-widths, narrowest first, of the counts that give a root's
+#: multiplicity (:func:`counted_multiplicities`): the narrowest is float64's own
+#: certification of a root (CERTIFIED_STEP); wider ones where the count there
+#: cannot decide, at the price of a refinement in mpmath.
+NEAR_WIDTHS = (1e-9, 1e-8, 1e-7, 1e-6)
 
 
 def confirmed(finder, found: list[float], count: int | None, omega_max: float | None = None,
@@ -130,9 +136,93 @@ def confirm_no_other_zeros(finder, known: list[float], upper: float) -> bool:
 
 def other_zeros(finder, known: list[float], lo: float | None, hi: float) -> int | None:
     """Zeros of det Ū_all in (lo, hi) less those in ``known`` (negative where a known
-    one is not a zero); lo None: the floor. None where the count cannot be made."""
+    one is not a zero); lo None: the floor. None where the count cannot be made.
+
+    The Wittrick–Williams count (:attr:`RootFinder.counter`, real
+    factorisations, exact for the same model) answers where it can decide:
+    the natural frequencies in (lo, hi) less the known ones there, and where
+    that is zero, every known root checked with its multiplicity by a count
+    across it (:func:`misplaced`), so that a known value that is not a root
+    cannot stand in for a missing one. Elsewhere (or for a finder without a
+    counter) the argument principle counts det with the known roots divided out.
+    """
+    counted = stiffness_other_zeros(finder, known, lo, hi)
+    if counted is not None:
+        return counted
     try:
         return count_zeros(deflated(finder.log_det, known), finder.floor if lo is None else lo, hi,
                            max_points=DEFLATED_MAX_POINTS, initial_points=DEFLATED_POINTS)
     except RuntimeError:
         return None
+
+
+def stiffness_other_zeros(finder, known: list[float], lo: float | None, hi: float) -> int | None:
+    """:func:`other_zeros` by Wittrick–Williams counts alone; None where they cannot decide."""
+    counted = stiffness_count(finder, known, lo, hi)
+    if counted is None or counted != 0:
+        return counted
+    wrong = misplaced(finder, known, lo, hi)
+    return None if wrong is None else -wrong
+
+
+def misplaced(finder, known: list[float], lo: float | None, hi: float) -> int | None:
+    """How far the multiplicities of the ``known`` roots in (lo, hi) are from the
+    Wittrick–Williams counts across each (:func:`_count_near`; a value that is no
+    root has none): the sum of the differences, 0 when every one holds. None where
+    a count cannot decide. The counts check multiplicities; where each root lies
+    is the polish's to say (its last step)."""
+    start, wrong = 0.0 if lo is None else lo, 0
+    for root in sorted({r for r in known if start < r < hi}):
+        near = _count_near(finder, root)
+        if near is None:
+            return None
+        wrong += abs(near[0] - known.count(root))
+    return wrong
+
+
+def stiffness_count(finder, known: list[float], lo: float | None, hi: float) -> int | None:
+    """Natural frequencies in (lo, hi) less those in ``known``, by the Wittrick–Williams
+    count J(hi) − J(lo) (:class:`~linmstmm.wittrick_williams.ModeCounter`); lo None:
+    from zero, less the rigid-body modes. None without a counter or where it
+    cannot decide."""
+    if finder.counter is None:
+        return None
+    upper = finder.counter(hi)
+    lower = finder.rigid_body_modes() if lo is None else finder.counter(lo)
+    if upper is None or lower is None:
+        return None
+    start = 0.0 if lo is None else lo
+    return upper - lower - sum(start < r < hi for r in known)
+
+
+def counted_multiplicities(finder, roots: list[float], lo: float | None, hi: float) -> list[float]:
+    """``roots`` (rad/s, repeated per multiplicity) with each distinct one in (lo, hi)
+    repeated as often as the Wittrick–Williams count finds natural frequencies
+    within a relative NEAR_WIDTHS of it (:func:`_count_near`): a member of a
+    multiple root the pencil did not see is added, a value that is no root
+    dropped. Roots where the count cannot decide stay as they are; so do all
+    without a counter. A member added at a width above CERTIFIED_STEP is known
+    only that closely: the width becomes the root's last step
+    (:attr:`RootFinder.last_step`), and the caller refines it in mpmath."""
+    if finder.counter is None:
+        return roots
+    start, counted = 0.0 if lo is None else lo, []
+    for root in sorted(set(roots)):
+        have = roots.count(root)
+        if start < root < hi:
+            near = _count_near(finder, root)
+            if near is not None and near[0] > have and near[1] > CERTIFIED_STEP:
+                finder.last_step[root] = max(finder.last_step.get(root, 0.0), near[1])
+            have = have if near is None else near[0]
+        counted += [root] * have
+    return counted
+
+
+def _count_near(finder, root: float) -> tuple[int, float] | None:
+    """(natural frequencies within ±width of ``root``, width (relative)) for the
+    narrowest of NEAR_WIDTHS where the count decides; None where none does."""
+    for width in NEAR_WIDTHS:
+        below, above = finder.counter(root * (1 - width)), finder.counter(root * (1 + width))
+        if below is not None and above is not None:
+            return above - below, width
+    return None

@@ -126,6 +126,11 @@ class RootFinder:
         self.unseparated: dict[float, tuple[int, float]] = {}
         #: root -> multiplicity a circle count gave it (1 where it could not be made; :meth:`_settled`)
         self._counted: dict[float, int] = {}
+        #: callable omega -> natural frequencies below omega (rad/s), rigid-body modes
+        #: included, or None where it cannot decide (a
+        #: :class:`~linmstmm.wittrick_williams.ModeCounter`); None: counts by the
+        #: argument principle only (see :func:`linmstmm.roots.certify.other_zeros`)
+        self.counter = None
 
     def divide_out_rigid_body_zeros(self, rigid: int) -> None:
         """Count and scan det Ū_all / ω^2r instead of det Ū_all.
@@ -144,6 +149,13 @@ class RootFinder:
     def rigid_body_modes(self) -> int:
         """Number of zero-frequency (rigid-body) modes, as given at construction."""
         return self._rigid
+
+    def _existing(self, count: int) -> int | None:
+        """How many of ``count`` elastic roots exist below the ceiling where the
+        Wittrick–Williams count says fewer do (the model has fewer than ``count``
+        modes there); None where it cannot say so."""
+        total = self.stiffness_count([], None, self.ceiling)
+        return total if total is not None and 0 <= total < count else None
 
     def find_near(self, guesses, count: int) -> list[float]:
         """The lowest ``count`` roots, warm-started from ``guesses`` (rad/s).
@@ -173,8 +185,12 @@ class RootFinder:
         """
         if count is not None and self.predictor is not None:
             predictions = self.predictor(count + PREDICTION_MARGIN + count // 10)
-            found = predicted_roots(self, predictions, count) if self._usable(predictions) else None
-            if found is not None:  # certified up to above the count-th: complete below omega_max too
+            wanted = count if predictions.size >= count else self._existing(count)
+            if wanted == 0:
+                return []
+            found = (predicted_roots(self, predictions, wanted)
+                     if wanted is not None and self._usable(predictions) else None)
+            if found is not None:  # certified up to above the wanted-th: complete below omega_max too
                 found = self._separated_above_floor(found)
                 return [w for w in found[:count] if omega_max is None or w <= omega_max]
         found = self._scan_ahead(count, omega_max) if count is not None or omega_max is not None else None
@@ -238,6 +254,9 @@ class RootFinder:
     _below_count = staticmethod(certify.below_count)
     confirm_no_other_zeros = certify.confirm_no_other_zeros
     other_zeros = certify.other_zeros
+    stiffness_count = certify.stiffness_count
+    stiffness_other_zeros = certify.stiffness_other_zeros
+    counted_multiplicities = certify.counted_multiplicities
 
     # the fast path: scan ahead, polish, close by one count (:mod:`linmstmm.roots.fast_path`)
     _scan_ahead = fast_path.scan_ahead

@@ -138,8 +138,7 @@ def mstmm_solve(model: Model, count: int, **options) -> np.ndarray:
         deduction = Deduction(build_topology(model))
         release_indeterminate(deduction)
         finder = RootFinder(deduction.log_det, lambda w: deduction.matrix(w, stable=True)[0], **options)
-    finder.rigid_body_modes()
-    return np.array(finder.find(count, None)) / (2 * np.pi)
+    return finder.find(count, None).roots / (2 * np.pi)
 
 
 # --------------------------------------------------------------------------

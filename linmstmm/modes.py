@@ -331,8 +331,9 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
     eigenspaces = _group(omegas)
     elastic = sum(m for _, m in eigenspaces)
     kept = {w for w, _ in eigenspaces}
-    note = search_note(finder, elastic, {w: v for w, v in solution.unseparated.items() if w in kept}, count, fmax)
-    if rigid_body and (rigid := finder.rigid_body_modes()):
+    note = search_note(solution.search, elastic, {w: v for w, v in solution.unseparated.items() if w in kept},
+                       count, fmax)
+    if rigid_body and (rigid := solution.search.rigid_body_modes):
         eigenspaces.insert(0, (0.0, rigid))
     if not eigenspaces:
         raise ModelError(model.source or model.name, "no mode to compute: " + (

@@ -220,7 +220,7 @@ def _multiple_newton(deduction, start, multiplicity: int, tolerance):
 
 def separated_cluster(deduction, model, omega: float, multiplicity: int, radius: float, digits: int):
     """The ``multiplicity`` roots within ``radius`` of ``omega`` (rad/s) that float64 could
-    not tell apart (:attr:`RootFinder.unseparated`), to ``digits`` digits; None if they
+    not tell apart (:attr:`RootSearchResult.unseparated`), to ``digits`` digits; None if they
     are not found in full.
 
     det Ū_all in mpmath on CLUSTER_POINTS points across the interval: each sign

@@ -17,7 +17,7 @@ from linmstmm.determinant import determinant
 from linmstmm.results import Result, decode_array
 from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.stages import report
-from linmstmm.roots import CERTIFIED_STEP, RootFinder
+from linmstmm.roots import CERTIFIED_STEP, RootFinder, RootSearchResult
 from linmstmm.threads import single_blas_thread
 from linmstmm.topology import build_topology
 from linmstmm.wittrick_williams import ModeCounter
@@ -148,7 +148,11 @@ class RootSolution:
     deduction : Deduction
         The deduced system (Ū_all and the states behind it).
     finder : RootFinder
-        The root finder that found them (rigid-body count, evaluations, notes).
+        The root finder that found them, for work after the search (its
+        determinant, the multiplicity of a root cut by the count).
+    search : RootSearchResult
+        What its search returned: the roots in float64 and the search's
+        diagnostics (rigid-body modes, note, ceiling).
     released : int
         Statically indeterminate unknowns released before the search.
     omegas : numpy.ndarray, shape (n,)
@@ -160,16 +164,20 @@ class RootSolution:
     unseparated : dict
         Root (rad/s) -> (multiplicity, radius rad/s) of each cluster neither
         float64 nor mpmath could separate.
+    evaluations : int
+        Float64 evaluations of det Ū_all the search and the mpmath refinement took.
     """
 
     deduction: Deduction
     finder: RootFinder
+    search: RootSearchResult
     released: int
     omegas: np.ndarray
     precision: str = "float64"
     frequencies_text: list | None = None
     omegas_text: list | None = None
     unseparated: dict = field(default_factory=dict)
+    evaluations: int = 0
 
 
 def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None, *, digits: int | None = None,
@@ -216,20 +224,24 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
     report("finding roots")
     omega_max = None if fmax is None else 2 * np.pi * fmax
     if guess_hz is not None and count is not None and fmax is None:
-        omegas = np.array(finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count))
+        search = finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count)
     else:
-        omegas = np.array(finder.find(count, omega_max))
-    unseparated = finder.unseparated_among(omegas)
-    uncertain = sorted({w for w in omegas if finder.last_step.get(w, 0.0) > CERTIFIED_STEP} - set(unseparated))
+        search = finder.find(count, omega_max)
+    omegas, unseparated = search.roots, dict(search.unseparated)
+    # (a root no Newton step reached has a NaN step: it is in unseparated)
+    uncertain = sorted({w for w, step in search.last_steps.items() if step > CERTIFIED_STEP} - set(unseparated))
     every = bool(digits and digits > FLOAT64_DIGITS)
     wanted = digits if every else (ESCALATION_DIGITS if uncertain or unseparated else None)
     if not wanted:
-        return RootSolution(deduction, finder, released, omegas, unseparated=unseparated)
+        return RootSolution(deduction, finder, search, released, omegas, unseparated=unseparated,
+                            evaluations=search.evaluations)
     report(f"refining in mpmath to {wanted} digits")
+    before = finder.determinant.evaluations
     omegas, precision, text, omega_text = _refined_in_mpmath(
         deduction, model, finder, omegas, [w for w in omegas if w not in unseparated and (every or w in uncertain)],
         unseparated, wanted, cut_by_count=count is not None)
-    return RootSolution(deduction, finder, released, omegas, precision, text, omega_text, unseparated)
+    return RootSolution(deduction, finder, search, released, omegas, precision, text, omega_text, unseparated,
+                        search.evaluations + finder.determinant.evaluations - before)
 
 
 @single_blas_thread
@@ -250,7 +262,7 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         Significant digits wanted; above FLOAT64_DIGITS every root is
         refined in mpmath. Without it, roots float64 cannot certify are
         refined at ESCALATION_DIGITS automatically, and so are clusters of
-        roots float64 could not tell apart (:attr:`RootFinder.unseparated`,
+        roots float64 could not tell apart (:attr:`RootSearchResult.unseparated`,
         separated by :func:`~linmstmm.precision.separated_cluster`); a
         cluster mpmath cannot separate either is named in the note.
     root : str or None
@@ -276,20 +288,21 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     """
     start = time.perf_counter()
     solution = solve_roots(model, count, fmax, digits=digits, root=root, guess_hz=guess_hz, engine=engine)
-    finder, omegas = solution.finder, solution.omegas
-    note = search_note(finder, omegas.size, solution.unseparated, count, fmax)
-    return FrequencyResult(model.name, omegas / (2 * np.pi), finder.rigid_body_modes(),
+    search, omegas = solution.search, solution.omegas
+    note = search_note(search, omegas.size, solution.unseparated, count, fmax)
+    return FrequencyResult(model.name, omegas / (2 * np.pi), search.rigid_body_modes,
                            solution.deduction.full_order, time.perf_counter() - start,
                            precision=solution.precision, note=note, indeterminate_released=solution.released,
                            frequencies_text=solution.frequencies_text, omegas_text=solution.omegas_text,
-                           evaluations=finder.determinant.evaluations)
+                           evaluations=solution.evaluations)
 
 
-def search_note(finder: RootFinder, found: int, unseparated: dict, count: int | None, fmax: float | None) -> str:
+def search_note(search: RootSearchResult, found: int, unseparated, count: int | None, fmax: float | None) -> str:
     """What a result of ``found`` elastic roots, asked for by ``count`` and/or ``fmax``,
-    must say about its search ("" if nothing): each cluster float64 could not separate
-    (``unseparated``: root rad/s -> (multiplicity, radius rad/s)), a search that stopped
-    short of what was asked (:attr:`RootFinder.note`), or that fewer than ``count`` exist."""
+    must say about the ``search`` that found them ("" if nothing): each cluster float64
+    could not separate (``unseparated``: root rad/s -> (multiplicity, radius rad/s)), a
+    search that stopped short of what was asked (:attr:`RootSearchResult.note`), or that
+    fewer than ``count`` exist (below :attr:`RootSearchResult.ceiling`)."""
     notes = [(f"float64 could not tell {m} roots within ±{radius / (2 * np.pi):.3g} Hz of {w / (2 * np.pi):.10g} Hz "
               "apart (a cluster, or a multiple root it could not confirm): they are reported together there")
              if m > 1 else
@@ -297,10 +310,10 @@ def search_note(finder: RootFinder, found: int, unseparated: dict, count: int | 
               f"{w / (2 * np.pi):.10g} Hz: it is reported there")
              for w, (m, radius) in unseparated.items()]
     fewer = count is not None and found < count
-    if finder.note and (fewer or count is None):  # the search stopped short of what was asked
-        notes.append(f"only {found} elastic natural frequencies were found: {finder.note}")
+    if search.note and (fewer or count is None):  # the search stopped short of what was asked
+        notes.append(f"only {found} elastic natural frequencies were found: {search.note}")
     elif fewer and fmax is None:
-        notes.append(f"only {found} elastic natural frequencies exist below {finder.ceiling:.3g} rad/s")
+        notes.append(f"only {found} elastic natural frequencies exist below {search.ceiling:.3g} rad/s")
     return "; ".join(notes)
 
 

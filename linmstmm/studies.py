@@ -439,8 +439,8 @@ def determinant_scan(model: Model, fmax: float, points: int = DEFAULT_SCAN_POINT
     report("scanning det Ubar_all")
     parts = [deduction.log_det(grid[start:start + SCAN_CHUNK]) for start in range(0, grid.size, SCAN_CHUNK)]
     report("finding roots")
-    roots = np.array(finder.find(None, omega_max))
-    note = search_note(finder, roots.size, finder.unseparated_among(roots), None, fmax)
+    search = finder.find(None, omega_max)
+    note = search_note(search, search.roots.size, search.unseparated, None, fmax)
     return ScanResult(model.name, grid, np.concatenate([p[0] for p in parts]),
-                      np.concatenate([p[1] for p in parts]), roots, deduction.full_order,
-                      finder.rigid_body_modes(), note)
+                      np.concatenate([p[1] for p in parts]), search.roots, deduction.full_order,
+                      search.rigid_body_modes, note)

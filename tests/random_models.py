@@ -372,7 +372,7 @@ def mstmm_frequencies(model: Model, count: int = 10, root: str | None = None,
     """Elastic frequencies (Hz) as ``natural_frequencies`` finds them, but with
     ``root`` and the loop cuts ``cut_at`` chosen (no mpmath escalation)."""
     _, finder, _ = frequency_finder(model, root=root, cut_at=cut_at)
-    return np.array(finder.find(count, None)) / (2 * np.pi)
+    return finder.find(count, None).roots / (2 * np.pi)
 
 
 # --------------------------------------------------------------------------

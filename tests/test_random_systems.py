@@ -172,7 +172,7 @@ def test_forced_cut_on_a_ring_without_boundary():
 def test_a_cluster_float64_cannot_separate_is_separated_in_mpmath():
     """Loops 32 at 40 modes: a root 3e-5 below another at 2663 Hz, which float64 Ū_all
     cannot tell apart. The float64 search flags what it could not separate
-    (RootFinder.unseparated; the FE root lies within the radius it gives: they had come
+    (RootSearchResult.unseparated; the FE root lies within the radius it gives: they had come
     back as one double root, silently, and since the bisection on the count encloses
     such a root it is one root at an interval's middle); natural_frequencies then
     finds it in mpmath, and all 40 agree with FE. (The predicted search's secant on
@@ -184,9 +184,9 @@ def test_a_cluster_float64_cannot_separate_is_separated_in_mpmath():
     reference = 2 * np.pi * fe_frequencies(model, count=40).frequencies_hz
     _, finder, _ = frequency_finder(model)
     finder.predictor = None  # the scan-based search: the predicted one's secant on det splits them in float64
-    finder.find(40, None)
-    assert finder.unseparated
-    for root, (_, radius) in finder.unseparated.items():
+    search = finder.find(40, None)
+    assert search.unseparated
+    for root, (_, radius) in search.unseparated.items():
         assert np.min(np.abs(reference - root)) <= radius
     result = natural_frequencies(model, 40)
     assert result.note == ""
@@ -330,7 +330,7 @@ def test_brackets_left_out_above_the_count_are_taken_before_scanning_on():
     log_det, matrix = finder.log_det, finder.matrix
     finder.log_det = lambda omega: highest.append(np.max(np.abs(omega))) or log_det(omega)
     finder.matrix = lambda omega: highest.append(np.max(np.abs(omega))) or matrix(omega)
-    roots = finder.find(80, None)
+    roots = finder.find(80, None).roots
     assert len(roots) == 80 and max(highest) < 10 * roots[-1]
 
 

@@ -30,10 +30,13 @@ itself is the stable (orthonormalised) one of :mod:`linmstmm.deduction`.
 Modules
 -------
 :class:`RootFinder` (:mod:`~linmstmm.roots.finder`) holds the search's state
-and coordinates it; each step is a function of its own module that takes the
-finder as its first argument ``finder`` and is the finder's method of the same
-name (with a leading underscore where it is internal), so the steps call each
-other through the finder:
+and coordinates it; its searches, :meth:`~RootFinder.find` and
+:meth:`~RootFinder.find_near`, return a frozen :class:`RootSearchResult`
+(:mod:`~linmstmm.roots.result`): the roots with the search's diagnostics.
+Each step is a function of its own module that takes the finder as its first
+argument ``finder`` and is the finder's method of the same name (with a
+leading underscore where it is internal), so the steps call each other
+through the finder:
 
 * :mod:`~linmstmm.roots.fast_path` — scan ahead, polish, close by one count;
 * :mod:`~linmstmm.roots.brackets` — sign-change brackets and quiet minima;
@@ -42,12 +45,14 @@ other through the finder:
 * :mod:`~linmstmm.roots.clusters` — clusters of close roots, multiplicities;
 * :mod:`~linmstmm.roots.certify` — argument-principle counts that certify;
 * :mod:`~linmstmm.roots.floor` — nothing hides below the floor;
-* :mod:`~linmstmm.roots.settings` — scan densities, limits, frequency ratios.
+* :mod:`~linmstmm.roots.settings` — scan densities, limits, frequency ratios;
+* :mod:`~linmstmm.roots.result` — the frozen result of a search.
 """
 
 from __future__ import annotations
 
 from linmstmm.roots.finder import RootFinder
+from linmstmm.roots.result import RootSearchResult
 from linmstmm.roots.settings import (
                                      CEILING_RATIO,
                                      CERTIFIED_STEP,
@@ -69,7 +74,7 @@ from linmstmm.roots.settings import (
                                      SCAN_OCTAVES,
 )
 
-__all__ = ["RootFinder", "CEILING_RATIO", "CERTIFIED_STEP", "CIRCLE_MAX_POINTS", "CIRCLE_POINTS", "DEFAULT_SCALE",
-           "DEFLATED_MAX_POINTS", "DEFLATED_POINTS", "FINE_SCAN_RATIO", "FIRST_CHUNK_RATIO", "FIRST_SEGMENT_RATIO",
-           "FLOOR_CHECK", "FLOOR_MARGIN", "FLOOR_RATIO", "MAX_XTOL", "MIN_POINTS_PER_OCTAVE", "POINTS_PER_OCTAVE",
-           "PREDICTION_MARGIN", "SCAN_OCTAVES"]
+__all__ = ["RootFinder", "RootSearchResult", "CEILING_RATIO", "CERTIFIED_STEP", "CIRCLE_MAX_POINTS", "CIRCLE_POINTS",
+           "DEFAULT_SCALE", "DEFLATED_MAX_POINTS", "DEFLATED_POINTS", "FINE_SCAN_RATIO", "FIRST_CHUNK_RATIO",
+           "FIRST_SEGMENT_RATIO", "FLOOR_CHECK", "FLOOR_MARGIN", "FLOOR_RATIO", "MAX_XTOL", "MIN_POINTS_PER_OCTAVE",
+           "POINTS_PER_OCTAVE", "PREDICTION_MARGIN", "SCAN_OCTAVES"]

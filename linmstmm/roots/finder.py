@@ -10,6 +10,7 @@ from linmstmm.counting import count_in_disc, deflated
 from linmstmm.predicted import predicted_roots
 from linmstmm.roots import brackets, certify, fast_path, floor, pencil, segments
 from linmstmm.roots import clusters as close_roots
+from linmstmm.roots.result import RootSearchResult, search_result
 from linmstmm.roots.settings import (
     CEILING_RATIO,
     DEFAULT_SCALE,
@@ -52,7 +53,8 @@ class RootFinder:
     SAME_ROOT = 1e-9
     #: Newton steps |μ|/ω that stop shrinking below this have reached the rounding
     #: floor of Ū_all: the root is accepted, with that step as its uncertainty
-    #: (:attr:`last_step`; the caller refines uncertain roots in mpmath).
+    #: (:attr:`last_step`, and the result's ``last_steps``; the caller refines uncertain
+    #: roots in mpmath).
     UNCERTAIN = 1e-7
     #: log|det| must rise by this much either side of a root without a sign change (a
     #: double root's rises by 2 ln 10 at ten times the distance to it).
@@ -157,8 +159,8 @@ class RootFinder:
         total = self.stiffness_count([], None, self.ceiling)
         return total if total is not None and 0 <= total < count else None
 
-    def find_near(self, guesses, count: int) -> list[float]:
-        """The lowest ``count`` roots, warm-started from ``guesses`` (rad/s).
+    def find_near(self, guesses, count: int) -> RootSearchResult:
+        """The lowest ``count`` roots, warm-started from ``guesses``.
 
         Guesses (e.g. the roots of a neighbouring scene of the same model) are
         taken as predictions (:func:`~linmstmm.predicted.predicted_roots`: the
@@ -166,7 +168,25 @@ class RootFinder:
         they are polished on the pencil and one count over (floor, just above
         the count-th root) must confirm that none was missed. Otherwise the
         full search runs.
+
+        Parameters
+        ----------
+        guesses : array_like, shape (m,)
+            rad/s, the roots of a similar model, in any order.
+        count : int
+            How many of the lowest elastic roots to find.
+
+        Returns
+        -------
+        RootSearchResult
+            The roots (rad/s, ascending, repeated per multiplicity) and the
+            search's diagnostics, frozen.
         """
+        self.note = ""
+        return self._search_result(self._near(guesses, count))
+
+    def _near(self, guesses, count: int) -> list[float]:
+        """The roots :meth:`find_near` returns, as a list (rad/s)."""
         guesses = np.sort(np.asarray(guesses, dtype=float))
         found = predicted_roots(self, guesses, count) if guesses.size >= count else None
         if found is not None:
@@ -174,15 +194,33 @@ class RootFinder:
         found = self._confirmed(self._polished(guesses, []), count)
         return found if found is not None else self._search(count, None)
 
-    def find(self, count: int | None, omega_max: float | None) -> list[float]:
-        """Elastic roots (rad/s) ascending, each repeated per multiplicity.
+    def find(self, count: int | None, omega_max: float | None) -> RootSearchResult:
+        """Elastic roots, ascending, each repeated per multiplicity.
 
         The lowest ``count``, or all up to ``omega_max``, with none missed:
         from the predictor's frequencies when one count confirms them
         (:func:`~linmstmm.predicted.predicted_roots`, with ``count``), else the
         fast path (:meth:`_scan_ahead`) when one count confirms it, else the
         segment search (:meth:`_search`).
+
+        Parameters
+        ----------
+        count : int or None
+            How many of the lowest elastic roots to find; None: all up to ``omega_max``.
+        omega_max : float or None
+            rad/s: every root up to it; with ``count``, whichever stops first.
+
+        Returns
+        -------
+        RootSearchResult
+            The roots (rad/s) and the search's diagnostics, frozen: a later
+            search on this finder does not change them.
         """
+        self.note = ""
+        return self._search_result(self._found(count, omega_max))
+
+    def _found(self, count: int | None, omega_max: float | None) -> list[float]:
+        """The roots :meth:`find` returns, as a list (rad/s)."""
         if count is not None and self.predictor is not None:
             predictions = self.predictor(count + PREDICTION_MARGIN + count // 10)
             wanted = count if predictions.size >= count else self._existing(count)
@@ -198,6 +236,11 @@ class RootFinder:
             found = self._search(count, omega_max)
         found = self._separated_above_floor(found)
         return found[:count] if count is not None else found
+
+    #: Evaluations of ``determinant`` already counted in an earlier search's result.
+    _evaluations_reported = 0
+    #: The frozen result of a search (:mod:`linmstmm.roots.result`).
+    _search_result = search_result
 
     # The steps of the search, each a function of the finder in its own module; called
     # through these attributes, so that one can be timed or replaced on the class.

@@ -7,20 +7,15 @@ negative eigenvalues of the dynamic stiffness matrix) is never negative. So
 J0 bounds J from below, and needs nothing but each beam's data: a request
 for every frequency up to some fmax can be refused before the search starts
 when J0 alone is too many (a beam has infinitely many; ``--fmax 1e30`` searched
-without end).
-
-Per beam, with both ends clamped:
-
-* bending, per principal plane: λ_k = β_k L ≈ (k + ½)π, so at least
-  ⌊βL/π⌋ − 1 lie below β(ω)L, β = (ρAω²/EI)^¼;
-* axial and torsion: ω_k = kπc/L (c = √(E/ρ), √(GJ/ρI_p)), so ⌈ωL/(πc)⌉ − 1.
-
-Massless beams and directions declared rigid have none.
+without end). J0 is counted exactly by
+:func:`linmstmm.dynamic_stiffness.clamped_counts`; the whole count J is
+:mod:`linmstmm.wittrick_williams`.
 """
 from __future__ import annotations
 
 import math
 
+from linmstmm.dynamic_stiffness import BeamTable, clamped_counts
 from linmstmm.model import Model, ModelError
 
 #: A request for every frequency up to fmax is refused when the beams' clamped-end
@@ -30,17 +25,15 @@ MAX_RANGE_MODES = 1000
 
 
 def clamped_modes_below(model: Model, omega: float) -> int:
-    """J0(ω): the clamped–clamped natural frequencies of all beams below ``omega`` (rad/s),
-    bending counted from below (⌊βL/π⌋ − 1 per plane): a lower bound on the model's."""
-    total = 0
-    for beam in model.beams:
-        k = beam.wavenumbers(omega)
-        for plane in ("bending_y", "bending_z"):
-            total += max(math.floor(k[plane] * beam.length / math.pi) - 1, 0)
-        for rod, deformable in (("axial", beam.axial), ("torsion", beam.torsion)):
-            if deformable:
-                total += max(math.ceil(k[rod] * beam.length / math.pi) - 1, 0)
-    return total
+    """J0(ω): the clamped–clamped natural frequencies of all beams below ``omega``
+    (rad/s), exactly: a lower bound on the model's. At one of them itself, those
+    below a hair lower."""
+    table = BeamTable.of(model.beams)
+    count = clamped_counts(table, omega)
+    while count is None:               # ω on a clamped frequency: the count just below it
+        omega *= 1 - 1e-8
+        count = clamped_counts(table, omega)
+    return count
 
 
 def check_range_request(model: Model, fmax: float, request: str | None = None,

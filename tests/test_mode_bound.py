@@ -36,12 +36,11 @@ def clamped_clamped_count(omega: float, length: float) -> int:
 
 
 @pytest.mark.parametrize("omega", [50.0, 3e3, 2e4, 1.3e5, 7e5])
-def test_one_clamped_beam_is_bounded_by_its_closed_forms_and_loses_at_most_one_per_plane(omega):
-    """One element clamped at both ends: J = J0, so the bound is the closed-form count less
-    at most one per bending plane (it counts ⌊βL/π⌋ − 1)."""
+def test_one_clamped_beam_counts_its_closed_forms(omega):
+    """One element clamped at both ends: J = J0, counted exactly (the roots of
+    cos βL = 1/cosh βL per bending plane, kπc/L per rod)."""
     model = single_beam_model(left=fixed(), right=fixed(), length=2.0, **SECTION)
-    exact = clamped_clamped_count(omega, 2.0)
-    assert exact - 2 <= clamped_modes_below(model, omega) <= exact
+    assert clamped_modes_below(model, omega) == clamped_clamped_count(omega, 2.0)
 
 
 def test_the_bound_holds_for_the_launcher_against_finite_elements():

@@ -74,10 +74,16 @@ class ModeCounter:
         self._maps, self._columns = _beam_maps(model, parts.layout, T)
         self._scatter = (self._columns[:, :, None] * (n + 1) + self._columns[:, None, :]).ravel()
         self._buffers = np.empty((2, n + 1, n + 1))
+        self._answers: dict[float, int | None] = {}
 
     def __call__(self, omega: float) -> int | None:
-        if self.engine == "compiled":
-            return self._compiled(float(omega))
+        omega = float(omega)
+        if omega not in self._answers:  # the certifying steps ask at the same ω more than once
+            self._answers[omega] = self._compiled(omega) if self.engine == "compiled" else self._numpy(omega)
+        return self._answers[omega]
+
+    def _numpy(self, omega: float) -> int | None:
+        """:meth:`__call__` by the numpy reference."""
         clamped = clamped_counts(self._beams, omega)
         if clamped is None:
             return None

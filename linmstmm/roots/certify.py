@@ -167,17 +167,37 @@ def stiffness_other_zeros(finder, known: list[float], lo: float | None, hi: floa
 
 def misplaced(finder, known: list[float], lo: float | None, hi: float) -> int | None:
     """How far the multiplicities of the ``known`` roots in (lo, hi) are from the
-    Wittrick–Williams counts across each (:func:`_count_near`; a value that is no
-    root has none): the sum of the differences, 0 when every one holds. None where
-    a count cannot decide. The counts check multiplicities; where each root lies
-    is the polish's to say (its last step)."""
+    Wittrick–Williams counts across each (:func:`_counts_near`; a value that is no
+    root has none): the sum of the differences at the narrowest width the count
+    decides, 0 when every one holds at some width. None where a count cannot
+    decide. A root that a narrower count contradicts and a wider one holds lies
+    that far from where float64 put it, whatever its last step said: that width
+    becomes its last step (:attr:`RootFinder.last_step`), and the caller refines it in mpmath
+    (a root of the second launcher at 13.25 krad/s, polished 1.5e-9 high, was
+    reported as certified before)."""
     start, wrong = 0.0 if lo is None else lo, 0
     for root in sorted({r for r in known if start < r < hi}):
-        near = _count_near(finder, root)
-        if near is None:
+        first, held = None, None
+        for count, width in _counts_near(finder, root):       # narrowest first, until one holds
+            if count is None:
+                continue
+            first = first or (count, width)
+            if count == _known_within(known, root, width):
+                held = width
+                break
+        if first is None:
             return None
-        wrong += abs(near[0] - known.count(root))
+        if held is None:
+            wrong += abs(first[0] - _known_within(known, root, first[1]))
+        elif held > first[1]:  # a narrower count disagreed: float64 placed it that far off
+            finder.last_step[root] = max(finder.last_step.get(root, 0.0), held)
     return wrong
+
+
+def _known_within(known: list[float], root: float, width: float) -> int:
+    """How many of ``known`` (with repeats) lie within ±``width`` (relative) of ``root``:
+    its own multiplicity, and a close neighbour's that the same count sees."""
+    return sum(abs(r - root) < width * root for r in known)
 
 
 def stiffness_count(finder, known: list[float], lo: float | None, hi: float) -> int | None:
@@ -211,18 +231,30 @@ def counted_multiplicities(finder, roots: list[float], lo: float | None, hi: flo
         have = roots.count(root)
         if start < root < hi:
             near = _count_near(finder, root)
-            if near is not None and near[0] > have and near[1] > CERTIFIED_STEP:
-                finder.last_step[root] = max(finder.last_step.get(root, 0.0), near[1])
-            have = have if near is None else near[0]
+            if near is not None:
+                # the count sees close neighbours too: this root holds what they leave
+                counted_here = near[0] - (_known_within(roots, root, near[1]) - have)
+                if counted_here > have and near[1] > CERTIFIED_STEP:
+                    finder.last_step[root] = max(finder.last_step.get(root, 0.0), near[1])
+                have = max(counted_here, 0)
         counted += [root] * have
     return counted
 
 
 def _count_near(finder, root: float) -> tuple[int, float] | None:
-    """(natural frequencies within ±width of ``root``, width (relative)) for the
-    narrowest of NEAR_WIDTHS where the count decides; None where none does."""
-    for width in NEAR_WIDTHS:
+    """(natural frequencies within ±width of ``root``, width (relative)) at the
+    narrowest width of :func:`_counts_near` where the count decides; None where
+    none does."""
+    return next(((count, width) for count, width in _counts_near(finder, root) if count is not None), None)
+
+
+def _counts_near(finder, root: float):
+    """(natural frequencies within ±width of ``root`` or None where the count cannot
+    decide, width) for each of NEAR_WIDTHS, narrowest first, none narrower than
+    four times the root's own uncertainty (its last step,
+    :attr:`RootFinder.last_step`: an uncertain root is refined in mpmath later,
+    and is counted where it may lie)."""
+    least = 4 * finder.last_step.get(root, 0.0)
+    for width in [w for w in NEAR_WIDTHS if w >= least] or [least]:
         below, above = finder.counter(root * (1 - width)), finder.counter(root * (1 + width))
-        if below is not None and above is not None:
-            return above - below, width
-    return None
+        yield (None if below is None or above is None else above - below), width

@@ -1,0 +1,70 @@
+"""The certifying logic on Wittrick–Williams counts, with a counter that knows the
+true natural frequencies (the counts themselves are checked against the FE route
+in tests/test_wittrick_williams.py): what the certification accepts, what it
+refuses, and what it repairs."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from linmstmm.roots import certify
+
+
+class KnownSpectrum:
+    """A finder whose counter answers J(ω) exactly for the frequencies ``true`` (rad/s)."""
+
+    def __init__(self, true, rigid=0):
+        self.true, self.rigid, self.last_step = np.sort(true), rigid, {}
+
+    def counter(self, omega):
+        return self.rigid + int(np.sum(self.true < omega))
+
+    def rigid_body_modes(self):
+        return self.rigid
+
+
+def test_complete_roots_with_their_multiplicities_are_certified():
+    finder = KnownSpectrum([10.0, 20.0, 20.0, 30.0], rigid=6)
+    assert certify.stiffness_other_zeros(finder, [10.0, 20.0, 20.0, 30.0], None, 35.0) == 0
+
+
+def test_a_missing_member_of_a_double_root_is_seen_and_added():
+    finder = KnownSpectrum([10.0, 20.0, 20.0, 30.0])
+    known = [10.0, 20.0, 30.0]
+    assert certify.stiffness_other_zeros(finder, known, None, 35.0) == 1
+    assert certify.counted_multiplicities(finder, known, None, 35.0) == [10.0, 20.0, 20.0, 30.0]
+
+
+def test_a_value_that_is_no_root_cannot_stand_in_for_a_missing_one():
+    """The total count balances (a false root at 25, the double root's second member
+    missing); the counts across each root do not."""
+    finder = KnownSpectrum([10.0, 20.0, 20.0, 30.0])
+    known = [10.0, 20.0, 25.0, 30.0]
+    assert certify.stiffness_count(finder, known, None, 35.0) == 0
+    assert certify.stiffness_other_zeros(finder, known, None, 35.0) != 0
+    assert certify.counted_multiplicities(finder, known, None, 35.0) == [10.0, 20.0, 20.0, 30.0]
+
+
+def test_a_root_placed_off_by_more_than_its_last_step_is_marked_for_refinement():
+    """True root 20, float64 put it 5e-9 high with a last step of 1e-12: the count
+    across ±1e-9 misses it, ±1e-8 holds it; its last step becomes 1e-8."""
+    finder = KnownSpectrum([10.0, 20.0, 30.0])
+    off = 20.0 * (1 + 5e-9)
+    finder.last_step = {10.0: 1e-13, off: 1e-12, 30.0: 1e-13}
+    assert certify.stiffness_other_zeros(finder, [10.0, off, 30.0], None, 35.0) == 0
+    assert finder.last_step[off] == pytest.approx(1e-8)
+    assert finder.last_step[10.0] == 1e-13
+
+
+def test_a_close_pair_is_certified_by_counts_that_see_both():
+    pair = [20.0, 20.0 * (1 + 3e-9)]
+    finder = KnownSpectrum([10.0, *pair])
+    assert certify.stiffness_other_zeros(finder, [10.0, *pair], None, 35.0) == 0
+    assert certify.counted_multiplicities(finder, [10.0, *pair], None, 35.0) == [10.0, *pair]
+
+
+def test_no_counter_means_no_answer_from_counts():
+    finder = KnownSpectrum([10.0])
+    finder.counter = None
+    assert certify.stiffness_other_zeros(finder, [10.0], None, 35.0) is None
+    assert certify.counted_multiplicities(finder, [10.0], None, 35.0) == [10.0]

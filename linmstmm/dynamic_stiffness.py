@@ -99,25 +99,30 @@ def dynamic_stiffness(beams: BeamTable, omega: float) -> np.ndarray:
     return d
 
 
-def clamped_counts(beams: BeamTable, omega: float) -> int | None:
+def clamped_counts(beams: BeamTable, omega: float, at_least: bool = False) -> int | None:
     """J₀(ω): the natural frequencies of all beams with both ends clamped that lie
-    below ``omega`` (rad/s), exactly; None within POLE of one of them."""
+    below ``omega`` (rad/s), exactly; None within POLE of one of them. at_least:
+    never None — a family float64 cannot place ω in (ω within POLE of one of its
+    frequencies, or so high that POLE spans one) counts one fewer, a lower bound."""
     total = 0
     for stiffness, inertia, deformable in ((beams.EA, beams.rhoA, beams.axial),
                                           (beams.GJ, beams.rhoIp, beams.torsion)):
         phase = omega * beams.L[deformable] * np.sqrt(inertia / stiffness)[deformable] / math.pi
         nearest = np.round(phase)
-        if np.any((nearest >= 1) & (np.abs(phase - nearest) < POLE * phase)):
+        undecided = (nearest >= 1) & (np.abs(phase - nearest) < POLE * phase)
+        if np.any(undecided) and not at_least:
             return None
-        total += int(np.floor(phase).sum())
+        total += int(np.maximum(np.floor(phase) - undecided, 0).sum())
     for stiffness in (beams.EIy, beams.EIz):
         lam = beams.L * (beams.rhoA * omega ** 2 / stiffness) ** 0.25
         lam = lam[lam >= SERIES_BELOW]            # none below 4.73
         delta = _scaled(lam)[:, 0]                # (1 − cos λ cosh λ) / cosh λ
-        if np.any(np.abs(delta) < POLE):
+        undecided = np.abs(delta) < POLE
+        if np.any(undecided) and not at_least:
             return None
         i = np.floor(lam / math.pi)
-        total += int((i - (1 - (-1.0) ** i * np.sign(delta)) / 2).sum())
+        exact = i - (1 - (-1.0) ** i * np.sign(delta)) / 2
+        total += int(np.maximum(np.where(undecided, i - 1, exact), 0).sum())
     return total
 
 

@@ -26,14 +26,9 @@ MAX_RANGE_MODES = 1000
 
 def clamped_modes_below(model: Model, omega: float) -> int:
     """J0(ω): the clamped–clamped natural frequencies of all beams below ``omega``
-    (rad/s), exactly: a lower bound on the model's. At one of them itself, those
-    below a hair lower."""
-    table = BeamTable.of(model.beams)
-    count = clamped_counts(table, omega)
-    while count is None:               # ω on a clamped frequency: the count just below it
-        omega *= 1 - 1e-8
-        count = clamped_counts(table, omega)
-    return count
+    (rad/s), exactly where float64 can place ω among them, one fewer per family
+    where it cannot (at one of them, or at 1e30 Hz): a lower bound on the model's."""
+    return clamped_counts(BeamTable.of(model.beams), omega, at_least=True)
 
 
 def check_range_request(model: Model, fmax: float, request: str | None = None,

@@ -91,6 +91,7 @@ def test_clamped_counts_follow_the_frequency_equations():
         assert clamped_counts(table, omega * (1 - 1e-7)) == 2 * (k - 1)
         assert clamped_counts(table, omega * (1 + 1e-7)) == 2 * k
         assert clamped_counts(table, omega) is None            # a pole of D: left undecided
+        assert clamped_counts(table, omega, at_least=True) == 2 * (k - 1)   # or counted from below
     # a rod's clamped modes at kL = nπ: the n-th axial one adds one to the count
     beam = _beam(length=1.5)
     stiff_only = BeamTable.of((_beam(length=1.5, axial=False),))

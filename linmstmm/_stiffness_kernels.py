@@ -16,15 +16,13 @@ import math
 import numpy as np
 from numba import njit
 
-from linmstmm.dynamic_stiffness import POLE, SERIES_BELOW, SERIES_TERMS
+from linmstmm.dynamic_stiffness import POLE, SERIES_BELOW, SERIES_COEFFICIENTS, SERIES_TERMS
 
 #: Columns of the beam table the kernels take (see :func:`beam_columns`).
 EA, GJ, EIY, EIZ, RHO_A, RHO_IP, LENGTH, AXIAL, TORSION = range(9)
 _X_Y = np.array([1, 5, 7, 11])
 _X_Z = np.array([2, 4, 8, 10])
 _FLIP = np.array([1.0, -1.0, 1.0, -1.0])
-_SERIES_FACTORIALS = np.array([[1.0 / math.factorial(4 * j + shift) for j in range(SERIES_TERMS)]
-                               for shift in range(5)])
 
 
 def beam_columns(beams) -> np.ndarray:
@@ -40,17 +38,12 @@ def _combinations(lam, out):
     (λ ≥ SERIES_BELOW) or ``_series`` (below) into ``out``; True for the series."""
     if lam < SERIES_BELOW:
         x = lam ** 4
-        shifts = (4, 1, 2, 1, 2, 3, 3)
-        scales = (4.0, 2.0, 2.0, 2.0, 2.0, 4.0, 2.0)
-        alternating = (True, True, True, False, False, True, False)
-        for i in range(7):
-            total, power, sign = 0.0, 1.0, 1.0
-            for j in range(SERIES_TERMS):
-                total += sign * power * _SERIES_FACTORIALS[shifts[i], j]
-                power *= x
-                if alternating[i]:
-                    sign *= -4.0
-            out[i] = scales[i] * total
+        out[:] = 0.0
+        power = 1.0
+        for j in range(SERIES_TERMS):
+            for i in range(7):
+                out[i] += SERIES_COEFFICIENTS[j, i] * power
+            power *= x
         return True
     c, s = math.cos(lam), math.sin(lam)
     decay = math.exp(-2 * lam)

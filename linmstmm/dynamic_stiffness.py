@@ -52,6 +52,11 @@ POLE = 1e-10
 _X_Y = np.array([1, 5, 7, 11])    # (v, θz) at both ends
 _X_Z = np.array([2, 4, 8, 10])    # (w, θy) at both ends, θy = −w′
 _FLIP = np.array([1.0, -1.0, 1.0, -1.0])
+#: The bending block from its six distinct entries K11 = β³(cS + sC), K12 = β²sS,
+#: β³(s + S), K14 = β²(C − c), K22 = β(sC − cS), K24 = β(S − s) (each over δ), with signs.
+_BENDING_PATTERN = np.array([[0, 1, 2, 3], [1, 4, 3, 5], [2, 3, 0, 1], [3, 5, 1, 4]])
+_BENDING_SIGNS = np.array([[1.0, 1.0, -1.0, 1.0], [1.0, 1.0, -1.0, 1.0],
+                           [-1.0, -1.0, 1.0, -1.0], [1.0, 1.0, -1.0, 1.0]])
 _AXIAL = np.array([0, 6])
 _TORSION = np.array([3, 9])
 
@@ -116,7 +121,8 @@ def clamped_counts(beams: BeamTable, omega: float, at_least: bool = False) -> in
     for stiffness in (beams.EIy, beams.EIz):
         lam = beams.L * (beams.rhoA * omega ** 2 / stiffness) ** 0.25
         lam = lam[lam >= SERIES_BELOW]            # none below 4.73
-        delta = _scaled(lam)[:, 0]                # (1 − cos λ cosh λ) / cosh λ
+        decay = np.exp(-2 * lam)
+        delta = 2 * np.sqrt(decay) / (1 + decay) - np.cos(lam)   # (1 − cos λ cosh λ) / cosh λ
         undecided = np.abs(delta) < POLE
         if np.any(undecided) and not at_least:
             return None
@@ -133,12 +139,14 @@ def _rod(d, dofs, stiffness, inertia, length, omega, deformable):
     kl = k * length
     small = kl < 1e-8                             # the static limit, and massless rods
     safe = np.where(small, 1.0, kl)
-    scale = np.where(small, stiffness / length, stiffness * k / np.where(small, 1.0, np.sin(safe)))
+    scale = np.where(small, stiffness / length, stiffness * k / np.sin(safe))
     diagonal = np.where(small, 1.0 - kl ** 2 / 3, np.cos(safe))
     off = np.where(small, -1.0 - kl ** 2 / 6, -1.0)
-    block = scale[:, None, None] * np.stack([np.stack([diagonal, off], -1), np.stack([off, diagonal], -1)], -2)
-    rigid = -omega ** 2 * (inertia * length)[:, None, None] / 6 * np.array([[2.0, 1.0], [1.0, 2.0]])
-    d[:, dofs[:, None], dofs] = np.where(deformable[:, None, None], block, rigid)
+    rigid = -omega ** 2 * inertia * length / 6    # consistent mass: 2 on the diagonal, 1 off it
+    diagonal = np.where(deformable, scale * diagonal, 2 * rigid)
+    off = np.where(deformable, scale * off, rigid)
+    d[:, dofs[0], dofs[0]] = d[:, dofs[1], dofs[1]] = diagonal
+    d[:, dofs[0], dofs[1]] = d[:, dofs[1], dofs[0]] = off
 
 
 def _bending(stiffness, inertia, length, omega):
@@ -155,12 +163,9 @@ def _bending(stiffness, inertia, length, omega):
     b1 = np.where(series, 1 / length, beta)
     b2 = np.where(series, 1 / length ** 2, beta ** 2)
     b3 = np.where(series, 1 / length ** 3, beta ** 3)
-    k11, k12, k13, k14 = f * b3 * cs_sc, f * b2 * ss, -f * b3 * s_plus, f * b2 * c_minus
-    k22, k24 = f * b1 * sc_cs, f * b1 * s_minus
-    return np.stack([np.stack([k11, k12, k13, k14], -1),
-                     np.stack([k12, k22, -k14, k24], -1),
-                     np.stack([k13, -k14, k11, -k12], -1),
-                     np.stack([k14, k24, -k12, k22], -1)], -2)
+    entries = np.stack([f * b3 * cs_sc, f * b2 * ss, f * b3 * s_plus, f * b2 * c_minus,
+                        f * b1 * sc_cs, f * b1 * s_minus], -1)
+    return entries[:, _BENDING_PATTERN] * _BENDING_SIGNS
 
 
 def _scaled(lam):
@@ -172,26 +177,28 @@ def _scaled(lam):
     return np.stack([inv_c - c, c * t + s, s * t, s * inv_c + t, 1.0 - c * inv_c, s - c * t, t - s * inv_c], -1)
 
 
+def _series_coefficients() -> np.ndarray:
+    """(SERIES_TERMS, 7): column i holds the coefficients of combination i of
+    :func:`_scaled` in powers of λ⁴, divided by the power of λ that leads it:
+    δ = −Σ_{j≥1} (−4)^j λ^{4j}/(4j)!, cS + sC = 2Σ (−4)^k λ^{4k+1}/(4k+1)!,
+    sS = 2Σ (−4)^k λ^{4k+2}/(4k+2)!, s + S = 2Σ λ^{4k+1}/(4k+1)!,
+    C − c = 2Σ λ^{4k+2}/(4k+2)!, sC − cS = 4Σ (−4)^k λ^{4k+3}/(4k+3)!,
+    S − s = 2Σ λ^{4k+3}/(4k+3)!."""
+    k = np.arange(SERIES_TERMS)
+    alternating, plain = (-4.0) ** k, np.ones(SERIES_TERMS)
+    columns = [(4, 4 * alternating), (1, 2 * alternating), (2, 2 * alternating), (1, 2 * plain),
+               (2, 2 * plain), (3, 4 * alternating), (3, 2 * plain)]
+    return np.column_stack([weights / np.array([math.factorial(4 * j + shift) for j in k], float)
+                            for shift, weights in columns])
+
+
+#: See :func:`_series_coefficients`; the compiled kernels use the same table.
+SERIES_COEFFICIENTS = _series_coefficients()
+
+
 def _series(lam):
     """(n, 7) the same combinations as :func:`_scaled`, by their power series, each
     divided by the power of λ that leads it (δ by λ⁴, cS + sC by λ, sS by λ², …),
     for λ below SERIES_BELOW. Their ratios are then the entries' coefficients in
     powers of 1/L (see :func:`_bending`)."""
-    x = lam[:, None] ** 4
-    k = np.arange(SERIES_TERMS)
-    alternating = (-4.0) ** k
-    powers = x ** k                                            # λ^(4k)
-
-    def series(shift, signs, scale=1.0):
-        # Σ_k signs_k λ^(4k+shift) / (4k+shift)!, divided by λ^shift
-        factorials = np.array([math.factorial(4 * j + shift) for j in k], float)
-        return scale * (powers * signs / factorials).sum(-1)
-
-    delta = -(-4.0) * series(4, (-4.0) ** k / 1.0)  # −Σ_{j≥1} (−4)^j λ^{4j}/(4j)!, divided by λ⁴
-    return np.stack([delta,
-                     series(1, alternating, 2.0),             # cS + sC, by λ
-                     series(2, alternating, 2.0),             # sS, by λ²
-                     series(1, 1.0, 2.0),                     # s + S, by λ
-                     series(2, 1.0, 2.0),                     # C − c, by λ²
-                     series(3, alternating, 4.0),             # sC − cS, by λ³
-                     series(3, 1.0, 2.0)], -1)                # S − s, by λ³
+    return (lam[:, None] ** 4) ** np.arange(SERIES_TERMS) @ SERIES_COEFFICIENTS

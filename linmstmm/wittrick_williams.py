@@ -181,6 +181,8 @@ def _block_inertia(factor: np.ndarray, pivots: np.ndarray, singular: float) -> i
     None where a 1 × 1 pivot or a 2 × 2 block's eigenvalue is below ``singular``."""
     negatives, k, n = 0, 0, len(pivots)
     diagonal = factor.diagonal()
+    if np.all(pivots > 0):  # 1 × 1 pivots only (the common case), at once
+        return None if np.min(np.abs(diagonal)) < singular else int(np.sum(diagonal < 0))
     while k < n:
         if pivots[k] > 0:
             if abs(diagonal[k]) < singular:

@@ -24,7 +24,7 @@ STAGES = (
     (predicted, "secant_roots", "polish (secant)"),
     (roots.RootFinder, "polish", "polish (pencil)"),
     (roots.RootFinder, "segment", "segment search"),
-    (solve, "ModeCounter", "Wittrick–Williams counter (build)"),
+    (solve, "mode_counter", "Wittrick–Williams counter (build)"),
     (roots.RootFinder, "other_zeros", "certify (counts)"),
     (solve, "_refined_in_mpmath", "mpmath refinement"),
 )

@@ -20,7 +20,7 @@ from linmstmm.stages import report
 from linmstmm.roots import CERTIFIED_STEP, RootFinder, RootSearchResult
 from linmstmm.threads import single_blas_thread
 from linmstmm.topology import build_topology
-from linmstmm.wittrick_williams import ModeCounter
+from linmstmm.wittrick_williams import mode_counter
 
 
 #: Digits float64 delivers; more are computed in mpmath.
@@ -120,7 +120,8 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     det Ū_all (:meth:`~linmstmm.roots.RootFinder.divide_out_rigid_body_zeros`),
     so every caller's counts see the elastic roots only. Its closing counts are
     Wittrick–Williams counts where they can decide
-    (:class:`~linmstmm.wittrick_williams.ModeCounter`, by the same engine). Its frequency scale (floor,
+    (:class:`~linmstmm.wittrick_williams.ModeCounter`, by the same engine, for
+    models small enough: :func:`~linmstmm.wittrick_williams.mode_counter`). Its frequency scale (floor,
     ceiling, scan chunks) is the lowest of the model's
     :func:`~linmstmm.nullspace.characteristic_frequencies`, so that no decision
     depends on the units the model is written in.
@@ -134,7 +135,7 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
                         predictor=lambda n: predict_frequencies(model, n),
                         scale=min(characteristic_frequencies(deduction.topology)), **options)
     finder.determinant = evaluator
-    finder.counter = ModeCounter(model, engine)
+    finder.counter = mode_counter(model, engine)
     finder.divide_out_rigid_body_zeros(finder.rigid_body_modes())
     return deduction, finder, released
 

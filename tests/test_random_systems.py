@@ -368,7 +368,7 @@ def test_a_range_the_search_could_not_finish_says_where_it_stopped(monkeypatch):
     highest root (it said nothing, as if the range had been searched to its end)."""
     from linmstmm import solve
 
-    monkeypatch.setattr(solve, "ModeCounter", lambda model, engine: None)
+    monkeypatch.setattr(solve, "mode_counter", lambda model, engine: None)
     result = natural_frequencies(model("ring", 5), count=None, fmax=2e7)
     np.testing.assert_allclose(result.frequencies_hz, fe_frequencies(model("ring", 5), count=80).frequencies_hz,
                                rtol=1e-9)
@@ -403,7 +403,7 @@ def test_scan_says_where_its_search_stopped(tmp_path, capsys, monkeypatch):
     from linmstmm import solve
     from linmstmm.cli import main
 
-    monkeypatch.setattr(solve, "ModeCounter", lambda model, engine: None)
+    monkeypatch.setattr(solve, "mode_counter", lambda model, engine: None)
     path = tmp_path / "ring5.toml"
     path.write_text(to_toml(model("ring", 5)))
     assert main(["scan", str(path), "--fmax", "2e7", "--points", "50", "--plot", str(tmp_path / "s.png"),

@@ -16,13 +16,13 @@ import pytest
 import scipy.linalg as la
 from scipy.optimize import brentq
 
-from builders import fixed, single_beam_model
+from builders import fixed, make_rigid, make_spring, single_beam_model
 from linmstmm import _stiffness_kernels as kernels
 from linmstmm.dynamic_stiffness import BeamTable, clamped_counts, dynamic_stiffness
 from linmstmm.fe import assemble, fe_frequencies
 from linmstmm.fe.elements import beam_element
-from linmstmm.model import load_model
-from linmstmm.wittrick_williams import ModeCounter, _block_inertia
+from linmstmm.model import Model, load_model
+from linmstmm.wittrick_williams import MAX_ORDER, ModeCounter, _block_inertia, mode_counter
 from random_models import KINDS, random_model
 from varied_models import in_units, varied_model
 
@@ -181,3 +181,20 @@ def test_clamped_pivots_leave_the_count_undecided():
         counter = ModeCounter(model, engine)
         assert counter(omega) is None
         assert counter(omega * (1 + 1e-6)) == 2           # both planes' first clamped-clamped mode
+
+
+def test_a_model_too_long_for_a_dense_count_gets_no_counter():
+    """A chain of 60 bodies (360 unknowns) is counted by the argument principle: the
+    dense factorisation grows as n³ and is made twice per root (a 1,000-body chain
+    took 12.8 s instead of 0.13 s); the launcher (72 unknowns) gets one."""
+    points = {"ground": np.zeros(3)}
+    for i in range(60):  # body i from x = i to i + 1, joined to the next by a spring
+        points[f"a{i}"], points[f"b{i}"] = np.array([i, 0.0, 0.0]), np.array([i + 1.0, 0.0, 0.0])
+    bodies = tuple(make_rigid(f"m{i}", [f"a{i}", f"b{i}"], 1.0, [i + 0.5, 0.0, 0.0], (0.1, 0.1, 0.1))
+                   for i in range(60))
+    springs = tuple(make_spring(f"k{i}", "ground" if i == 0 else f"b{i - 1}", f"a{i}", [1e4] * 6)
+                    for i in range(60))
+    chain = Model("chain", points, rigids=bodies, springs=springs, boundary={"ground": fixed()})
+    assert mode_counter(chain) is None
+    launcher = mode_counter(load_model("models/mlrs/mlrs.toml"))
+    assert launcher is not None and launcher.n_dof <= MAX_ORDER

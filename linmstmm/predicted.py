@@ -112,7 +112,8 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
 
         scaling = diags(scale)
         lam = eigsh((scaling @ fe.K @ scaling).tocsc(), k=wanted + 1, M=(scaling @ fe.M @ scaling).tocsc(),
-                    sigma=-shift, which="LM", return_eigenvectors=False)
+                    sigma=-shift, which="LM", return_eigenvectors=False,
+                    v0=np.random.default_rng(0).standard_normal(fe.n_dof))  # the same start every run
         lam = np.sort(lam)[fe.rigid_modes.shape[1]:]
         return np.sqrt(np.maximum(lam[:count], 0.0))
     try:  # Cholesky of M: every unknown carries mass

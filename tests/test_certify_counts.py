@@ -68,3 +68,14 @@ def test_no_counter_means_no_answer_from_counts():
     finder.counter = None
     assert certify.stiffness_other_zeros(finder, [10.0], None, 35.0) is None
     assert certify.counted_multiplicities(finder, [10.0], None, 35.0) == [10.0]
+
+
+def test_a_certified_last_step_does_not_widen_the_count():
+    """A root float64 calls certified (last step 7.3e-10, below 1e-9) but 2.5e-9 off, as the
+    second launcher's at 4.90 krad/s was: the count across ±1e-9 still judges it, and its
+    last step becomes the width that holds it (1e-8), so it is refined in mpmath."""
+    finder = KnownSpectrum([10.0, 20.0, 30.0])
+    off = 20.0 * (1 + 2.5e-9)
+    finder.last_step = {off: 7.3e-10}
+    assert certify.stiffness_other_zeros(finder, [10.0, off, 30.0], None, 35.0) == 0
+    assert finder.last_step[off] == pytest.approx(1e-8)

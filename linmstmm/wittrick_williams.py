@@ -43,8 +43,8 @@ from linmstmm.model import Model
 MAX_ORDER = 150
 
 #: A pivot of the equilibrated D(ω) below this, relative to the largest term that
-#: entered it, is rounding:
-#: ω is at a natural frequency to float64's eyes, and the count is left undecided.
+#: entered it, is rounding: ω is at a natural frequency to float64's eyes, and the
+#: count is left undecided.
 SINGULAR_PIVOT = 1e-11
 
 
@@ -91,6 +91,7 @@ class ModeCounter:
         self._scatter = (self._columns[:, :, None] * (n + 1) + self._columns[:, None, :]).ravel()
         self._buffers = np.empty((2, n + 1, n + 1))
         self._answers: dict[float, int | None] = {}
+        self._table = None  # the beams as the compiled kernels take them, on their first call
 
     def __call__(self, omega: float) -> int | None:
         omega = float(omega)
@@ -113,7 +114,7 @@ class ModeCounter:
         """:meth:`__call__` with J₀ and D(ω) assembled by the compiled kernel."""
         from linmstmm import _stiffness_kernels as kernels
 
-        if not hasattr(self, "_table"):
+        if self._table is None:
             self._table = kernels.beam_columns(self._beams)
         matrix, magnitude = self._buffers
         clamped = kernels.assembled(omega, self._table, self._maps, self._columns, self._static, self._mass,

@@ -121,8 +121,7 @@ def clamped_counts(beams: BeamTable, omega: float, at_least: bool = False) -> in
     for stiffness in (beams.EIy, beams.EIz):
         lam = beams.L * (beams.rhoA * omega ** 2 / stiffness) ** 0.25
         lam = lam[lam >= SERIES_BELOW]            # none below 4.73
-        decay = np.exp(-2 * lam)
-        delta = 2 * np.sqrt(decay) / (1 + decay) - np.cos(lam)   # (1 − cos λ cosh λ) / cosh λ
+        delta = _hyperbolic(lam)[0] - np.cos(lam)   # (1 − cos λ cosh λ) / cosh λ
         undecided = np.abs(delta) < POLE
         if np.any(undecided) and not at_least:
             return None
@@ -168,12 +167,17 @@ def _bending(stiffness, inertia, length, omega):
     return entries[:, _BENDING_PATTERN] * _BENDING_SIGNS
 
 
+def _hyperbolic(lam):
+    """(1 / cosh λ, tanh λ) from e^(−2λ): no overflow at any λ ≥ 0."""
+    decay = np.exp(-2 * lam)
+    return 2 * np.sqrt(decay) / (1 + decay), (1 - decay) / (1 + decay)
+
+
 def _scaled(lam):
     """(n, 7) the combinations δ, cS + sC, sS, s + S, C − c, sC − cS, S − s, each
     divided by cosh λ (stable at any λ ≥ 0)."""
     c, s = np.cos(lam), np.sin(lam)
-    decay = np.exp(-2 * lam)
-    inv_c, t = 2 * np.sqrt(decay) / (1 + decay), (1 - decay) / (1 + decay)
+    inv_c, t = _hyperbolic(lam)
     return np.stack([inv_c - c, c * t + s, s * t, s * inv_c + t, 1.0 - c * inv_c, s - c * t, t - s * inv_c], -1)
 
 

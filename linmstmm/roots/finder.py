@@ -289,7 +289,7 @@ class RootFinder:
     _next_top = staticmethod(segments.next_top)
     _search = segments.search
 
-    # certification by argument-principle counts (:mod:`linmstmm.roots.certify`)
+    # certification by counts: Wittrick–Williams, else the argument principle (:mod:`linmstmm.roots.certify`)
     _confirmed = certify.confirmed
     _settled = certify.settled
     _count_top = certify.count_top

@@ -288,17 +288,15 @@ def _secant_polished(finder, predictions: np.ndarray, start: int, stop: int,
     stands where it stayed within half the gap to the neighbouring prediction,
     alone on its root, and converged to xtol for a cluster member (a multiple
     root's det keeps its sign: the secant creeps to the rounding floor there), to
-    CERTIFIED_STEP for the others (a secant that stalled above it on a noisy det,
-    1.3e-9 on a ring's 10th root, goes to the pencil).
+    the finder's rtol for the others (a secant that stalled above it on a noisy det,
+    1.3e-9 on a ring's 10th root with the default rtol, goes to the pencil).
     """
-    from linmstmm.roots.settings import CERTIFIED_STEP  # the root search imports this module
-
     found, steps = secant_roots(finder.log_det, predictions[start:stop], finder.xtol, finder.UNCERTAIN)
     in_cluster = np.zeros(predictions.size, dtype=bool)
     for group in _clusters(predictions):
         in_cluster[group] = len(group) > 1
     settled = np.array([not np.isnan(root) and abs(root - predictions[i]) <= 0.5 * _gap(predictions, i)
-                        and steps[i - start] <= (finder.xtol if in_cluster[i] else CERTIFIED_STEP)
+                        and steps[i - start] <= (finder.xtol if in_cluster[i] else finder.rtol)
                         and not _known(root, known, finder.SAME_ROOT)
                         for i, root in enumerate(found, start)], dtype=bool)
     for i in np.flatnonzero(settled):  # two that settled on one root: neither stands

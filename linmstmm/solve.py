@@ -17,7 +17,7 @@ from linmstmm.determinant import determinant
 from linmstmm.results import Result, decode_array
 from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.stages import report
-from linmstmm.roots import CERTIFIED_STEP, RootFinder, RootSearchResult
+from linmstmm.roots import MAX_XTOL, RootFinder, RootSearchResult
 from linmstmm.threads import single_blas_thread
 from linmstmm.topology import build_topology
 from linmstmm.wittrick_williams import mode_counter
@@ -27,6 +27,10 @@ from linmstmm.wittrick_williams import mode_counter
 FLOAT64_DIGITS = 14
 #: Digits used when an uncertified root is escalated to mpmath.
 ESCALATION_DIGITS = 20
+#: With ``rtol``, the secant and Newton polish stop at steps this fraction of it
+#: (within float64's reach, and no looser than MAX_XTOL): a superlinear step that
+#: small leaves an error far below rtol, which the count across the root confirms.
+XTOL_PER_RTOL = 1e-2
 
 
 @dataclass(frozen=True)
@@ -182,7 +186,8 @@ class RootSolution:
 
 
 def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None, *, digits: int | None = None,
-                root: str | None = None, guess_hz=None, engine: str = "auto") -> RootSolution:
+                root: str | None = None, guess_hz=None, engine: str = "auto",
+                rtol: float | None = None) -> RootSolution:
     """The elastic roots of det Ū_all of ``model``: the one pipeline of frequencies and modes.
 
     Builds the deduction and its root finder (:func:`frequency_finder`), finds
@@ -207,6 +212,8 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
         Frequencies of a similar model to start from (with ``count`` only).
     engine : str
         How det Ū_all is evaluated: "numpy", "compiled" or "auto".
+    rtol : float or None
+        Relative accuracy every root is certified to (:func:`natural_frequencies`).
 
     Returns
     -------
@@ -221,7 +228,8 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
     if fmax is not None and count is None:
         check_range_request(model, fmax)
     report("deducing Ubar_all")
-    deduction, finder, released = frequency_finder(model, root, engine=engine)
+    accuracy = {} if rtol is None else {"rtol": rtol, "xtol": min(max(XTOL_PER_RTOL * rtol, 1e-14), MAX_XTOL)}
+    deduction, finder, released = frequency_finder(model, root, engine=engine, **accuracy)
     report("finding roots")
     omega_max = None if fmax is None else 2 * np.pi * fmax
     if guess_hz is not None and count is not None and fmax is None:
@@ -230,7 +238,7 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
         search = finder.find(count, omega_max)
     omegas, unseparated = search.roots, dict(search.unseparated)
     # (a root no Newton step reached has a NaN step: it is in unseparated)
-    uncertain = sorted({w for w, step in search.last_steps.items() if step > CERTIFIED_STEP} - set(unseparated))
+    uncertain = sorted({w for w, step in search.last_steps.items() if step > finder.rtol} - set(unseparated))
     every = bool(digits and digits > FLOAT64_DIGITS)
     wanted = digits if every else (ESCALATION_DIGITS if uncertain or unseparated else None)
     if not wanted:
@@ -248,7 +256,7 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
 @single_blas_thread
 def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None = None,
                         digits: int | None = None, root: str | None = None,
-                        guess_hz=None, engine: str = "auto") -> FrequencyResult:
+                        guess_hz=None, engine: str = "auto", rtol: float | None = None) -> FrequencyResult:
     """Elastic natural frequencies of ``model`` by the transfer matrix method.
 
     Parameters
@@ -287,8 +295,11 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         more modes than a range is searched for
         (:func:`~linmstmm.mode_bound.check_range_request`).
     """
+    if rtol is not None and digits is not None:
+        raise ValueError("give rtol or digits, not both: digits asks for mpmath's precision, rtol for float64's")
     start = time.perf_counter()
-    solution = solve_roots(model, count, fmax, digits=digits, root=root, guess_hz=guess_hz, engine=engine)
+    solution = solve_roots(model, count, fmax, digits=digits, root=root, guess_hz=guess_hz, engine=engine,
+                           rtol=rtol)
     search, omegas = solution.search, solution.omegas
     note = search_note(search, omegas.size, solution.unseparated, count, fmax)
     return FrequencyResult(model.name, omegas / (2 * np.pi), search.rigid_body_modes,

@@ -7,14 +7,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from linmstmm.roots import certify
+from linmstmm.roots import CERTIFIED_STEP, certify
 
 
 class KnownSpectrum:
-    """A finder whose counter answers J(ω) exactly for the frequencies ``true`` (rad/s)."""
+    """A finder whose counter answers J(ω) exactly for the frequencies ``true`` (rad/s),
+    certifying roots to ``rtol``."""
 
-    def __init__(self, true, rigid=0):
-        self.true, self.rigid, self.last_step = np.sort(true), rigid, {}
+    def __init__(self, true, rigid=0, rtol=CERTIFIED_STEP):
+        self.true, self.rigid, self.last_step, self.rtol = np.sort(true), rigid, {}, rtol
 
     def counter(self, omega):
         return self.rigid + int(np.sum(self.true < omega))
@@ -26,6 +27,19 @@ class KnownSpectrum:
 def test_complete_roots_with_their_multiplicities_are_certified():
     finder = KnownSpectrum([10.0, 20.0, 20.0, 30.0], rigid=6)
     assert certify.stiffness_other_zeros(finder, [10.0, 20.0, 20.0, 30.0], None, 35.0) == 0
+
+
+def test_a_root_is_certified_to_the_finders_rtol_and_no_closer():
+    """A root 5e-7 (relative) off its true value: at rtol 1e-5 the count across it
+    (±1e-5) holds the true one and it stands as certified; at the default rtol the
+    counts at ±1e-9 … 1e-7 hold nothing and only ±1e-6 holds it, so that width
+    becomes its last step (the caller refines it in mpmath)."""
+    true, off = [10.0, 20.0, 30.0], 20.0 * (1 + 5e-7)
+    loose, default = KnownSpectrum(true, rtol=1e-5), KnownSpectrum(true)
+    for finder in (loose, default):
+        assert certify.stiffness_other_zeros(finder, [10.0, off, 30.0], None, 35.0) == 0
+    assert off not in loose.last_step
+    assert default.last_step[off] == 1e-6
 
 
 def test_a_missing_member_of_a_double_root_is_seen_and_added():

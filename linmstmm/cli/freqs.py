@@ -5,6 +5,7 @@ With ``--damped``, the damped natural frequencies and damping ratios
 """
 from __future__ import annotations
 
+import argparse
 import math
 
 from linmstmm import load_model, natural_frequencies
@@ -14,10 +15,12 @@ from linmstmm.cli.common import (
     add_request_options,
     as_options,
     emit,
+    positive_float,
     positive_int,
     request,
     stages,
 )
+from linmstmm.roots import MAX_RTOL, MIN_RTOL
 
 
 def add_freqs_command(subparsers) -> None:
@@ -25,8 +28,12 @@ def add_freqs_command(subparsers) -> None:
     freqs = subparsers.add_parser("freqs", help="natural frequencies by the transfer matrix method")
     add_request_options(freqs)
     add_output_options(freqs, csv_layout="one row per frequency")
-    freqs.add_argument("--digits", type=positive_int, default=None,
-                       help="significant digits wanted (above 14 the mpmath path is used)")
+    accuracy = freqs.add_mutually_exclusive_group()
+    accuracy.add_argument("--digits", type=positive_int, default=None,
+                          help="significant digits wanted (above 14 the mpmath path is used)")
+    accuracy.add_argument("--rtol", type=certified_rtol, default=None, metavar="R",
+                          help=f"relative accuracy each frequency is certified to, {MIN_RTOL:g} to {MAX_RTOL:g} "
+                               "(default: polished to rounding, certified to 1e-9)")
     freqs.add_argument("--root", default=None, help="boundary point to use as the root")
     freqs.add_argument("--engine", choices=("auto", "numpy", "compiled"), default="auto",
                        help="how det Ū_all is evaluated: the numpy carry, or numba-compiled kernels "
@@ -34,6 +41,18 @@ def add_freqs_command(subparsers) -> None:
                             "auto: numpy in a new process")
     add_damped_option(freqs)
     freqs.set_defaults(run=run_freqs)
+
+
+def certified_rtol(text: str) -> float:
+    """``--rtol`` text as a relative accuracy in [MIN_RTOL, MAX_RTOL] (argparse type)."""
+    value = positive_float(text)
+    if value > MAX_RTOL:
+        raise argparse.ArgumentTypeError(f"must be at most {MAX_RTOL:g} (roots closer than that "
+                                         f"are reported as one multiple root), got {text}")
+    if value < MIN_RTOL:
+        raise argparse.ArgumentTypeError(f"must be at least {MIN_RTOL:g} (float64's rounding; "
+                                         f"--digits asks for more), got {text}")
+    return value
 
 
 def run_freqs(args) -> int:
@@ -44,7 +63,7 @@ def run_freqs(args) -> int:
     count, fmax = request(args)
     with as_options(model, "root"), stages(args, "freqs"):
         result = natural_frequencies(model, count=count, fmax=fmax, digits=args.digits, root=args.root,
-                                     engine=args.engine)
+                                     engine=args.engine, rtol=args.rtol)
     data = result.to_dict()
     emit(args, model, data, lambda d: print_frequency_table(f"{model.name}: natural frequencies (MSTMM)", d),
          lambda: frequency_csv(data))

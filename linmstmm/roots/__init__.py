@@ -67,7 +67,9 @@ from linmstmm.roots.settings import (
                                      FLOOR_CHECK,
                                      FLOOR_MARGIN,
                                      FLOOR_RATIO,
+                                     MAX_RTOL,
                                      MAX_XTOL,
+                                     MIN_RTOL,
                                      MIN_POINTS_PER_OCTAVE,
                                      POINTS_PER_OCTAVE,
                                      PREDICTION_MARGIN,
@@ -76,5 +78,5 @@ from linmstmm.roots.settings import (
 
 __all__ = ["RootFinder", "RootSearchResult", "CEILING_RATIO", "CERTIFIED_STEP", "CIRCLE_MAX_POINTS", "CIRCLE_POINTS",
            "DEFAULT_SCALE", "DEFLATED_MAX_POINTS", "DEFLATED_POINTS", "FINE_SCAN_RATIO", "FIRST_CHUNK_RATIO",
-           "FIRST_SEGMENT_RATIO", "FLOOR_CHECK", "FLOOR_MARGIN", "FLOOR_RATIO", "MAX_XTOL", "MIN_POINTS_PER_OCTAVE",
+           "FIRST_SEGMENT_RATIO", "FLOOR_CHECK", "FLOOR_MARGIN", "FLOOR_RATIO", "MAX_RTOL", "MAX_XTOL", "MIN_RTOL", "MIN_POINTS_PER_OCTAVE",
            "POINTS_PER_OCTAVE", "PREDICTION_MARGIN", "SCAN_OCTAVES"]

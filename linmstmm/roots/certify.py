@@ -7,12 +7,13 @@ from __future__ import annotations
 import numpy as np
 
 from linmstmm.counting import count_zeros, count_zeros_many, deflated
-from linmstmm.roots.settings import CERTIFIED_STEP, DEFLATED_MAX_POINTS, DEFLATED_POINTS
+from linmstmm.roots.settings import DEFLATED_MAX_POINTS, DEFLATED_POINTS
 
 #: Relative half-widths, narrowest first, of the counts that give a root's
 #: multiplicity (:func:`counted_multiplicities`): the narrowest is float64's own
 #: certification of a root (CERTIFIED_STEP); wider ones where the count there
-#: cannot decide, at the price of a refinement in mpmath.
+#: cannot decide, at the price of a refinement in mpmath. A finder certifying to a
+#: looser rtol starts at its rtol (:func:`near_widths`).
 NEAR_WIDTHS = (1e-9, 1e-8, 1e-7, 1e-6)
 
 
@@ -221,7 +222,7 @@ def counted_multiplicities(finder, roots: list[float], lo: float | None, hi: flo
     within a relative NEAR_WIDTHS of it (:func:`_count_near`): a member of a
     multiple root the pencil did not see is added, a value that is no root
     dropped. Roots where the count cannot decide stay as they are; so do all
-    without a counter. A member added at a width above CERTIFIED_STEP is known
+    without a counter. A member added at a width above the finder's rtol is known
     only that closely: the width becomes the root's last step
     (:attr:`RootFinder.last_step`), and the caller refines it in mpmath."""
     if finder.counter is None:
@@ -234,7 +235,7 @@ def counted_multiplicities(finder, roots: list[float], lo: float | None, hi: flo
             if near is not None:
                 # the count sees close neighbours too: this root holds what they leave
                 counted_here = near[0] - (_known_within(roots, root, near[1]) - have)
-                if counted_here > have and near[1] > CERTIFIED_STEP:
+                if counted_here > have and near[1] > finder.rtol:
                     finder.last_step[root] = max(finder.last_step.get(root, 0.0), near[1])
                 have = max(counted_here, 0)
         counted += [root] * have
@@ -250,13 +251,21 @@ def _count_near(finder, root: float) -> tuple[int, float] | None:
 
 def _counts_near(finder, root: float):
     """(natural frequencies within ±width of ``root`` or None where the count cannot
-    decide, width) for each of NEAR_WIDTHS, narrowest first; for a root float64
-    could not certify (last step above CERTIFIED_STEP, :attr:`RootFinder.last_step`:
+    decide, width) for each of :func:`near_widths`, narrowest first; for a root float64
+    could not certify (last step above the finder's rtol, :attr:`RootFinder.last_step`:
     it is refined in mpmath later), none narrower than four times that step, so it
     is counted where it may lie. A certified root is held to the narrowest (the
     second launcher's root at 4.90 krad/s, last step 7.3e-10, was 2.5e-9 off)."""
     step = finder.last_step.get(root, 0.0)
-    least = 4 * step if step > CERTIFIED_STEP else 0.0   # a certified root is held to NEAR_WIDTHS[0]
-    for width in [w for w in NEAR_WIDTHS if w >= least] or [least]:
+    least = 4 * step if step > finder.rtol else 0.0   # a certified root is held to the narrowest
+    for width in [w for w in near_widths(finder.rtol) if w >= least] or [least]:
         below, above = finder.counter(root * (1 - width)), finder.counter(root * (1 + width))
         yield (None if below is None or above is None else above - below), width
+
+
+def near_widths(rtol: float) -> list[float]:
+    """Relative half-widths of the counts across a root of a finder certifying to
+    ``rtol``, narrowest first: NEAR_WIDTHS from ``rtol`` up (``rtol`` itself where it
+    is looser than the narrowest, alone where it is looser than all)."""
+    narrowest = max(rtol, NEAR_WIDTHS[0])
+    return [narrowest] + [width for width in NEAR_WIDTHS if width > narrowest]

@@ -15,8 +15,11 @@ from linmstmm.roots.settings import (
     CEILING_RATIO,
     DEFAULT_SCALE,
     FLOOR_RATIO,
+    CERTIFIED_STEP,
+    MAX_RTOL,
     MAX_XTOL,
     MIN_POINTS_PER_OCTAVE,
+    MIN_RTOL,
     POINTS_PER_OCTAVE,
     PREDICTION_MARGIN,
 )
@@ -39,6 +42,10 @@ class RootFinder:
     (e.g. :func:`linmstmm.predicted.predict_frequencies` of the model), or None.
     scale : rad/s, the model's own frequency scale; the floor, ceiling and scan
     chunks are multiples of it (see DEFAULT_SCALE).
+    rtol : relative accuracy a root is certified to, in [MIN_RTOL, MAX_RTOL]: a root
+    whose last step exceeds it is uncertified (the caller refines it in mpmath),
+    and the Wittrick–Williams count across each root is made no narrower than it
+    (:func:`~linmstmm.roots.certify.near_widths`).
 
     Candidates come from the scan; each is polished by local linearisation
     (Newton for the nonlinear eigenproblem Ū(ω) v = 0): with A = Ū(ω) and
@@ -88,7 +95,8 @@ class RootFinder:
 
     def __init__(self, log_det, matrix, xtol: float = 1e-14,
                  points_per_octave: int = POINTS_PER_OCTAVE, points_per_root: int = 6,
-                 rigid_body_modes: int = 0, predictor=None, scale: float = DEFAULT_SCALE):
+                 rigid_body_modes: int = 0, predictor=None, scale: float = DEFAULT_SCALE,
+                 rtol: float = CERTIFIED_STEP):
         if not 0 < xtol <= MAX_XTOL:
             raise ValueError(f"xtol must be in (0, {MAX_XTOL:g}], got {xtol:g}: looser Newton "
                              "tolerances blur distinct roots into one")
@@ -96,6 +104,9 @@ class RootFinder:
             raise ValueError(f"points_per_octave must be at least {MIN_POINTS_PER_OCTAVE}, got "
                              f"{points_per_octave:g}: a coarser scan is slower, not faster (the roots "
                              "it misses cost more to recover than it saves; reports/speed_accuracy.md)")
+        if not MIN_RTOL <= rtol <= MAX_RTOL:
+            raise ValueError(f"rtol must be in [{MIN_RTOL:g}, {MAX_RTOL:g}], got {rtol:g}: roots closer than "
+                             f"{self.SPLIT:g} are one multiple root, and digits asks for more than float64's")
         if not (np.isfinite(scale) and scale > 0):
             raise ValueError(f"scale must be a positive frequency (rad/s), got {scale!r}")
         self.log_det = log_det
@@ -104,6 +115,8 @@ class RootFinder:
         #: search for ``count`` roots gives up
         self.scale, self.floor, self.ceiling = scale, FLOOR_RATIO * scale, CEILING_RATIO * scale
         self.xtol = xtol
+        #: relative accuracy each root is certified to (see the class docstring)
+        self.rtol = rtol
         self.points_per_octave = points_per_octave
         self.points_per_root = points_per_root
         #: root -> relative size of the last Newton step that reached it

@@ -8,7 +8,6 @@ import numpy as np
 import scipy.linalg
 
 from linmstmm.nullspace import equilibration
-from linmstmm.roots.settings import CERTIFIED_STEP
 
 
 def pencil(finder, omegas, step: float = 1e-7):
@@ -108,12 +107,12 @@ def polish(finder, starts, iterations: int = 40, early: bool = False):
 
 def checked(finder, results):
     """``polish`` results less the roots accepted at the rounding floor (a last step
-    above CERTIFIED_STEP) that det itself does not bear out: no sign change and no
+    above the finder's rtol) that det itself does not bear out: no sign change and no
     dip of log|det| between ω(1 ± 10·step). Where the pencil of Ū_all is not smooth,
     Newton can settle beside a root (random loops 122: 975.90 and 977.07 Hz for one
     root at 976.97, and the count bisection then gave up)."""
     doubtful = [i for i, (root, _) in enumerate(results)
-                if root is not None and finder.last_step.get(root, 0.0) > CERTIFIED_STEP]
+                if root is not None and finder.last_step.get(root, 0.0) > finder.rtol]
     if not doubtful:
         return results
     roots = np.array([results[i][0] for i in doubtful])

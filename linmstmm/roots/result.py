@@ -31,8 +31,8 @@ class RootSearchResult:
     last_steps : Mapping[float, float]
         Each distinct root (rad/s) -> the relative size |Δω|/ω of the last
         Newton step that reached it (of a narrowed bracket: its relative
-        width); above :data:`~linmstmm.roots.CERTIFIED_STEP` the root is
-        uncertified in float64. NaN for a root no step reached, placed by a
+        width); above the finder's ``rtol`` (by default
+        :data:`~linmstmm.roots.CERTIFIED_STEP`) the root is uncertified in float64. NaN for a root no step reached, placed by a
         count alone (it is in ``unseparated``).
     unseparated : Mapping[float, tuple[int, float]]
         Each root (rad/s) of ``roots`` that stands for several float64 could

@@ -19,6 +19,13 @@ MIN_POINTS_PER_OCTAVE = POINTS_PER_OCTAVE
 #: relative, is uncertified: checked on det itself (:meth:`RootFinder._checked`), and
 #: refined in mpmath by ``natural_frequencies``.
 CERTIFIED_STEP = 1e-9
+#: Loosest accuracy (relative) a root may be certified to (RootFinder's ``rtol``):
+#: roots are told apart down to RootFinder.SPLIT = 1e-4.
+MAX_RTOL = 1e-4
+#: Tightest: a hundred times float64's rounding floor of a root (the launcher's first
+#: 20 are 6e-15 off at any setting). Roots float64 cannot bring within rtol are
+#: refined in mpmath at 20 digits; tighter requests are ``digits``'.
+MIN_RTOL = 1e-12
 #: Loosest Newton tolerance (relative) RootFinder accepts: roots are told apart
 #: down to SPLIT = 1e-4, so the polishing must be much tighter than that.
 MAX_XTOL = 1e-6

@@ -1,0 +1,69 @@
+"""``rtol``: the accuracy a frequency request is certified to, against references
+independent of the transfer matrices (the cantilever's closed-form frequency
+equation, the FE route on the launcher), and the requests it refuses."""
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import mpmath as mp
+import numpy as np
+import pytest
+from builders import fixed, single_beam_model
+
+from linmstmm import load_model, natural_frequencies
+from linmstmm.fe import fe_frequencies
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def cantilever_bending_hz(beam, count):
+    """The lowest ``count`` bending frequencies (Hz) of a cantilever in its Iz plane:
+    roots λ of cos λ cosh λ + 1 = 0 (Blevins, table 8-1) at 30 digits."""
+    with mp.workdps(30):
+        lambdas = [mp.findroot(lambda x: mp.cos(x) * mp.cosh(x) + 1, (2 * n - 1) * mp.pi / 2)
+                   for n in range(1, count + 1)]
+        return np.array([float(lam**2 * mp.sqrt(beam.E * beam.Iz / (beam.rho * beam.A * beam.length**4))
+                               / (2 * mp.pi)) for lam in lambdas])
+
+
+@pytest.fixture(scope="module")
+def cantilever():
+    """Bending in the Iz plane below 300 Hz only (the Iy plane's first mode is at 324 Hz,
+    axial and torsion rigid): the closed form is the whole spectrum there."""
+    return single_beam_model(fixed(), None, length=2.0, Iz=2e-7, Iy=2e-4, axial=False, torsion=False)
+
+
+@pytest.mark.parametrize("rtol", [1e-4, 1e-8, 1e-12])
+def test_every_frequency_lies_within_rtol_of_the_closed_form(cantilever, rtol):
+    result = natural_frequencies(cantilever, 3, rtol=rtol)
+    expected = cantilever_bending_hz(cantilever.beams[0], 3)
+    assert np.max(np.abs(result.frequencies_hz / expected - 1)) <= rtol
+
+
+def test_a_looser_rtol_takes_fewer_evaluations(cantilever):
+    loose, tight = (natural_frequencies(cantilever, 3, rtol=rtol) for rtol in (1e-4, 1e-12))
+    assert loose.evaluations < tight.evaluations
+
+
+def test_the_launcher_at_rtol_1e4_agrees_with_the_fe_route():
+    model = load_model(ROOT / "models" / "mlrs" / "mlrs.toml")
+    result = natural_frequencies(model, 10, rtol=1e-4)
+    fe = fe_frequencies(model, 10, rtol=1e-9)
+    assert np.max(np.abs(result.frequencies_hz / fe.frequencies_hz - 1)) <= 1e-4
+
+
+@pytest.mark.parametrize("options", [{"rtol": 1e-3}, {"rtol": 1e-13}, {"rtol": 0.0}, {"rtol": 1e-6, "digits": 20}])
+def test_requests_outside_the_range_or_with_digits_are_refused(cantilever, options):
+    with pytest.raises(ValueError, match="rtol"):
+        natural_frequencies(cantilever, 2, **options)
+
+
+@pytest.mark.parametrize("arguments, message", [(["--rtol", "1e-3"], "must be at most 0.0001"),
+                                                (["--rtol", "1e-13"], "must be at least 1e-12"),
+                                                (["--rtol", "1e-6", "--digits", "20"], "not allowed with")])
+def test_the_command_line_refuses_them_with_exit_status_2(arguments, message):
+    done = subprocess.run([sys.executable, "-m", "linmstmm", "freqs", "models/spring_mass_chain.toml", *arguments],
+                          cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and message in done.stderr and "Traceback" not in done.stderr

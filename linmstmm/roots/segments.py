@@ -7,6 +7,7 @@ import numpy as np
 
 from linmstmm.counting import count_zeros
 from linmstmm.roots.brackets import quiet_minima
+from linmstmm.roots.counted_search import counted_segment
 from linmstmm.roots.settings import FIRST_SEGMENT_RATIO, SCAN_OCTAVES
 
 
@@ -92,12 +93,18 @@ def isolate(finder, lo, hi, expected, found, depth=0) -> list[float]:
 def segment(finder, lo: float, hi: float, expected: int | None = None) -> list[float]:
     """Every root in (lo, hi], rad/s, ascending, repeated per multiplicity.
 
-    The argument-principle count says how many there are; a scan with at
+    By Wittrick–Williams counts where they decide
+    (:func:`~linmstmm.roots.counted_search.counted_segment`: bisection on the
+    count, each root from its sign change) and agree with ``expected``. Else the
+    argument-principle count says how many there are; a scan with at
     least ``points_per_root`` points per counted root finds them; bisection
     on the count finds any the scan missed. A segment wider than
     SCAN_OCTAVES (the first one starts at the floor) is split by a count
     first, so an empty bottom is not scanned point by point.
     """
+    counted = counted_segment(finder, lo, hi)
+    if counted is not None and (expected is None or len(counted) == expected):
+        return counted
     if expected is None:
         expected = count_zeros(finder.log_det, lo, hi)
     if expected == 0:

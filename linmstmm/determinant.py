@@ -4,7 +4,11 @@ Both engines answer the same two questions with the same numbers (to
 rounding): ``log_det(ω)`` — sign (phase, for complex ω) and log|det Ū_all| —
 and ``matrix(ω)`` — the orthonormalised Ū_all whose differences are smooth in
 ω (Newton's pencil); both count their evaluations (one per frequency), the
-cost figure the benchmarks report per root.
+cost figure the benchmarks report per root. Both also give ``plain_matrix(ω)``,
+Ū_all as the unknowns stand (no orthonormalisation, not counted), on which
+:func:`linmstmm.nullspace.release_indeterminate` reads the statically
+indeterminate unknowns; a compiled determinant serves the unknowns it was
+compiled for, so after a release it is compiled anew.
 
 * :class:`NumpyDeterminant` — :meth:`Deduction.log_det` / :meth:`Deduction.matrix`,
   vectorised over a stack of frequencies (a run of identical cells by powers of
@@ -97,6 +101,10 @@ class NumpyDeterminant:
         self.evaluations += omega.size
         return self.deduction.matrix(omega, stable=True)
 
+    def plain_matrix(self, omega) -> np.ndarray:
+        """Ū_all (n, N, N) at each of ``omega`` (n,) rad/s, not orthonormalised: :meth:`Deduction.matrix`."""
+        return self.deduction.matrix(omega)
+
 
 class CompiledDeterminant:
     """det Ū_all of one deduction, evaluated by the compiled kernels.
@@ -108,6 +116,8 @@ class CompiledDeterminant:
     """
 
     def __init__(self, deduction: Deduction):
+        self.deduction = deduction
+        self._released = deduction.released_columns  # the unknowns compiled for
         self.program = compile_program(deduction)
         p = self.program
         self._operations = (p.slot_offset, p.slot_rows, p.slot_width, p.operations, p.terms, p.places,
@@ -123,17 +133,24 @@ class CompiledDeterminant:
         """Order N of Ū_all (after any release)."""
         return self.program.kept_columns.size
 
+    def _frequencies(self, omega) -> np.ndarray:
+        """``omega`` as a contiguous float or complex array (n,), once the program is
+        known to serve the deduction's unknowns as they stand."""
+        if self.deduction.released_columns is not self._released:
+            raise RuntimeError("unknowns were released after this determinant was compiled: compile it anew")
+        omega = np.atleast_1d(np.asarray(omega))
+        return np.ascontiguousarray(omega.astype(complex if np.iscomplexobj(omega) else float))
+
     def _evaluate(self, omega, group: int | None, with_matrices: bool):
         from linmstmm import _kernels  # numba loads here, not at import
 
-        omega = np.atleast_1d(np.asarray(omega))
-        omega = omega.astype(complex if np.iscomplexobj(omega) else float)
+        omega = self._frequencies(omega)
         n, order = omega.size, self.order
         matrices = np.zeros((n if with_matrices else 0, order, order), dtype=omega.dtype)
         sign = np.zeros(n, dtype=omega.dtype)
         log_abs, log_scale = np.zeros(n), np.zeros(n)
-        _kernels.evaluate(self._operations, self._layout, np.ascontiguousarray(omega), max(group or n, 1),
-                          matrices, sign, log_abs, log_scale)
+        _kernels.evaluate(self._operations, self._layout, omega, max(group or n, 1), matrices, sign, log_abs,
+                          log_scale)
         self.evaluations += n
         return matrices, sign, log_abs, log_scale
 
@@ -152,3 +169,15 @@ class CompiledDeterminant:
         decisions, so that differences between its entries are smooth in ω."""
         matrices, _, _, log_scale = self._evaluate(omega, None, True)
         return matrices, log_scale
+
+    def plain_matrix(self, omega) -> np.ndarray:
+        """Ū_all (n, N, N) at each of ``omega`` (n,) rad/s, not orthonormalised: the columns
+        are the unknowns, as :meth:`Deduction.matrix` gives them (to rounding); not counted
+        among the evaluations. By the compiled program with every beam in one piece and
+        its orthonormalisations only laid out (:func:`linmstmm._kernels.plain_matrices`)."""
+        from linmstmm import _kernels
+
+        omega = self._frequencies(omega)
+        matrices = np.zeros((omega.size, self.order, self.order), dtype=omega.dtype)
+        _kernels.plain_matrices(self._operations, self._layout, omega, matrices)
+        return matrices

@@ -119,12 +119,18 @@ def _torsion_scales(topology, records, mass) -> list[float]:
 ROUNDING_TOLERANCE = 1e-12
 
 
-def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINATE_TOLERANCE) -> int:
+def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINATE_TOLERANCE,
+                          matrix=None) -> int:
     """Find and release statically indeterminate unknowns of ``deduction``.
 
     probe : rad/s, the generic frequencies to look at (default :data:`PROBES`
     times each of the model's :func:`characteristic_frequencies` in turn, until
     one can be read: no overflow, no null space that moves).
+    matrix : callable, frequencies (n,) rad/s → Ū_all (n, N, N) as the unknowns
+    stand (not orthonormalised: the null vectors index the unknowns); default
+    ``deduction.matrix``, the numpy carry. A compiled determinant's
+    :meth:`~linmstmm.determinant.CompiledDeterminant.plain_matrix` gives the same
+    matrix to rounding, several times cheaper.
 
     Redundant rigid constraints (a rigid direction fixed at both ends, ``inf``
     springs closing a loop) make Ū_all singular at every ω, with constant
@@ -142,14 +148,14 @@ def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINAT
         for scale in scales[:-1]:
             try:
                 with np.errstate(over="ignore", invalid="ignore"):  # an overflowing scale is the next one's turn
-                    return release_indeterminate(deduction, np.asarray(PROBES) * scale)
+                    return release_indeterminate(deduction, np.asarray(PROBES) * scale, matrix=matrix)
             except (RuntimeError, np.linalg.LinAlgError):
                 continue
         probe = np.asarray(PROBES) * scales[-1]
-    samples = deduction.matrix(np.asarray(probe, dtype=float))
+    samples = (matrix or deduction.matrix)(np.asarray(probe, dtype=float))
     rows, cols = equilibration(samples[0])
     samples = rows[:, None] * samples * cols
-    r = min(nullity(sample, tolerance) for sample in samples)
+    r = _common_nullity(samples, tolerance)
     if r == 0:
         return 0
     u, _, vt = np.linalg.svd(samples[0])
@@ -159,13 +165,27 @@ def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINAT
         if (np.abs(sample @ right_null).max() > 1e-9 * scale
                 or np.abs(left_null.T @ sample).max() > 1e-9 * scale):
             if tolerance > ROUNDING_TOLERANCE:
-                return release_indeterminate(deduction, probe, ROUNDING_TOLERANCE)
+                return release_indeterminate(deduction, probe, ROUNDING_TOLERANCE, matrix)
             raise RuntimeError("Ū_all is singular at every frequency with a null space that "
                                "moves with frequency: the model has a mechanism")
     released_columns = scipy.linalg.qr(right_null.T, pivoting=True)[2][:r]
     released_rows = scipy.linalg.qr(left_null.T, pivoting=True)[2][:r]
     deduction.release(released_columns, released_rows)
     return r
+
+
+def _common_nullity(samples: np.ndarray, tolerance: float) -> int:
+    """The least :func:`nullity` of the (n, N, N) ``samples``, their first ones first: once
+    one has none the rest are not decomposed. Unless one is not finite (an overflowing
+    probe), where each is, so that one the SVD cannot read raises as it would."""
+    if not np.all(np.isfinite(samples)):
+        return min(nullity(sample, tolerance) for sample in samples)
+    least = nullity(samples[0], tolerance)
+    for sample in samples[1:]:
+        if least == 0:
+            break
+        least = min(least, nullity(sample, tolerance))
+    return least
 
 
 def _statically_determinate(topology) -> bool:

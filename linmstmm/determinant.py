@@ -4,11 +4,12 @@ Both engines answer the same two questions with the same numbers (to
 rounding): ``log_det(ω)`` — sign (phase, for complex ω) and log|det Ū_all| —
 and ``matrix(ω)`` — the orthonormalised Ū_all whose differences are smooth in
 ω (Newton's pencil); both count their evaluations (one per frequency), the
-cost figure the benchmarks report per root. Both also give ``plain_matrix(ω)``,
-Ū_all as the unknowns stand (no orthonormalisation, not counted), on which
-:func:`linmstmm.nullspace.release_indeterminate` reads the statically
-indeterminate unknowns; a compiled determinant serves the unknowns it was
-compiled for, so after a release it is compiled anew.
+cost figure the benchmarks report per root. The compiled one also gives
+``plain_matrix(ω)``, Ū_all as the unknowns stand (no orthonormalisation, not
+counted), with which :func:`linmstmm.nullspace.release_indeterminate` screens
+its probes for statically indeterminate unknowns (``plain_matrix`` is None for
+the numpy carry, which reads them itself); a compiled determinant serves the
+unknowns it was compiled for, so after a release it is compiled anew.
 
 * :class:`NumpyDeterminant` — :meth:`Deduction.log_det` / :meth:`Deduction.matrix`,
   vectorised over a stack of frequencies (a run of identical cells by powers of
@@ -101,9 +102,8 @@ class NumpyDeterminant:
         self.evaluations += omega.size
         return self.deduction.matrix(omega, stable=True)
 
-    def plain_matrix(self, omega) -> np.ndarray:
-        """Ū_all (n, N, N) at each of ``omega`` (n,) rad/s, not orthonormalised: :meth:`Deduction.matrix`."""
-        return self.deduction.matrix(omega)
+    #: no faster plain Ū_all than the deduction's own, which the probes read themselves
+    plain_matrix = None
 
 
 class CompiledDeterminant:

@@ -128,8 +128,8 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     Returns (deduction, finder, number of indeterminate unknowns released).
     """
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
-    evaluator = determinant(deduction, engine)  # compiled first: its plain Ū_all serves the probes
-    released = release_indeterminate(deduction, matrix=evaluator.plain_matrix)
+    evaluator = determinant(deduction, engine)  # compiled first: its plain Ū_all screens the probes
+    released = release_indeterminate(deduction, screen=evaluator.plain_matrix)
     if released:  # the program carries the unknowns it was compiled for
         evaluator = determinant(deduction, engine)
     finder = RootFinder(evaluator.log_det, lambda omega: evaluator.matrix(omega)[0],

@@ -9,10 +9,7 @@ counterpart that stays the readable reference and the test oracle:
 * :func:`evaluate` — :meth:`linmstmm.deduction.Deduction.matrix` and
   :meth:`~linmstmm.deduction.Deduction.log_det` with ``stable=True``: the carry
   with Godunov orthonormalisation (:class:`linmstmm.godunov._Orthonormaliser`),
-  beams cut into pieces of βL ≤ 4, Ū_all assembled, LU;
-* :func:`plain_matrices` — :meth:`~linmstmm.deduction.Deduction.matrix` with
-  ``stable=False``: the same program with every beam in one piece and every
-  orthonormalisation only laid out, so that the columns stay the unknowns.
+  beams cut into pieces of βL ≤ 4, Ū_all assembled, LU.
 
 Frequencies are evaluated in groups of consecutive entries that take the
 same decisions (pieces per beam, orthonormalisations skipped), as one numpy
@@ -217,14 +214,13 @@ def _orthonormal_columns(columns, diagonal):
 
 
 @njit(cache=True)
-def _orthonormalise(program, index, work, reference, log_scale, group, plain):
-    """Orthonormalisation record ``index`` for the ``group`` members' workspaces ``work`` (g, W);
-    with ``plain``, only its layout (the blocks placed on its columns)."""
+def _orthonormalise(program, index, work, reference, log_scale, group):
+    """Orthonormalisation record ``index`` for the ``group`` members' workspaces ``work`` (g, W)."""
     (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
     first, count, state, width = orthos[index, 0], orthos[index, 1], orthos[index, 2], orthos[index, 3]
     state_src = blocks[first + state, 0]
     skip = True
-    for m in range(group if orthos[index, 4] == 0 and not plain else 0):
+    for m in range(group if orthos[index, 4] == 0 else 0):
         ref = reference[m, state_src]
         if math.isnan(ref) or ref == 0.0:  # no reference, or grown from nothing (numpy: inf)
             skip = False
@@ -306,9 +302,8 @@ def _orthonormalise(program, index, work, reference, log_scale, group, plain):
 
 
 @njit(cache=True)
-def _run(program, omegas, work, reference, log_scale, plain):
-    """Replay the operations for one group of frequencies ``omegas`` (g,); with ``plain``,
-    each beam in one piece and no orthonormalisation (:func:`plain_matrices`)."""
+def _run(program, omegas, work, reference, log_scale):
+    """Replay the operations for one group of frequencies ``omegas`` (g,)."""
     (slot_offset, slot_rows, slot_width, operations, terms, places, places_start, matrices,
      orthos, ortho_blocks, beams, beam_rotation) = program
     ortho_program = (slot_offset, slot_rows, slot_width, places, places_start, orthos, ortho_blocks)
@@ -322,7 +317,7 @@ def _run(program, omegas, work, reference, log_scale, plain):
         code, a, b, c, d = (operations[op, 0], operations[op, 1], operations[op, 2], operations[op, 3],
                             operations[op, 4])
         if code == ORTHO:
-            _orthonormalise(ortho_program, a, work, reference, log_scale, group, plain)
+            _orthonormalise(ortho_program, a, work, reference, log_scale, group)
             continue
         for m in range(group):
             if code == TIP:
@@ -373,7 +368,7 @@ def _run(program, omegas, work, reference, log_scale, plain):
                 reference[m, a] = ref if known else np.nan
         if code == BEAM:
             beam = beams[b]
-            if c == 1 and not plain:
+            if c == 1:
                 softer = min(beam[4], beam[5])
                 beta_L = (beam[2] * beam[3] * largest ** 2 / (beam[0] * softer)) ** 0.25 * beam[8]
                 pieces[b] = max(int(math.ceil(beta_L / BEAM_PIECE_BETA_L)), 1)
@@ -384,7 +379,7 @@ def _run(program, omegas, work, reference, log_scale, plain):
                     state = _view(work[m], slot_offset[a], 12, slot_width[a])
                     state[:, :] = piece[m] @ state.copy()
                 if c == 0 and d >= 0:
-                    _orthonormalise(ortho_program, d, work, reference, log_scale, group, plain)
+                    _orthonormalise(ortho_program, d, work, reference, log_scale, group)
 
 
 @njit(cache=True)
@@ -433,7 +428,7 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
         work = whole[:size]
         reference = np.full((size, n_slots), np.nan)
         log_scale = np.zeros(size)
-        _run(program, omegas[start:stop], work, reference, log_scale, False)
+        _run(program, omegas[start:stop], work, reference, log_scale)
         for m in range(size):
             ubar = _assembled(root, root_row, rows, order, kept_rows, kept_columns, work[m], slot_offset,
                               slot_width, slot_columns, slot_columns_start, slot_rows)
@@ -447,19 +442,3 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
                 sign_out[start + m] = np.nan
                 log_abs_out[start + m] = np.nan
             log_scale_out[start + m] = log_scale[m]
-
-
-@njit(cache=True)
-def plain_matrices(program, layout, omegas, matrices_out):
-    """Ū_all as the unknowns stand, no orthonormalisation, at each of ``omegas`` (n,) into
-    ``matrices_out`` (n, N, N): :meth:`linmstmm.deduction.Deduction.matrix` with
-    ``stable=False`` (the null vectors of this matrix index the unknowns)."""
-    (slot_offset, slot_width, slot_columns, slot_columns_start, workspace, n_slots, root, root_row,
-     rows, order, kept_rows, kept_columns, slot_rows) = layout
-    work = np.empty((1, workspace), dtype=omegas.dtype)
-    reference = np.full((1, n_slots), np.nan)
-    log_scale = np.zeros(1)
-    for m in range(omegas.size):
-        _run(program, omegas[m:m + 1], work, reference, log_scale, True)
-        matrices_out[m] = _assembled(root, root_row, rows, order, kept_rows, kept_columns, work[0], slot_offset,
-                                     slot_width, slot_columns, slot_columns_start, slot_rows)

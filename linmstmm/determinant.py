@@ -142,16 +142,19 @@ class CompiledDeterminant:
         return np.ascontiguousarray(omega.astype(complex if np.iscomplexobj(omega) else float))
 
     def _evaluate(self, omega, group: int | None, with_matrices: bool):
+        omega = self._frequencies(omega)
+        self.evaluations += omega.size
+        return self._replayed(self._operations, omega, group, with_matrices)
+
+    def _replayed(self, operations, omega, group: int | None, with_matrices: bool):
+        """(matrices, sign, log_abs, log_scale) of the kernels replaying ``operations``."""
         from linmstmm import _kernels  # numba loads here, not at import
 
-        omega = self._frequencies(omega)
         n, order = omega.size, self.order
         matrices = np.zeros((n if with_matrices else 0, order, order), dtype=omega.dtype)
         sign = np.zeros(n, dtype=omega.dtype)
         log_abs, log_scale = np.zeros(n), np.zeros(n)
-        _kernels.evaluate(self._operations, self._layout, omega, max(group or n, 1), matrices, sign, log_abs,
-                          log_scale)
-        self.evaluations += n
+        _kernels.evaluate(operations, self._layout, omega, max(group or n, 1), matrices, sign, log_abs, log_scale)
         return matrices, sign, log_abs, log_scale
 
     def log_det(self, omega):
@@ -172,12 +175,18 @@ class CompiledDeterminant:
 
     def plain_matrix(self, omega) -> np.ndarray:
         """Ū_all (n, N, N) at each of ``omega`` (n,) rad/s, not orthonormalised: the columns
-        are the unknowns, as :meth:`Deduction.matrix` gives them (to rounding); not counted
-        among the evaluations. By the compiled program with every beam in one piece and
-        its orthonormalisations only laid out (:func:`linmstmm._kernels.plain_matrices`)."""
-        from linmstmm import _kernels
+        are the unknowns, :meth:`Deduction.matrix` to rounding; not counted among the
+        evaluations.
 
+        The program with every orthonormalisation only laid out (the flag of those the
+        final LU takes over, :data:`linmstmm.program.FINAL_CARRIES`), one frequency at a
+        time. A beam's pieces of βL ≤ 4 are multiplied through, the same transfer as the
+        numpy carry's one piece; at the probes of
+        :func:`~linmstmm.nullspace.release_indeterminate`, below every beam's own scale,
+        each beam is one piece.
+        """
         omega = self._frequencies(omega)
-        matrices = np.zeros((omega.size, self.order, self.order), dtype=omega.dtype)
-        _kernels.plain_matrices(self._operations, self._layout, omega, matrices)
-        return matrices
+        laid_out = self.program.orthos.copy()
+        laid_out[:, 4] = 1
+        operations = self._operations[:8] + (laid_out,) + self._operations[9:]
+        return self._replayed(operations, omega, 1, True)[0]

@@ -1,8 +1,8 @@
 """Statically indeterminate unknowns found on the compiled program's plain Ū_all.
 
 :meth:`~linmstmm.determinant.CompiledDeterminant.plain_matrix` replays the
-compiled program with every beam in one piece and no orthonormalisation: it must
-be :meth:`~linmstmm.deduction.Deduction.matrix` (the numpy carry, ``stable=False``)
+compiled program with its orthonormalisations only laid out: it must be
+:meth:`~linmstmm.deduction.Deduction.matrix` (the numpy carry, ``stable=False``)
 to rounding. :func:`~linmstmm.nullspace.release_indeterminate` screens its probes
 with it and must release exactly the unknowns and rows the numpy carry alone
 releases, and still refuse a null space that moves with ω.

@@ -120,8 +120,7 @@ class CompiledDeterminant:
         self._released = deduction.released_columns  # the unknowns compiled for
         self.program = compile_program(deduction)
         p = self.program
-        self._operations = (p.slot_offset, p.slot_rows, p.slot_width, p.operations, p.terms, p.places,
-                            p.places_start, p.matrices, p.orthos, p.ortho_blocks, p.beams, p.beam_rotation)
+        self._operations = _kernel_operations(p, p.orthos)
         self._layout = (p.slot_offset, p.slot_width, p.slot_columns, p.slot_columns_start, p.workspace,
                         p.slot_rows.size, p.root, p.root_row, p.geometric_rows, p.order, p.kept_rows,
                         p.kept_columns, p.slot_rows)
@@ -188,5 +187,12 @@ class CompiledDeterminant:
         omega = self._frequencies(omega)
         laid_out = self.program.orthos.copy()
         laid_out[:, 4] = 1
-        operations = self._operations[:8] + (laid_out,) + self._operations[9:]
-        return self._replayed(operations, omega, 1, True)[0]
+        return self._replayed(_kernel_operations(self.program, laid_out), omega, 1, True)[0]
+
+
+def _kernel_operations(program, orthos: np.ndarray) -> tuple:
+    """The arrays of ``program`` that :func:`linmstmm._kernels.evaluate` replays, in its
+    order, with ``orthos`` (O, 5) for its orthonormalisation records."""
+    p = program
+    return (p.slot_offset, p.slot_rows, p.slot_width, p.operations, p.terms, p.places, p.places_start,
+            p.matrices, orthos, p.ortho_blocks, p.beams, p.beam_rotation)

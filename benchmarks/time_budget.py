@@ -17,8 +17,8 @@ from linmstmm import predicted, roots, solve
 STAGES = (
     (solve, "build_topology", "topology"),
     (solve, "Deduction", "deduction"),
-    (solve, "release_indeterminate", "indeterminate unknowns (numpy probes)"),
     (solve, "determinant", "compile the program"),
+    (solve, "release_indeterminate", "indeterminate unknowns (probes)"),
     (solve, "rigid_body_mode_count", "rigid-body count"),
     (solve, "predict_frequencies", "predict (coarse FE)"),
     (predicted, "secant_roots", "polish (secant)"),

@@ -4,7 +4,12 @@ Both engines answer the same two questions with the same numbers (to
 rounding): ``log_det(ω)`` — sign (phase, for complex ω) and log|det Ū_all| —
 and ``matrix(ω)`` — the orthonormalised Ū_all whose differences are smooth in
 ω (Newton's pencil); both count their evaluations (one per frequency), the
-cost figure the benchmarks report per root.
+cost figure the benchmarks report per root. The compiled one also gives
+``plain_matrix(ω)``, Ū_all as the unknowns stand (no orthonormalisation, not
+counted), with which :func:`linmstmm.nullspace.release_indeterminate` screens
+its probes for statically indeterminate unknowns (``plain_matrix`` is None for
+the numpy carry, which reads them itself); a compiled determinant serves the
+unknowns it was compiled for, so after a release it is compiled anew.
 
 * :class:`NumpyDeterminant` — :meth:`Deduction.log_det` / :meth:`Deduction.matrix`,
   vectorised over a stack of frequencies (a run of identical cells by powers of
@@ -97,6 +102,9 @@ class NumpyDeterminant:
         self.evaluations += omega.size
         return self.deduction.matrix(omega, stable=True)
 
+    #: no faster plain Ū_all than the deduction's own, which the probes read themselves
+    plain_matrix = None
+
 
 class CompiledDeterminant:
     """det Ū_all of one deduction, evaluated by the compiled kernels.
@@ -108,10 +116,11 @@ class CompiledDeterminant:
     """
 
     def __init__(self, deduction: Deduction):
+        self.deduction = deduction
+        self._released = deduction.released_columns  # the unknowns compiled for
         self.program = compile_program(deduction)
         p = self.program
-        self._operations = (p.slot_offset, p.slot_rows, p.slot_width, p.operations, p.terms, p.places,
-                            p.places_start, p.matrices, p.orthos, p.ortho_blocks, p.beams, p.beam_rotation)
+        self._operations = _kernel_operations(p, p.orthos)
         self._layout = (p.slot_offset, p.slot_width, p.slot_columns, p.slot_columns_start, p.workspace,
                         p.slot_rows.size, p.root, p.root_row, p.geometric_rows, p.order, p.kept_rows,
                         p.kept_columns, p.slot_rows)
@@ -123,18 +132,28 @@ class CompiledDeterminant:
         """Order N of Ū_all (after any release)."""
         return self.program.kept_columns.size
 
+    def _frequencies(self, omega) -> np.ndarray:
+        """``omega`` as a contiguous float or complex array (n,), once the program is
+        known to serve the deduction's unknowns as they stand."""
+        if self.deduction.released_columns is not self._released:
+            raise RuntimeError("unknowns were released after this determinant was compiled: compile it anew")
+        omega = np.atleast_1d(np.asarray(omega))
+        return np.ascontiguousarray(omega.astype(complex if np.iscomplexobj(omega) else float))
+
     def _evaluate(self, omega, group: int | None, with_matrices: bool):
+        omega = self._frequencies(omega)
+        self.evaluations += omega.size
+        return self._replayed(self._operations, omega, group, with_matrices)
+
+    def _replayed(self, operations, omega, group: int | None, with_matrices: bool):
+        """(matrices, sign, log_abs, log_scale) of the kernels replaying ``operations``."""
         from linmstmm import _kernels  # numba loads here, not at import
 
-        omega = np.atleast_1d(np.asarray(omega))
-        omega = omega.astype(complex if np.iscomplexobj(omega) else float)
         n, order = omega.size, self.order
         matrices = np.zeros((n if with_matrices else 0, order, order), dtype=omega.dtype)
         sign = np.zeros(n, dtype=omega.dtype)
         log_abs, log_scale = np.zeros(n), np.zeros(n)
-        _kernels.evaluate(self._operations, self._layout, np.ascontiguousarray(omega), max(group or n, 1),
-                          matrices, sign, log_abs, log_scale)
-        self.evaluations += n
+        _kernels.evaluate(operations, self._layout, omega, max(group or n, 1), matrices, sign, log_abs, log_scale)
         return matrices, sign, log_abs, log_scale
 
     def log_det(self, omega):
@@ -152,3 +171,28 @@ class CompiledDeterminant:
         decisions, so that differences between its entries are smooth in ω."""
         matrices, _, _, log_scale = self._evaluate(omega, None, True)
         return matrices, log_scale
+
+    def plain_matrix(self, omega) -> np.ndarray:
+        """Ū_all (n, N, N) at each of ``omega`` (n,) rad/s, not orthonormalised: the columns
+        are the unknowns, :meth:`Deduction.matrix` to rounding; not counted among the
+        evaluations.
+
+        The program with every orthonormalisation only laid out (the flag of those the
+        final LU takes over, :data:`linmstmm.program.FINAL_CARRIES`), one frequency at a
+        time. A beam's pieces of βL ≤ 4 are multiplied through, the same transfer as the
+        numpy carry's one piece; at the probes of
+        :func:`~linmstmm.nullspace.release_indeterminate`, below every beam's own scale,
+        each beam is one piece.
+        """
+        omega = self._frequencies(omega)
+        laid_out = self.program.orthos.copy()
+        laid_out[:, 4] = 1
+        return self._replayed(_kernel_operations(self.program, laid_out), omega, 1, True)[0]
+
+
+def _kernel_operations(program, orthos: np.ndarray) -> tuple:
+    """The arrays of ``program`` that :func:`linmstmm._kernels.evaluate` replays, in its
+    order, with ``orthos`` (O, 5) for its orthonormalisation records."""
+    p = program
+    return (p.slot_offset, p.slot_rows, p.slot_width, p.operations, p.terms, p.places, p.places_start,
+            p.matrices, orthos, p.ortho_blocks, p.beams, p.beam_rotation)

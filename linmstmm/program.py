@@ -123,6 +123,7 @@ class _Planner:
     def __init__(self, deduction: Deduction):
         self.deduction = deduction
         self.slots: list[tuple[int, np.ndarray]] = []  # (rows, columns)
+        self.column_sets: list[frozenset] = []  # each slot's columns, for the orthonormalisations' unions
         self.operations: list[tuple] = []
         self.terms: list[tuple] = []
         self.places: list[np.ndarray] = []
@@ -134,7 +135,9 @@ class _Planner:
 
     # -- storage ----------------------------------------------------------------------
     def slot(self, rows: int, columns) -> int:
-        self.slots.append((rows, np.asarray(columns, dtype=np.int64)))
+        columns = np.asarray(columns, dtype=np.int64)
+        self.slots.append((rows, columns))
+        self.column_sets.append(frozenset(columns.tolist()))
         return len(self.slots) - 1
 
     def matrix(self, matrix) -> int:
@@ -191,14 +194,14 @@ def compile_program(deduction: Deduction) -> Program:
 
         emit : False to record it without an ORTHO operation (a beam's pieces
         after the first run it themselves)."""
-        columns = set(plan.columns(state).tolist())
+        columns = set(plan.column_sets[state])
         others = ([("row", i, r[1]) for i, r in enumerate(rows)]
                   + [("state", key, slot) for key, slot in open_states.items()]
                   + [("waiting", key, slot) for key, slot in waiting.items()])
-        held = [set(plan.columns(slot).tolist()) for *_, slot in others]
+        held = [plan.column_sets[slot] for *_, slot in others]
         chosen: set[int] = set()
         while True:
-            more = {i for i, cs in enumerate(held) if i not in chosen and cs & columns}
+            more = {i for i, cs in enumerate(held) if i not in chosen and not cs.isdisjoint(columns)}
             if not more:
                 break
             chosen |= more
@@ -213,7 +216,7 @@ def compile_program(deduction: Deduction) -> Program:
         first = len(plan.ortho_blocks)
         new_slots = []
         for (kind, key, src), count, forces in zip(blocks, block_rows, block_forces):
-            same = np.array_equal(plan.columns(src), union)
+            same = len(plan.column_sets[src]) == union.size  # its columns are among the union's
             dst = src if same else plan.slot(count, union)
             place = -1 if same else plan.place(plan.columns(src), union)
             plan.ortho_blocks.append((src, dst, count, ROW_BLOCK if kind == "row" else STATE_BLOCK, place,

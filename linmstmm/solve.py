@@ -132,8 +132,10 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     Returns (deduction, finder, number of indeterminate unknowns released).
     """
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
-    released = release_indeterminate(deduction)
-    evaluator = determinant(deduction, engine)
+    evaluator = determinant(deduction, engine)  # compiled first: its plain Ū_all screens the probes
+    released = release_indeterminate(deduction, screen=evaluator.plain_matrix)
+    if released:  # the program carries the unknowns it was compiled for
+        evaluator = determinant(deduction, engine)
     finder = RootFinder(evaluator.log_det, lambda omega: evaluator.matrix(omega)[0],
                         rigid_body_modes=rigid_body_mode_count(model),
                         predictor=lambda n: predict_frequencies(model, n),

@@ -1,0 +1,146 @@
+"""Statically indeterminate unknowns found on the compiled program's plain Ū_all.
+
+:meth:`~linmstmm.determinant.CompiledDeterminant.plain_matrix` replays the
+compiled program with its orthonormalisations only laid out: it must be
+:meth:`~linmstmm.deduction.Deduction.matrix` (the numpy carry, ``stable=False``)
+to rounding. :func:`~linmstmm.nullspace.release_indeterminate` screens its probes
+with it and must release exactly the unknowns and rows the numpy carry alone
+releases, and still refuse a null space that moves with ω.
+"""
+from __future__ import annotations
+
+import mpmath
+import numpy as np
+import pytest
+from builders import BUNDLED_MODELS
+from random_models import KINDS, random_model
+from test_extremes import nafems_fv2_double_cross
+from test_joints import beam_on_joint, four_bar, hinged_chain, pinned_bars, sliding_carts, with_random_joints
+from varied_models import varied_model
+
+from linmstmm.deduction import Deduction
+from linmstmm.determinant import CompiledDeterminant
+from linmstmm.model import load_model
+from linmstmm.nullspace import PROBES, characteristic_frequencies, equilibration, release_indeterminate
+from linmstmm.solve import natural_frequencies
+from linmstmm.topology import build_topology
+
+#: Models of the test suite in which something is released (found by the numpy carry):
+#: inf springs closing loops, pinned axially rigid arms, joints beside rigid springs.
+RELEASING = {
+    "varied 24": lambda: varied_model(24)[0],
+    "varied 71": lambda: varied_model(71)[0],
+    "varied 358 (two)": lambda: varied_model(358)[0],
+    "varied 522": lambda: varied_model(522)[0],
+    "random tree 9": lambda: random_model("tree", 9),
+    "random loops 25": lambda: random_model("loops", 25),
+    "random loops 46": lambda: random_model("loops", 46),
+    "random floating loops 42": lambda: random_model("floating_loops", 42),
+    "random tree 19 with joints": lambda: with_random_joints(random_model("tree", 19), np.random.default_rng(1019)),
+    "NAFEMS FV2 (six)": nafems_fv2_double_cross,
+}
+JOINTS = {"four bar": four_bar, "hinged chain": hinged_chain, "pinned bars": pinned_bars,
+          "sliding carts": sliding_carts, "ball joint": lambda: beam_on_joint(["rx", "ry", "rz"])}
+
+
+def released(model, screened: bool):
+    """(count, released columns, released rows) of ``model``, its probes screened by the
+    compiled plain Ū_all or read by the numpy carry alone."""
+    deduction = Deduction(build_topology(model))
+    screen = CompiledDeterminant(deduction).plain_matrix if screened else None
+    count = release_indeterminate(deduction, screen=screen)
+    return count, deduction.released_columns.tolist(), deduction.released_rows.tolist()
+
+
+@pytest.mark.parametrize("make", list(RELEASING.values()), ids=list(RELEASING))
+def test_the_screened_probes_release_the_numpy_carrys_unknowns(make):
+    model = make()
+    numpy_release = released(model, screened=False)
+    assert numpy_release[0] >= 1
+    assert released(model, screened=True) == numpy_release
+
+
+@pytest.mark.parametrize("make", [lambda path=path: load_model(path) for path in BUNDLED_MODELS]
+                         + list(JOINTS.values()), ids=[p.name for p in BUNDLED_MODELS] + list(JOINTS))
+def test_bundled_and_joint_models_release_the_same(make):
+    model = make()
+    assert released(model, screened=True) == released(model, screened=False)
+
+
+def test_hundreds_of_random_models_release_the_same():
+    """320 varied models (the extremes: slender beams, Iy/Iz to 1e12, other units) and 40
+    random models of each kind, 14 of which release something."""
+    models = [varied_model(seed)[0] for seed in range(320)]
+    models += [random_model(kind, seed) for kind in KINDS for seed in range(40)]
+    releasing = 0
+    for model in models:
+        numpy_release = released(model, screened=False)
+        assert released(model, screened=True) == numpy_release, model.name
+        releasing += numpy_release[0] > 0
+    assert releasing >= 10
+
+
+def moving_null_vector(matrix, scale):
+    """``matrix`` (frequencies (n,) -> (n, N, N)) with its first column made ω / scale times
+    its second: singular at every ω, its null vector moving with ω."""
+    def moved(omega):
+        samples = np.array(matrix(omega))
+        samples[:, :, 0] = samples[:, :, 1] * (np.asarray(omega) / scale)[:, None]
+        return samples
+    return moved
+
+
+@pytest.mark.parametrize("screened", [False, True])
+def test_a_null_space_that_moves_with_frequency_is_still_refused(screened, monkeypatch):
+    """No model of the suite has one (a conservative model's constant null vectors are
+    redundant constraints or massless motions); one is made by mixing two columns with
+    a weight ω / scale, in the numpy carry and in the screen alike."""
+    deduction = Deduction(build_topology(random_model("loops", 25)))
+    scale = min(characteristic_frequencies(deduction.topology))
+    screen = moving_null_vector(CompiledDeterminant(deduction).plain_matrix, scale) if screened else None
+    monkeypatch.setattr(deduction, "matrix", moving_null_vector(deduction.matrix, scale))
+    with pytest.raises(RuntimeError, match="the model has a mechanism"):
+        release_indeterminate(deduction, screen=screen)
+
+
+def plain_cases():
+    models = [random_model(kind, seed) for kind in KINDS for seed in range(8)]
+    models += [with_random_joints(random_model(kind, seed), np.random.default_rng(1000 + seed))
+               for kind in KINDS for seed in range(3)]
+    return models + [load_model(path) for path in BUNDLED_MODELS]
+
+
+def test_the_plain_matrix_is_the_numpy_carrys():
+    """At the probes and up to 3000 times the model's scale, balanced as the release
+    balances it (by the numpy matrix at the first probe), each entry within 1e-12 of
+    the largest; where a carry loses more to cancellation (a random floating loop,
+    2.2e-11 apart at 0.07 times its scale), the compiled matrix must be as close to the
+    exact one (mpmath, 40 digits) as the numpy one is, within a factor 2."""
+    for model in plain_cases():
+        deduction = Deduction(build_topology(model))
+        plain = CompiledDeterminant(deduction).plain_matrix
+        omegas = np.r_[PROBES, 3.0, 30.0, 300.0, 3000.0] * min(characteristic_frequencies(deduction.topology))
+        reference, compiled = deduction.matrix(omegas), plain(omegas)
+        rows, cols = equilibration(reference[0])
+        for omega, a, b in zip(omegas, rows[:, None] * reference * cols, rows[:, None] * compiled * cols):
+            largest = np.abs(a).max()
+            if np.abs(b - a).max() <= 1e-12 * largest:
+                continue
+            with mpmath.workdps(40):
+                exact = np.array(deduction.matrix(np.array([mpmath.mpf(omega)], dtype=object))[0].tolist(), float)
+            exact = rows[:, None] * exact * cols
+            assert np.abs(b - exact).max() <= 2 * np.abs(a - exact).max(), (model.name, omega)
+
+
+def test_a_program_compiled_before_a_release_is_not_used_after_it():
+    """The program carries the unknowns it was compiled for: after a release it must be
+    compiled anew, and the solve does so (the same frequencies as the numpy engine)."""
+    model = random_model("loops", 25)
+    deduction = Deduction(build_topology(model))
+    early = CompiledDeterminant(deduction)
+    assert release_indeterminate(deduction, screen=early.plain_matrix) == 1
+    with pytest.raises(RuntimeError, match="compile it anew"):
+        early.log_det(np.array([10.0]))
+    compiled, reference = (natural_frequencies(model, 6, engine=engine) for engine in ("compiled", "numpy"))
+    assert compiled.indeterminate_released == reference.indeterminate_released == 1
+    np.testing.assert_allclose(compiled.frequencies_hz, reference.frequencies_hz, rtol=1e-10)

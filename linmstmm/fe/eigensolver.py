@@ -1,6 +1,6 @@
 """The lowest elastic eigenpairs: Lanczos (ARPACK) on ``K⁺M`` or the dense
 condensed start, polished by subspace iteration with Rayleigh–Ritz energies
-computed from strains (:func:`fe_modes`)."""
+computed from the element forces of the flexibility solve (:func:`fe_modes`)."""
 from __future__ import annotations
 
 import numpy as np
@@ -17,8 +17,12 @@ DENSE_LIMIT = 120
 SWEEP_TOLERANCE = 1e-14
 
 
-def _rayleigh_ritz(fe: FEModel, Y: np.ndarray):
-    """Ritz pairs of span(Y), energies from strains.
+def _rayleigh_ritz(fe: FEModel, Y: np.ndarray, strains: np.ndarray):
+    """Ritz pairs of span(Y), energies from the strains of Y.
+
+    Y : (n_dof, b) displacements; strains : (n_strain, b) their ``D^½ G Y``
+    as :meth:`_Flexibility.solve` gives them (carried through every linear
+    combination of Y, never recomputed from the combined vectors).
 
     Returns ascending λ (rad²/s²) and mass-normalised vectors (n_dof, m);
     directions of span(Y) without mass are dropped.
@@ -26,16 +30,17 @@ def _rayleigh_ritz(fe: FEModel, Y: np.ndarray):
     MY = fe.M @ Y
     norms = np.sqrt(np.maximum(np.einsum("ij,ij->j", Y, MY), 0.0))
     keep = norms > 0.0
-    Y = Y[:, keep] / norms[keep]
+    Y, strains = Y[:, keep] / norms[keep], strains[:, keep] / norms[keep]
     gram = Y.T @ (fe.M @ Y)
     weights, directions = la.eigh(0.5 * (gram + gram.T))
     keep = weights > 1e-12 * weights[-1]          # drop numerically dependent directions
-    Z = Y @ (directions[:, keep] / np.sqrt(weights[keep]))
-    strains = np.sqrt(fe.D)[:, None] * (fe.G @ Z)
+    combination = directions[:, keep] / np.sqrt(weights[keep])
+    Z, strains = Y @ combination, strains @ combination
     _, C = la.eigh(strains.T @ strains)
-    X = Z @ C
-    X /= np.sqrt(np.einsum("ij,ij->j", X, fe.M @ X))
-    lam = np.sum((np.sqrt(fe.D)[:, None] * (fe.G @ X)) ** 2, axis=0)
+    X, strains = Z @ C, strains @ C
+    masses = np.sqrt(np.einsum("ij,ij->j", X, fe.M @ X))
+    X, strains = X / masses, strains / masses
+    lam = np.sum(strains ** 2, axis=0)
     order = np.argsort(lam)
     return lam[order], X[:, order]
 
@@ -90,9 +95,9 @@ def _lowest_modes(fe: FEModel, flexibility, wanted: int, sweeps: int = 8):
         X = _lanczos_start(fe, flexibility, block)
     if X.shape[1] == 0:
         return np.zeros(0), X, np.zeros(0)
-    lam, X = _rayleigh_ritz(fe, flexibility(fe.M @ X))
+    lam, X = _rayleigh_ritz(fe, *flexibility.solve(fe.M @ X))
     for _ in range(sweeps):
-        new_lam, X = _rayleigh_ritz(fe, flexibility(fe.M @ X))
+        new_lam, X = _rayleigh_ritz(fe, *flexibility.solve(fe.M @ X))
         m = min(len(lam), len(new_lam))
         change = np.abs(new_lam[:m] - lam[:m]) / new_lam[:m]
         lam, X = new_lam[:m], X[:, :m]

@@ -29,10 +29,11 @@ free to move), gets the modal sum alone and a note.
 The frequency response (receptance) between a load and the points is the
 modal sum H(Ω) = Σ_k φ^k (d · φ^k_load) / (M_k (ω_k² − Ω² + i Ω c_k)).
 
-A spring's dashpot ``c`` couples the modes; this modal route cannot honour
-it and the time response refuses such a model (:func:`refuse_dashpots`)
-instead of dropping it. The FRF of such a model is solved directly
-(:func:`linmstmm.forced.direct_frf`).
+A spring's dashpot ``c`` couples the modes: its damping in modal coordinates
+(:func:`linmstmm.modal_dashpots.modal_dashpots`) joins the modal equations,
+which are then solved together, still exactly
+(:func:`linmstmm.modal_dashpots.coupled_unit_response`). The FRF of such a
+model is solved directly (:func:`linmstmm.forced.direct_frf`).
 """
 from __future__ import annotations
 
@@ -52,7 +53,8 @@ from linmstmm.loads import (
     step,
     table,
 )
-from linmstmm.model import Model, ModelError
+from linmstmm.modal_dashpots import coupled_unit_response, modal_dashpots
+from linmstmm.model import Model
 from linmstmm.modes import ModalResult, mode_shapes
 from linmstmm.results import Result, decode_array, decode_arrays, encode_array
 
@@ -60,7 +62,7 @@ from linmstmm.results import Result, decode_array, decode_arrays, encode_array
 #: (:mod:`linmstmm.loads`, :mod:`linmstmm.duhamel`) this module has always offered.
 __all__ = ["DampingRatioError", "FRFResult", "LoadCase", "PointLoad", "QUANTITY_UNITS", "ResponseResult",
            "TimeFunction", "frf", "half_sine", "harmonic", "impulse", "load_loads", "modal_damping",
-           "modal_response", "participation", "quantity_units", "refuse_dashpots", "respond", "step", "table",
+           "modal_response", "participation", "quantity_units", "respond", "step", "table",
            "unit_response"]
 
 
@@ -275,7 +277,7 @@ def participation(modes: ModalResult, point: str, vector) -> np.ndarray:
 
 
 def modal_response(modes: ModalResult, loads, times, points=None, damping=None, *,
-                   damping_ratio=None, static=None) -> ResponseResult:
+                   damping_ratio=None, static=None, dashpots=None) -> ResponseResult:
     """Response of the points to ``loads`` by modal superposition.
 
     Parameters
@@ -292,6 +294,10 @@ def modal_response(modes: ModalResult, loads, times, points=None, damping=None, 
         each load's part of K⁺f that the modal sum leaves out, times g(t)
         (and g', g'' for velocity and acceleration), so that a slowly
         applied or lasting load gives the static solution exactly.
+    dashpots : (n, n) the springs' dashpots in the modal coordinates, M⁻¹C,
+        1/s (:func:`~linmstmm.modal_dashpots.modal_dashpots`), or None. Given,
+        the modal equations they couple are solved together
+        (:func:`~linmstmm.modal_dashpots.coupled_unit_response`).
 
     Returns
     -------
@@ -302,8 +308,11 @@ def modal_response(modes: ModalResult, loads, times, points=None, damping=None, 
     rate = modal_damping(modes.omega, damping, damping_ratio)
     histories = np.zeros((3, times.size, modes.omega.size))
     for load in loads:
-        response = unit_response(modes.omega, rate, load.time, times)
-        histories += participation(modes, load.point, load.vector) * np.stack(response)
+        p = participation(modes, load.point, load.vector)
+        if dashpots is None:
+            histories += p * np.stack(unit_response(modes.omega, rate, load.time, times))
+        else:
+            histories += np.stack(coupled_unit_response(modes.omega, rate, dashpots, p, load.time, times))
     shapes = np.stack([modes.point_displacements[p] for p in points], axis=1)  # (n, p, 6)
     physical = np.einsum("htk,kpc->htpc", histories, shapes)
     if static is not None:
@@ -382,39 +391,25 @@ def respond(model: Model, case: LoadCase, damping_ratio=None,
 
     Raises
     ------
-    ModelError
-        For a spring with a dashpot (:func:`refuse_dashpots`).
     DampingRatioError
         For damping ratios that do not fit the modes.
+    DefectiveDampingError
+        Where the springs' dashpots make two damped modes coincide
+        (:func:`~linmstmm.modal_dashpots.coupled_unit_response`).
     """
     from linmstmm.fe.flexibility import static_displacements
 
-    refuse_dashpots(model, "time response")
     modes = mode_shapes(model, case.modes)
     points = tuple(modes.point_displacements) if case.points is None else case.points
     held = modes.rigid_body_modes == 0
     static = (static_displacements(model, [(load.point, load.vector) for load in case.loads], points)
               if static_correction and held else None)
     damping = model.damping if damping_ratio is None else None
-    result = modal_response(modes, case.loads, case.times, points, damping,
-                            damping_ratio=damping_ratio, static=static)
+    result = modal_response(modes, case.loads, case.times, points, damping, damping_ratio=damping_ratio,
+                            static=static,
+                            dashpots=modal_dashpots(model, modes.point_displacements, modes.modal_mass))
     if static_correction and not held:
         return replace(result, note=f"no static correction: the model has {modes.rigid_body_modes} "
                                     f"rigid-body modes (free-floating, or a joint's mechanism); the "
                                     f"modal sum alone")
     return result
-
-
-def refuse_dashpots(model: Model, what: str) -> None:
-    """Raise ModelError on the first spring with a nonzero dashpot ``c``.
-
-    The modal route's modes are undamped and their damping is proportional
-    (``[damping]``) or modal (ratios); a discrete dashpot couples the modes,
-    so the modal ``what`` (e.g. "time response") cannot honour it.
-    """
-    for spring in model.springs:
-        if spring.c is not None and np.any(spring.c > 0):
-            raise ModelError(model.source or model.name,
-                             f"the modal {what} cannot honour a spring's dashpot (its modes are "
-                             f"undamped); remove 'c' and give [damping] or modal damping ratios",
-                             element=f"spring '{spring.name}'", key="c")

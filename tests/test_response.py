@@ -410,16 +410,6 @@ def dashpot_chain(tmp_path):
     return path
 
 
-def test_dashpots_are_refused_not_dropped(capsys, tmp_path, chain_step):
-    """The time response is modal only; the FRF takes the direct route (tests/test_forced.py)."""
-    model = dashpot_chain(tmp_path)
-    status, out, err = command(capsys, "response", model, chain_step)
-    assert status == 2 and out == ""
-    assert err.strip() == (f"linmstmm: error: {model}: spring 'k2': key 'c': the modal time response cannot "
-                           f"honour a spring's dashpot (its modes are undamped); remove 'c' and give [damping] "
-                           f"or modal damping ratios")
-
-
 def test_zeta_that_does_not_fit_the_modes_exits_2(capsys):
     status, _, err = command(capsys, "frf", CHAIN_FILE, "--point", "b1", "--direction", "y", "--fmax", "10",
                              "--zeta", "0.01,0.02")

@@ -2,8 +2,8 @@
 
 ``--zeta`` gives modal damping ratios (one for every elastic mode, or a comma
 list with one per elastic mode in the sum); they replace the model's
-``[damping]`` for that run. A model with a spring dashpot ``c`` is refused
-(the modal route cannot honour it).
+``[damping]`` for that run. A spring dashpot ``c`` acts too: the modal
+equations it couples are solved together (:mod:`linmstmm.modal_dashpots`).
 """
 from __future__ import annotations
 

@@ -335,7 +335,7 @@ def _static_correction(modes: ModalResult, loads, times, shapes, static) -> np.n
 
 
 def frf(modes: ModalResult, point: str, vector, excitation_hz, points=None,
-        damping=None, *, damping_ratio=None) -> FRFResult:
+        damping=None, *, damping_ratio=None, static=None) -> FRFResult:
     """Receptance between a load ``vector`` at ``point`` and the response ``points``.
 
     Parameters
@@ -355,6 +355,16 @@ def frf(modes: ModalResult, point: str, vector, excitation_hz, points=None,
     damping_ratio : float or sequence of float, optional
         Modal damping ratios ζ instead (neither: undamped, infinite at the
         natural frequencies).
+    static : array_like, shape (n_points, 6), optional
+        K⁺f of the load ``vector`` at the response points (m, rad;
+        :func:`linmstmm.fe.static_displacements`). Given, the residual
+        flexibility of the modes left out of the sum, K⁺f − Σ φ_k p_k / ω_k²,
+        is added at every frequency: the modes above respond to a load below
+        them quasi-statically, so the receptance is exact at Ω = 0 and errs by
+        about (Ω/ω)² of the first mode left out above (and a massless point's
+        flexibility, which no mode holds, is exact). Without it those modes are
+        missing altogether (a cantilever's axial receptance below its first
+        axial mode is then almost zero).
 
     Returns
     -------
@@ -364,9 +374,15 @@ def frf(modes: ModalResult, point: str, vector, excitation_hz, points=None,
     points = tuple(modes.point_displacements) if points is None else tuple(points)
     Omega = 2 * np.pi * excitation_hz[:, None]
     rate = modal_damping(modes.omega, damping, damping_ratio)
-    modal = participation(modes, point, vector) / (modes.omega**2 - Omega**2 + 1j * Omega * rate)
+    loading = participation(modes, point, vector)
+    modal = loading / (modes.omega**2 - Omega**2 + 1j * Omega * rate)
     shapes = np.stack([modes.point_displacements[p] for p in points], axis=1)
-    return FRFResult(excitation_hz, points, np.einsum("fk,kpc->fpc", modal, shapes))
+    receptance = np.einsum("fk,kpc->fpc", modal, shapes)
+    if static is not None:
+        elastic = modes.omega > 0
+        modal_static = np.einsum("k,kpc->pc", loading[elastic] / modes.omega[elastic] ** 2, shapes[elastic])
+        receptance += np.asarray(static, dtype=float) - modal_static
+    return FRFResult(excitation_hz, points, receptance)
 
 
 def respond(model: Model, case: LoadCase, damping_ratio=None,

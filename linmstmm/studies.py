@@ -89,7 +89,9 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
     summary : dict
         JSON-ready: ``model``, ``load`` {point, direction}, ``fmax_hz``, the damping
         used (:func:`damping_in_use`), ``route`` ("modal" or "direct"),
-        ``modes_in_sum`` (0 on the direct route), ``rigid_body_modes``,
+        ``modes_in_sum`` (0 on the direct route), ``static_correction`` (the
+        modal sum's residual flexibility added: a held model on the modal
+        route, :func:`linmstmm.response.frf`), ``rigid_body_modes``,
         ``frequencies_hz`` (modal route: the elastic natural frequencies in the
         sum; direct route: the undamped model's elastic natural frequencies up
         to fmax; Hz), ``load_unit`` and ``receptance_units`` (per component).
@@ -124,6 +126,7 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
     load_unit = "N m" if direction.startswith("r") else "N"
     summary = {"model": model.name, "load": {"point": point, "direction": direction}, "fmax_hz": fmax,
                **damping, "route": "direct" if direct else "modal", "modes_in_sum": in_sum,
+               "static_correction": not direct and rigid == 0,
                "rigid_body_modes": rigid, "frequencies_hz": natural,
                "load_unit": load_unit, "receptance_units": receptance_units(load_unit)}
     return result, summary
@@ -137,9 +140,14 @@ def _modal_sweep(model: Model, point: str, unit, sweep, targets, fmax: float, mo
     if reach:
         check_range_request(model, reach, f"fmax = {fmax:g} Hz (the modal sum takes every mode "
                             f"up to {FRF_MODE_REACH:g} x fmax)", "ask for a lower fmax, or for N modes")
+    from linmstmm.fe.flexibility import static_displacements  # the command line starts without the FE route
+
     shapes = mode_shapes(model, modes, fmax=reach)
     report("receptance")
-    result = frf(shapes, point, unit, sweep, targets, damping["damping"], damping_ratio=damping_ratio)
+    static = (static_displacements(model, [(point, unit)], targets)[0] if shapes.rigid_body_modes == 0
+              else None)  # a free model's K⁺f depends on the mesh (see respond)
+    result = frf(shapes, point, unit, sweep, targets, damping["damping"], damping_ratio=damping_ratio,
+                 static=static)
     return result, int(np.count_nonzero(shapes.omega > 0)), shapes.rigid_body_modes, _elastic_hz(shapes)
 
 

@@ -249,6 +249,9 @@ def _roots_near(log_det, omega: float, multiplicity: int, known: list) -> list[c
         remaining = multiplicity - len(found)
         root = _secant(reduced, omega, remaining)
         inside = count_inside(reduced, root, MULTIPLICITY_RADIUS * abs(root))
+        if inside == 0 and remaining > 1:  # the damping split the eigenspace into simple roots
+            root = _secant(reduced, omega, 1)  # (a dashpot along one of two equal bending planes)
+            inside = count_inside(reduced, root, MULTIPLICITY_RADIUS * abs(root))
         if inside == 0:
             raise RuntimeError(f"no damped root found near the undamped {omega / (2 * np.pi):.6g} Hz")
         if inside < remaining:  # the damping splits the eigenspace: polish the part found

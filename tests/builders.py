@@ -5,7 +5,7 @@ from linmstmm.builders import (STEEL, beam_axes, fixed, make_beam, make_rigid, m
                                single_beam_model, spring_mass_chain)
 
 __all__ = ["STEEL", "beam_axes", "fixed", "make_beam", "make_rigid", "make_spring",
-           "single_beam_model", "spring_mass_chain", "BUNDLED_MODELS"]
+           "single_beam_model", "spring_mass_chain", "BUNDLED_MODELS", "cantilever_with_tip_dashpot"]
 
 from linmstmm.model import ModelError, load_model  # noqa: E402
 
@@ -22,3 +22,20 @@ def _is_model(path: Path) -> bool:
 #: Every model file under models/, sorted.
 BUNDLED_MODELS = [p for p in sorted((Path(__file__).resolve().parents[1] / "models").rglob("*.toml"))
                   if _is_model(p)]
+
+
+def cantilever_with_tip_dashpot(folder: Path):
+    """models/cantilever_tip_mass.toml with a spring and dashpot from the tip body to
+    the ground (k = 1000 N/m, 10 N m/rad; c = 30 N s/m along y, 60 along z: the
+    double bending roots split), written into ``folder`` and loaded."""
+    text = (Path(__file__).resolve().parents[1] / "models" / "cantilever_tip_mass.toml").read_text()
+    text = text.replace('tip  = [2.0, 0.0, 0.0]', 'tip  = [2.0, 0.0, 0.0]\nmount = [2.0, 0.0, 0.0]\n'
+                        'ground = [2.0, 0.0, 0.0]')
+    text = text.replace('ports = ["tip"]', 'ports = ["tip", "mount"]')
+    text = text.replace('[boundary]\nroot = "fixed"',
+                        '[[spring]]\nname = "damper"\nends = ["mount", "ground"]\n'
+                        'k = [1000.0, 1000.0, 1000.0, 10.0, 10.0, 10.0]\nc = [0.0, 30.0, 60.0, 0.0, 0.0, 0.0]\n\n'
+                        '[boundary]\nroot = "fixed"\nground = "fixed"')
+    path = folder / "tip_damper.toml"
+    path.write_text(text)
+    return load_model(path)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from builders import cantilever_with_tip_dashpot
 
 from linmstmm import cli, load_model
 from linmstmm.fe.assembly import assemble
@@ -51,19 +52,7 @@ def test_the_chain_with_a_dashpot_follows_its_closed_state_space_solution():
 
 @pytest.fixture(scope="module")
 def tip_damper(tmp_path_factory):
-    """The bundled tip-mass cantilever with a spring and dashpot from the tip body to the
-    ground (30 N s/m along y, 60 along z: the double bending roots split)."""
-    text = (ROOT / "models" / "cantilever_tip_mass.toml").read_text()
-    text = text.replace('tip  = [2.0, 0.0, 0.0]', 'tip  = [2.0, 0.0, 0.0]\nmount = [2.0, 0.0, 0.0]\n'
-                        'ground = [2.0, 0.0, 0.0]')
-    text = text.replace('ports = ["tip"]', 'ports = ["tip", "mount"]')
-    text = text.replace('[boundary]\nroot = "fixed"',
-                        '[[spring]]\nname = "damper"\nends = ["mount", "ground"]\n'
-                        'k = [1000.0, 1000.0, 1000.0, 10.0, 10.0, 10.0]\nc = [0.0, 30.0, 60.0, 0.0, 0.0, 0.0]\n\n'
-                        '[boundary]\nroot = "fixed"\nground = "fixed"')
-    path = tmp_path_factory.mktemp("damper") / "tip_damper.toml"
-    path.write_text(text)
-    return load_model(path)
+    return cantilever_with_tip_dashpot(tmp_path_factory.mktemp("damper"))
 
 
 def test_a_beam_with_a_tip_dashpot_converges_on_the_fe_state_space_solution(tip_damper):

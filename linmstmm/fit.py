@@ -349,17 +349,30 @@ class _Problem:
         return macs
 
 
+#: A singular value of the Jacobian (scaled unknowns, relative frequencies) below this
+#: fraction of the largest is a direction the data do not determine.
+UNDETERMINED = 1e-8
+#: An unknown with a component above this in such a direction has no 1-sigma (null).
+FREE_COMPONENT = 1e-6
+
+
 def _sigma(residuals: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
     """(n,) 1-sigma of the scaled unknowns: √diag(s² (JᵀJ)⁻¹), s² = Σr² / (m − n); nan where
-    no degree of freedom is left or JᵀJ is singular."""
+    no degree of freedom is left, and for every unknown the data do not determine: one
+    with a part in a direction J's singular values leave below UNDETERMINED of the
+    largest (E and ρ of a beam enter its frequencies only as E/ρ: JᵀJ is singular
+    to rounding, and its inverse gave a finite 1.5e5 Pa)."""
     m, n = jacobian.shape
     if m <= n:
         return np.full(n, np.nan)
-    try:
-        covariance = np.linalg.inv(jacobian.T @ jacobian) * (residuals @ residuals) / (m - n)
-    except np.linalg.LinAlgError:
+    _, singular, vt = np.linalg.svd(jacobian, full_matrices=True)
+    kept = singular > UNDETERMINED * singular.max(initial=0.0)
+    if not kept.any():
         return np.full(n, np.nan)
-    return np.sqrt(np.abs(np.diag(covariance)))
+    variance = (residuals @ residuals) / (m - n)
+    sigma = np.sqrt(variance * ((vt[:kept.sum()] / singular[kept, None]) ** 2).sum(axis=0))
+    free = np.abs(vt[kept.sum():]).max(axis=0, initial=0.0) > FREE_COMPONENT
+    return np.where(free, np.nan, sigma)
 
 
 def _json(value: float):

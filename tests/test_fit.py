@@ -153,3 +153,20 @@ def test_bad_requests_exit_2_with_one_line(argv, csv_text, message, tmp_path):
     status, out, err = run_cli("fit", CHAIN, csv_file, *argv)
     assert status == 2 and out == ""
     assert err.count("\n") == 1 and message in err and "Traceback" not in err, err
+
+
+def test_values_the_frequencies_do_not_separate_have_no_interval(tmp_path):
+    """A bare cantilever's frequencies depend on E and ρ only through E/ρ: fitted
+    together from its own frequencies, neither is determined, and both 1-sigma are
+    null (the inverse of the singular JᵀJ gave a finite 1.5e5 Pa)."""
+    text = (MODELS / "cantilever_tip_mass.toml").read_text()
+    bare = tmp_path / "bare.toml"
+    bare.write_text(text[:text.index("[[rigid]]")] + text[text.index("[boundary]"):])
+    status, out, err = run_cli("freqs", bare, "--count", 6, "--json")
+    assert status == 0, err
+    measured = json.loads(out)["frequencies_hz"]
+    csv_file = write_csv(tmp_path / "measured.csv", ["frequency [Hz]"], [[repr(float(f))] for f in measured])
+    status, out, err = run_cli("fit", bare, csv_file, "--vary", "beam.arm.E=1e11:3e11",
+                               "--vary", "beam.arm.rho=5000:9000", "--json")
+    assert status == 0, err
+    assert [p["sigma"] for p in json.loads(out)["parameters"]] == [None, None]

@@ -56,6 +56,11 @@ ENGINE = "numpy"
 SHAPE_STATIONS = 2
 
 
+#: A column whose shape's MAC against its shape at the neighbouring step is below this
+#: holds another mode there (:attr:`SweepResult.switched`).
+SAME_MODE_MAC = 0.5
+
+
 @dataclass(frozen=True)
 class Vary:
     """One swept key: ``n`` values from ``start`` to ``stop`` (both included),
@@ -269,6 +274,14 @@ class SweepResult(Result):
     def frequencies_hz(self) -> np.ndarray:
         """(steps, count) Hz in tracked order: column c follows one mode shape."""
         return _tracked(self.frequencies_hz_by_rank, self.order)
+
+    @property
+    def switched(self) -> np.ndarray:
+        """(steps, count) bool: where a column holds another mode than at the neighbouring
+        step (its MAC there below SAME_MODE_MAC): the mode it followed left the lowest
+        ``count``, and one that entered took its place."""
+        with np.errstate(invalid="ignore"):
+            return self.tracking_mac < SAME_MODE_MAC
 
     def to_dict(self) -> dict:
         """The ``linmstmm sweep --json`` object (``docs/cli.md``); nan is null."""

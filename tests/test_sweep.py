@@ -262,7 +262,7 @@ def test_cli_csv_plot_and_table(tmp_path):
     assert err == "" and "mode 1 [Hz]" in out
     header, *rows = csv_file.read_text().splitlines()
     assert header.split(",")[:2] == ["spring.k2.k[0] [N/m]", "mode 1 [Hz]"] and len(rows) == 3
-    assert header.split(",")[-1] == "mode 3 rank" and "wrote" in out
+    assert header.split(",")[-1] == "mode 3 MAC" and "wrote" in out
     assert png.read_bytes()[:4] == b"\x89PNG"
 
 
@@ -323,3 +323,20 @@ def test_a_study_without_tracking_gives_the_same_frequencies_by_rank():
     assert np.all(np.isnan(by_rank.tracking_mac))
     with pytest.raises(ValueError, match="track_modes"):
         sweep(chain, steps, count=3, sensitivity=True, track_modes=False)
+
+
+def test_a_column_whose_mode_leaves_the_lowest_count_is_marked(tmp_path):
+    """The chain's x-mode rises with spring k2's x stiffness and leaves the lowest 4 at
+    1149 N/m; a y/z mode (MAC 0 with it: another direction) takes its column there.
+    The table marks that cell and says why; the CSV carries each column's MAC."""
+    argv = ("sweep", CHAIN, "--vary", "spring.k2.k[0]=500:2000:6:log", "--count", 4, "--quiet")
+    status, out, _ = run_cli(*argv)
+    assert status == 0
+    rows = [line for line in out.splitlines() if line.strip()[:1].isdigit()]
+    marked = [(i, cell) for i, line in enumerate(rows) for cell in line.split() if cell.endswith("*")]
+    assert len(marked) == 1 and marked[0][0] == 3
+    assert "another mode than the step before" in out
+    status, _, _ = run_cli(*argv, "--csv", tmp_path / "sweep.csv")
+    header, *lines = (tmp_path / "sweep.csv").read_text().splitlines()
+    column = header.split(",").index("mode 4 MAC")
+    assert [float(line.split(",")[column]) < 0.5 for line in lines] == [False, False, False, True, False, False]

@@ -21,7 +21,7 @@ from linmstmm.cli.common import (
 )
 from linmstmm.determinant import ENGINES
 from linmstmm.parameters import parse_key, unit
-from linmstmm.sweep import ENGINE, Vary, grid, sweep
+from linmstmm.sweep import ENGINE, SAME_MODE_MAC, Vary, grid, sweep
 
 #: Elastic frequencies per step unless --count says otherwise.
 DEFAULT_COUNT = 5
@@ -91,9 +91,12 @@ def print_table(result) -> None:
           f"{result.seconds:.2f} s); columns follow mode shapes (MAC)")
     head = [f"{key:>14}" for key in result.keys] + [f"{'mode ' + str(c + 1) + ' [Hz]':>14}" for c in range(count)]
     print("  " + "  ".join(head))
-    for values, row in zip(result.values, result.frequencies_hz):
-        cells = [f"{v:>14.6g}" for v in values] + [f"{f:>14.8g}" for f in row]
+    for values, row, switched in zip(result.values, result.frequencies_hz, result.switched):
+        cells = [f"{v:>14.6g}" for v in values] + [f"{f:>13.8g}{'*' if s else ' '}" for f, s in zip(row, switched)]
         print("  " + "  ".join(cells))
+    if result.switched.any():
+        print(f"  * another mode than the step before (MAC below {SAME_MODE_MAC:g}): the mode this column "
+              f"followed left the lowest {count}")
     for step, note in result.notes.items():
         print(f"  note (step {step + 1}): {note}")
 
@@ -102,15 +105,16 @@ def csv_table(model, result) -> tuple[list[str], list[list[str]]]:
     """The ``--csv`` table: (header, rows), one row per step.
 
     Columns: every varied key ``KEY [unit]``, the tracked frequencies
-    ``mode c [Hz]``, the rank of each column's mode ``mode c rank`` (1 = lowest)
-    and, with sensitivities, ``dmode c/dKEY [Hz/unit]``; empty cells where a
+    ``mode c [Hz]``, the rank of each column's mode ``mode c rank`` (1 = lowest),
+    its MAC against the step before ``mode c MAC`` (below SAME_MODE_MAC: another
+    mode) and, with sensitivities, ``dmode c/dKEY [Hz/unit]``; empty cells where a
     step has fewer modes.
     """
     count = result.order.shape[1]
     units = {key: unit(parse_key(model, key)) for key in result.keys}
     header = [f"{key} [{units[key]}]" for key in result.keys] + [f"mode {c + 1} [Hz]" for c in range(count)] + \
-        [f"mode {c + 1} rank" for c in range(count)]
-    blocks = [result.values, result.frequencies_hz, result.order + 1.0]
+        [f"mode {c + 1} rank" for c in range(count)] + [f"mode {c + 1} MAC" for c in range(count)]
+    blocks = [result.values, result.frequencies_hz, result.order + 1.0, result.tracking_mac]
     for key, values in result.sensitivities.items():
         header += [f"dmode {c + 1}/d{key} [{_per(units[key])}]" for c in range(count)]
         blocks.append(values)

@@ -110,16 +110,11 @@ def unit_differences(model, units: str, frequencies, count: int) -> list[str]:
 
 #: What is known of a seed that disagreed, found by hand after a run (printed under the
 #: seed's line whenever it disagrees again). Seeds 218 in km and 248 in mm-t-s were the FE
-#: route's rigid motions mixing the units (fixed, tests/test_fe_units.py).
-DIAGNOSES = {
-    98: "MSTMM is right: its float64 f2 equals its own mpmath refinement (--digits 20, "
-        "0.033477060955 Hz) to 1e-11, and fixed FE meshes converge on it as h² (32, 64, 128, 256 "
-        "elements per beam: 1.6e-3, 4.0e-4, 1.0e-4, 2.5e-5 off). The FE route's extrapolated value "
-        "(meshes up to 1024 elements per beam) is 1.66e-9 off while its estimate says 4.5e-11: "
-        "optimistic by 37×; why the extrapolation goes wrong on this model (bending planes 7e10 "
-        "apart) is not established. The Wittrick–Williams count cannot arbitrate: it leaves every "
-        "frequency near f2 undecided.",
-}
+#: route's rigid motions mixing the units (fixed, tests/test_fe_units.py); seed 98 was the
+#: FE eigensolver's Rayleigh quotients taken from deflated vectors (fixed, tests/test_fe_rounding.py).
+DIAGNOSES: dict[int, str] = {}
+
+
 #: Known limits the agreement check does not reach.
 KNOWN_LIMITS = ("Beams are cut into pieces by their bending waves (βL) alone, so off the real axis a "
                 "shaft whose polar inertia is far above its torsion constant (Ip/J = 4.3e11 in seed 4) "

@@ -19,14 +19,10 @@ search from the frequencies of its neighbour in the grid (below), so a step
 waits for its neighbour and the parallelism is that of the grid's tracking
 tree (a single line runs in order).
 
-Tracking: frequencies by rank swap places where two modes veer or cross. Each
-step is compared with its neighbour in the grid (the step one before it along
-the last range that is not at its start) by the MAC of the mode shapes at the
-model's points, translations in m and rotations times the model's size in m
-(so the MAC does not depend on the units of length); the assignment that
-maximises the sum of the MACs gives each column the mode nearest in shape to
-the column's mode at the neighbour. Column c at step s is rank
-``order[s, c]`` there; repeated frequencies keep one column per multiplicity.
+Tracking (:mod:`linmstmm.tracking`): each step is compared by MAC with its
+neighbour in the grid (the step one before it along the last range that is
+not at its start). Column c at step s is rank ``order[s, c]`` there; repeated
+frequencies keep one column per multiplicity.
 
 Steps run serially, in local processes (``workers``) or on a dask.distributed
 cluster (``dask``); the results are the same.
@@ -46,6 +42,7 @@ from linmstmm.model import Model, ModelError
 from linmstmm.parameters import get_value, parse_key, with_values
 from linmstmm.results import Result, decode_array, decode_arrays
 from linmstmm.sweep_runners import run_steps
+from linmstmm.tracking import SAME_MODE_MAC, length_scale, track
 
 #: How every step evaluates det Ū_all unless told: the engine ``linmstmm freqs`` uses in a
 #: new process. Not "auto" (which follows what this process has loaded), so that a step
@@ -54,11 +51,6 @@ ENGINE = "numpy"
 #: Stations along each beam for the mode shapes of a step: its ends (a step's shapes are
 #: read at the points; the points' displacements do not depend on the stations).
 SHAPE_STATIONS = 2
-
-
-#: A column whose shape's MAC against its shape at the neighbouring step is below this
-#: holds another mode there (:attr:`SweepResult.switched`).
-SAME_MODE_MAC = 0.5
 
 
 @dataclass(frozen=True)
@@ -392,7 +384,7 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
     solutions, label = run_steps(models, solve, previous if warm_start else [None] * len(models),
                                  workers, dask, progress)
     if track_modes:
-        order, mac = track([s.shapes for s in solutions], previous, count, _length_scale(model))
+        order, mac = track([s.shapes for s in solutions], previous, count, length_scale(model))
     else:  # every column its rank
         found = np.array([s.frequencies_hz.size for s in solutions])[:, None]
         order = np.where(np.arange(count) < found, np.arange(count), -1)
@@ -405,50 +397,6 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
         np.array([s.rigid_body_modes for s in solutions], dtype=int),
         {i: s.note for i, s in enumerate(solutions) if s.note}, time.perf_counter() - start, label,
         engine, warm_start)
-
-
-def track(shapes, previous, count: int, length: float) -> tuple[np.ndarray, np.ndarray]:
-    """Columns that follow mode shapes from step to step.
-
-    Parameters
-    ----------
-    shapes : list of ndarray
-        Per step (m, p, 6) shapes at the points (m <= count).
-    previous : list of int or None
-        Per step the index of the step it is tracked from (None: ranks as they are).
-    count : int
-        Columns.
-    length : float
-        m, the model's size; rotations are weighted by it in the MAC.
-
-    Returns
-    -------
-    order : ndarray
-        (steps, count) int: rank of each column's mode, -1 where none.
-    mac : ndarray
-        (steps, count): MAC of each column against the same column at the previous step.
-    """
-    # here, not at the top: importing scipy.optimize costs every command 0.1 s
-    from scipy.optimize import linear_sum_assignment
-
-    steps = len(shapes)
-    order = np.full((steps, count), -1, dtype=int)
-    mac = np.full((steps, count), np.nan)
-    vectors = [_mac_vectors(s, length) for s in shapes]
-    for step, back in enumerate(previous):
-        found = vectors[step].shape[0]
-        if back is None:
-            order[step, :found], mac[step, :found] = np.arange(found), 1.0
-            continue
-        columns = np.flatnonzero(order[back] >= 0)
-        matrix = _mac(vectors[back][order[back, columns]], vectors[step])
-        rows, ranks = linear_sum_assignment(matrix, maximize=True)
-        order[step, columns[rows]] = ranks
-        mac[step, columns[rows]] = matrix[rows, ranks]
-        unclaimed = np.setdiff1d(np.arange(found), ranks)
-        free = np.flatnonzero(order[step] < 0)[:unclaimed.size]
-        order[step, free] = unclaimed[:free.size]
-    return order, mac
 
 
 def _check_steps(steps: list, shape: tuple) -> None:
@@ -469,26 +417,6 @@ def _edited(model: Model, keys, step: dict) -> Model:
         where = ", ".join(f"{key.text} = {step[key.text]:g}" for key in keys)
         raise ModelError(error.file, f"{error.message} (in the step {where})",
                          element=error.element, key=error.key) from None
-
-
-def _length_scale(model: Model) -> float:
-    """m: the diagonal of the box around the model's points and mass centres (1 if that is 0)."""
-    places = np.array([*model.points.values(), *(r.com for r in model.rigids)], dtype=float)
-    size = float(np.linalg.norm(np.ptp(places, axis=0)))
-    return size if size > 0 else 1.0
-
-
-def _mac_vectors(shapes: np.ndarray, length: float) -> np.ndarray:
-    """(m, 6 p) shape vectors: translations, and rotations times ``length`` (both m)."""
-    scaled = np.concatenate([shapes[..., :3], shapes[..., 3:] * length], axis=-1)
-    return scaled.reshape(scaled.shape[0], -1)
-
-
-def _mac(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(n_a, n_b) MAC between the rows of ``a`` and of ``b``."""
-    from linmstmm.modes import mac_matrix
-
-    return mac_matrix(a, b) if a.size and b.size else np.zeros((a.shape[0], b.shape[0]))
 
 
 def _padded(rows, count: int) -> np.ndarray:

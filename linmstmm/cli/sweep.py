@@ -21,7 +21,8 @@ from linmstmm.cli.common import (
 )
 from linmstmm.determinant import ENGINES
 from linmstmm.parameters import parse_key, unit
-from linmstmm.sweep import ENGINE, SAME_MODE_MAC, Vary, grid, sweep
+from linmstmm.sweep import ENGINE, Vary, grid, sweep
+from linmstmm.tracking import SAME_MODE_MAC
 
 #: Elastic frequencies per step unless --count says otherwise.
 DEFAULT_COUNT = 5

@@ -10,9 +10,17 @@ import scipy.sparse as sp
 
 from linmstmm.fe.constraints import _drop_debris, _eliminate
 from linmstmm.fe.elements import frame_elements
-from linmstmm.fe.layout import DofIndex, _beam_axes, _layout, _Triplets, element_maps, spring_rows
+from linmstmm.fe.layout import (
+    DofIndex,
+    _beam_axes,
+    _layout,
+    _Triplets,
+    element_maps,
+    spring_rows,
+)
 from linmstmm.fe.masses import _negligible_mass_removed
 from linmstmm.fe.rigid_motions import _rigid_basis, _rigid_motions
+from linmstmm.fe.sparse import csr_of_distinct
 from linmstmm.model import Model
 
 
@@ -138,7 +146,7 @@ def _port_map(model, layout, constraints):
     rows = np.concatenate([np.repeat(ports[first], 6, axis=1).ravel(), kept])
     cols = np.concatenate([np.tile(centres[first], 6).ravel(), kept])
     values = np.concatenate([kinematics[first].ravel(), np.ones(len(kept))])
-    return sp.csr_matrix((values, (rows, column_of[cols])), shape=(n_full, len(kept))), kept
+    return csr_of_distinct(rows, column_of[cols], values, (n_full, len(kept))), kept
 
 
 @dataclass(frozen=True, eq=False)
@@ -177,7 +185,7 @@ def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
     stiffness and mass are left to the caller)."""
     layout = _layout(model, elements_per_beam)
     n_full = 6 * layout.n_nodes
-    strains, mass, constraints = _Triplets(), _Triplets(), _Triplets()
+    strains, mass, constraints = _Triplets(), _Triplets(repeats=True), _Triplets()
     stiffness = []
     beams = _beam_elements(model, layout, elements_per_beam)
     _add_beam_constraints(beams, constraints)
@@ -266,13 +274,18 @@ def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
     G = (strains.matrix(n_full) @ T).tocsr()
     D = np.concatenate(stiffness) if stiffness else np.zeros(0)
     M = _symmetric(T.T @ mass.matrix(n_full, n_full) @ T)
-    K = _symmetric(G.T @ sp.diags(D) @ G)
+    K = _symmetric(_scaled_transpose(G, D) @ G)
     motions, weight = _rigid_motions(model, layout)
     rigid_modes, supports = _rigid_basis(motions[masters], M, weight[masters])
     return FEModel(M=M, K=K, T=T, G=G, D=D, dof_index=layout.index,
                    n_dof=T.shape[1], n_full=n_full, elements_per_beam=n,
                    rigid_modes=rigid_modes, supports=supports, frames=layout.frames,
                    massive=np.flatnonzero(M.diagonal()))
+
+
+def _scaled_transpose(G: sp.csr_matrix, D: np.ndarray) -> sp.csc_matrix:
+    """``G.T @ diag(D)`` without a product: G's entries times their row's D, transposed."""
+    return sp.csc_matrix((G.data * np.repeat(D, np.diff(G.indptr)), G.indices, G.indptr), shape=G.shape[::-1])
 
 
 def _symmetric(matrix) -> sp.csr_matrix:

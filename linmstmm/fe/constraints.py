@@ -59,8 +59,7 @@ def _in_masters(cols: list, values: list, expression: dict) -> tuple[dict, float
         for master, e in (((j, 1.0),) if terms is None else terms.items()):
             term = c * e
             row[master] = row.get(master, 0.0) + term
-            if abs(term) > scale:
-                scale = abs(term)
+            scale = max(scale, abs(term))
     return row, scale
 
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from linmstmm.fe.sparse import csr_of_distinct
 from linmstmm.model import Model
 
 
@@ -113,11 +114,17 @@ def element_maps(nodes: np.ndarray, axes: np.ndarray) -> tuple[np.ndarray, np.nd
 
 
 class _Triplets:
-    """Growing COO lists (rows, cols, values) of one sparse matrix."""
+    """Growing COO lists (rows, cols, values) of one sparse matrix.
 
-    def __init__(self):
+    repeats : True where entries may fall on the same position (mass blocks that
+    share a node) and are summed; False where each position is written once
+    (strain and constraint rows), and the matrix is built without summing.
+    """
+
+    def __init__(self, repeats: bool = False):
         self.rows, self.cols, self.values = [], [], []
         self.n_rows = 0
+        self.repeats = repeats
 
     def add(self, rows, cols, values):
         rows, cols, values = np.broadcast_arrays(rows, cols, values)
@@ -138,15 +145,18 @@ class _Triplets:
         self.n_rows += other.n_rows
 
     def matrix(self, n_cols, n_rows=None) -> sp.csr_matrix:
+        """(n_rows, n_cols) canonical CSR of the entries, zeros dropped (summed first
+        where they repeat, in scipy's order); ``n_rows`` defaults to the rows numbered."""
         n_rows = self.n_rows if n_rows is None else n_rows
         if not self.rows:
             return sp.csr_matrix((n_rows, n_cols))
-        coo = sp.coo_matrix((np.concatenate(self.values),
-                             (np.concatenate(self.rows), np.concatenate(self.cols))),
-                            shape=(n_rows, n_cols))
-        matrix = coo.tocsr()
-        matrix.eliminate_zeros()
-        return matrix
+        rows, cols, values = (np.concatenate(part) for part in (self.rows, self.cols, self.values))
+        if self.repeats:
+            matrix = sp.coo_matrix((values, (rows, cols)), shape=(n_rows, n_cols)).tocsr()
+            matrix.eliminate_zeros()
+            return matrix
+        nonzero = values != 0
+        return csr_of_distinct(rows[nonzero], cols[nonzero], values[nonzero], (n_rows, n_cols))
 
 
 def _spring_directions(spring, index: DofIndex, kept_only: bool):

@@ -5,8 +5,6 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.linalg as la
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from linmstmm.fe.constraints import NEGLIGIBLE_ENTRY, REDUNDANT_CONSTRAINT
 from linmstmm.fe.layout import spring_rows
@@ -30,11 +28,20 @@ def _edges(model, layout) -> tuple[np.ndarray, np.ndarray]:
 
 def _components(edges: np.ndarray, n_nodes: int) -> np.ndarray:
     """(n_nodes,) label of the connected part each node is in, parts numbered in the
-    order of their first node; ``edges`` (e, 2) the node pairs joined."""
-    order = np.argsort(edges[:, 0], kind="stable")
-    starts = np.searchsorted(edges[order, 0], np.arange(n_nodes + 1))
-    graph = sp.csr_matrix((np.ones(len(edges)), edges[order, 1], starts), shape=(n_nodes, n_nodes))
-    return connected_components(graph, directed=True, connection="weak")[1]
+    order of their lowest node; ``edges`` (e, 2) the node pairs joined.
+
+    Each node points at a lower one of its part (at first itself): every edge hooks
+    the higher of its two ends' roots onto the lower, and pointers are followed to
+    their roots, until every edge joins nodes of one root, the lowest of the part.
+    """
+    root = np.arange(n_nodes)
+    while True:
+        a, b = root[edges[:, 0]], root[edges[:, 1]]
+        if np.array_equal(a, b):
+            return np.unique(root, return_inverse=True)[1]
+        np.minimum.at(root, np.maximum(a, b), np.minimum(a, b))
+        while not np.array_equal(root[root], root):
+            root = root[root]
 
 
 def _rigid_field(positions, frames, segments) -> tuple[np.ndarray, float]:
@@ -51,11 +58,15 @@ def _rigid_field(positions, frames, segments) -> tuple[np.ndarray, float]:
     size = np.abs(arm).max()
     if size <= NEGLIGIBLE_ENTRY * np.abs(positions).max():
         arm, size = np.zeros_like(arm), 1.0
+    unit = np.eye(3)[:, None, :]                                   # (3 axes, 1, 3)
+    moment = np.stack([unit[..., 1] * arm[:, 2] - unit[..., 2] * arm[:, 1],   # unit × arm, as np.cross
+                       unit[..., 2] * arm[:, 0] - unit[..., 0] * arm[:, 2],
+                       unit[..., 0] * arm[:, 1] - unit[..., 1] * arm[:, 0]], axis=-1)
     field = np.zeros((len(positions), 6, 6))
-    for k, unit in enumerate(np.eye(3)):
-        field[:, :3, k] = frames @ unit
-        field[:, :3, 3 + k] = (frames @ np.cross(unit, arm)[:, :, None])[:, :, 0] / size
-        field[:, 3:, 3 + k] = frames @ unit / size
+    turned = frames + 0.0                                          # = frames @ unit k, column k (no −0)
+    field[:, :3, :3] = turned
+    field[:, :3, 3:] = np.moveaxis((frames @ moment[..., None])[..., 0], 0, 2) / size
+    field[:, 3:, 3:] = turned / size
     placed = np.zeros((len(positions), 6, 6 * (segments.max() + 1)))
     columns = 6 * segments[:, None, None] + np.arange(6)
     placed[np.arange(len(positions))[:, None, None], np.arange(6)[:, None], columns] = field

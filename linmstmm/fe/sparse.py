@@ -20,10 +20,18 @@ def csr_of_distinct(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shap
     Returns
     -------
     scipy.sparse.csr_matrix of ``shape``, canonical.
+
+    Raises
+    ------
+    ValueError
+        If a position is given twice.
     """
     order = np.lexsort((cols, rows))
+    if np.any((np.diff(rows[order]) == 0) & (np.diff(cols[order]) == 0)):
+        raise ValueError("csr_of_distinct: a (row, col) position is given twice")
     starts = np.zeros(shape[0] + 1, dtype=np.int64)
     np.cumsum(np.bincount(rows, minlength=shape[0]), out=starts[1:])
     matrix = sp.csr_matrix((np.asarray(values, float)[order], cols[order], starts), shape=shape)
     matrix.has_sorted_indices = True
     return matrix
+

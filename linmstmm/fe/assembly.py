@@ -20,7 +20,7 @@ from linmstmm.fe.layout import (
 )
 from linmstmm.fe.masses import _negligible_mass_removed
 from linmstmm.fe.rigid_motions import _rigid_basis, _rigid_motions
-from linmstmm.fe.sparse import csr_of_distinct
+from linmstmm.fe.sparse import csr_of_distinct, symmetric_part
 from linmstmm.model import Model
 
 
@@ -289,4 +289,5 @@ def _scaled_transpose(G: sp.csr_matrix, D: np.ndarray) -> sp.csc_matrix:
 
 
 def _symmetric(matrix) -> sp.csr_matrix:
-    return ((matrix + matrix.T) * 0.5).tocsr()
+    """(A + Aᵀ) / 2 of a sparse product A (:func:`~linmstmm.fe.sparse.symmetric_part`)."""
+    return symmetric_part(matrix)

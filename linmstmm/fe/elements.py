@@ -46,16 +46,31 @@ def frame_elements(beams, h: np.ndarray):
     """
     E, G, rho, A, Iy, Iz, J, Ip = (np.array([getattr(beam, key) for beam in beams], float)
                                     for key in ("E", "G", "rho", "A", "Iy", "Iz", "J", "Ip"))
-    length = h[:, None]
-    u1, v1, w1, tx1, ty1, tz1, u2, v2, w2, tx2, ty2, tz2 = np.eye(12)
-    rows = np.stack([np.broadcast_to(tz2 - tz1, (len(h), 12)), (tz1 + tz2) / 2 - (v2 - v1) / length,
-                     np.broadcast_to(ty2 - ty1, (len(h), 12)), (ty1 + ty2) / 2 + (w2 - w1) / length,
-                     np.broadcast_to(u2 - u1, (len(h), 12)), np.broadcast_to(tx2 - tx1, (len(h), 12))], axis=1)
+    rows = _ROWS + (1 / h)[:, None, None] * _ROWS_PER_LENGTH
     d = np.stack([E * Iz / h, 12 * E * Iz / h, E * Iy / h, 12 * E * Iy / h, E * A / h, G * J / h], axis=1)
     strain = np.ones((len(h), 6), bool)
     strain[:, 4] = [beam.axial for beam in beams]
     strain[:, 5] = [beam.torsion for beam in beams]
     return rows, d, _frame_masses(rho * A, rho * Ip, h), strain
+
+
+def _deformation_rows() -> tuple[np.ndarray, np.ndarray]:
+    """(6, 12) the deformation rows of :func:`frame_elements` as a part that does not
+    depend on the element length and (6, 12) one to divide by it (m)."""
+    u1, v1, w1, tx1, ty1, tz1, u2, v2, w2, tx2, ty2, tz2 = np.eye(12)
+    zero = np.zeros(12)
+    fixed = np.array([tz2 - tz1, (tz1 + tz2) / 2, ty2 - ty1, (ty1 + ty2) / 2, u2 - u1, tx2 - tx1])
+    per_length = np.array([zero, v1 - v2, zero, w2 - w1, zero, zero])
+    return fixed, per_length
+
+
+_ROWS, _ROWS_PER_LENGTH = _deformation_rows()
+#: Cubic Hermite consistent mass (v, θz at both nodes) / (ρA h / 420): constant, h and h² parts.
+_HERMITE = (np.array([[156.0, 0, 54, 0], [0, 0, 0, 0], [54, 0, 156, 0], [0, 0, 0, 0]]),
+            np.array([[0.0, 22, 0, -13], [22, 0, 13, 0], [0, 13, 0, -22], [-13, 0, -22, 0]]),
+            np.array([[0.0, 0, 0, 0], [0, 4, 0, -3], [0, 0, 0, 0], [0, -3, 0, 4]]))
+_BAR = np.array([[2.0, 1.0], [1.0, 2.0]]) / 6.0
+_FLIP = np.outer([1.0, -1.0, 1.0, -1.0], [1.0, -1.0, 1.0, -1.0])    # (v, θz) -> (w, −θy)
 
 
 def _frame_masses(rho_a: np.ndarray, rho_ip: np.ndarray, h: np.ndarray) -> np.ndarray:
@@ -65,18 +80,13 @@ def _frame_masses(rho_a: np.ndarray, rho_ip: np.ndarray, h: np.ndarray) -> np.nd
     h : (b,) element lengths, m.
     """
     m = np.zeros((len(h), 12, 12))
-    bar = np.array([[2.0, 1.0], [1.0, 2.0]]) / 6.0
-    m[:, [[0], [6]], [0, 6]] = (rho_a * h)[:, None, None] * bar                   # axial
-    m[:, [[3], [9]], [3, 9]] = (rho_ip * h)[:, None, None] * bar                  # torsion
+    m[:, [[0], [6]], [0, 6]] = (rho_a * h)[:, None, None] * _BAR                  # axial
+    m[:, [[3], [9]], [3, 9]] = (rho_ip * h)[:, None, None] * _BAR                 # torsion
     h = h[:, None, None]
-    hermite = rho_a[:, None, None] * h / 420.0 * np.block([
-        [np.full_like(h, 156.0), 22 * h, np.full_like(h, 54.0), -13 * h],
-        [22 * h, 4 * h * h, 13 * h, -3 * h * h],
-        [np.full_like(h, 54.0), 13 * h, np.full_like(h, 156.0), -22 * h],
-        [-13 * h, -3 * h * h, -22 * h, 4 * h * h]])
+    constant, linear, square = _HERMITE
+    hermite = rho_a[:, None, None] * h / 420.0 * (constant + linear * h + square * h * h)
     m[:, [[1], [5], [7], [11]], [1, 5, 7, 11]] = hermite                           # v, θz
-    flip = np.array([1.0, -1.0, 1.0, -1.0])                                        # (w, -θy)
-    m[:, [[2], [4], [8], [10]], [2, 4, 8, 10]] = hermite * np.outer(flip, flip)
+    m[:, [[2], [4], [8], [10]], [2, 4, 8, 10]] = hermite * _FLIP                   # w, θy
     return m
 
 

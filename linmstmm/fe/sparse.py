@@ -26,12 +26,38 @@ def csr_of_distinct(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shap
     ValueError
         If a position is given twice.
     """
-    order = np.lexsort((cols, rows))
-    if np.any((np.diff(rows[order]) == 0) & (np.diff(cols[order]) == 0)):
+    position = rows * shape[1] + cols
+    order = np.argsort(position)
+    position = position[order]
+    if np.any(position[1:] == position[:-1]):
         raise ValueError("csr_of_distinct: a (row, col) position is given twice")
-    starts = np.zeros(shape[0] + 1, dtype=np.int64)
-    np.cumsum(np.bincount(rows, minlength=shape[0]), out=starts[1:])
+    starts = np.searchsorted(position, np.arange(shape[0] + 1) * shape[1])
     matrix = sp.csr_matrix((np.asarray(values, float)[order], cols[order], starts), shape=shape)
     matrix.has_sorted_indices = True
     return matrix
 
+
+def symmetric_part(matrix) -> sp.csr_matrix:
+    """(A + Aᵀ) / 2 of a square CSR or CSC matrix A without repeated positions, as
+    canonical CSR: each entry is formed as scipy's sum forms it, (a + b) * 0.5, and
+    positions where a + b is zero are dropped.
+
+    Parameters
+    ----------
+    matrix : (n, n) scipy.sparse CSR or CSC matrix.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, (n, n), symmetric bit for bit.
+    """
+    n = matrix.shape[0]
+    major = np.repeat(np.arange(n), np.diff(matrix.indptr))
+    rows, cols = (major, matrix.indices) if matrix.format == "csr" else (matrix.indices, major)
+    position = np.concatenate([rows * n + cols, cols * n + rows])
+    order = np.argsort(position, kind="stable")
+    position = position[order]
+    first = np.flatnonzero(np.diff(position, prepend=-1))
+    sums = np.add.reduceat(np.concatenate([matrix.data, matrix.data])[order], first)
+    kept = sums != 0
+    position = position[first][kept]
+    return csr_of_distinct(position // n, position % n, sums[kept] * 0.5, (n, n))

@@ -26,13 +26,18 @@ def csr_of_distinct(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shap
     ValueError
         If a position is given twice.
     """
-    position = rows * shape[1] + cols
+    position = rows.astype(np.int64) * shape[1] + cols
     order = np.argsort(position)
     position = position[order]
     if np.any(position[1:] == position[:-1]):
         raise ValueError("csr_of_distinct: a (row, col) position is given twice")
+    return _csr_of_sorted(position, cols[order], np.asarray(values, float)[order], shape)
+
+
+def _csr_of_sorted(position: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> sp.csr_matrix:
+    """CSR of entries at ascending distinct ``position`` = row × n_cols + col."""
     starts = np.searchsorted(position, np.arange(shape[0] + 1) * shape[1])
-    matrix = sp.csr_matrix((np.asarray(values, float)[order], cols[order], starts), shape=shape)
+    matrix = sp.csr_matrix((values, cols, starts), shape=shape)
     matrix.has_sorted_indices = True
     return matrix
 
@@ -51,8 +56,9 @@ def symmetric_part(matrix) -> sp.csr_matrix:
     scipy.sparse.csr_matrix, (n, n), symmetric bit for bit.
     """
     n = matrix.shape[0]
-    major = np.repeat(np.arange(n), np.diff(matrix.indptr))
-    rows, cols = (major, matrix.indices) if matrix.format == "csr" else (matrix.indices, major)
+    major = np.repeat(np.arange(n, dtype=np.int64), np.diff(matrix.indptr))
+    minor = matrix.indices.astype(np.int64)
+    rows, cols = (major, minor) if matrix.format == "csr" else (minor, major)
     position = np.concatenate([rows * n + cols, cols * n + rows])
     order = np.argsort(position, kind="stable")
     position = position[order]
@@ -60,4 +66,4 @@ def symmetric_part(matrix) -> sp.csr_matrix:
     sums = np.add.reduceat(np.concatenate([matrix.data, matrix.data])[order], first)
     kept = sums != 0
     position = position[first][kept]
-    return csr_of_distinct(position // n, position % n, sums[kept] * 0.5, (n, n))
+    return _csr_of_sorted(position, position % n, sums[kept] * 0.5, (n, n))

@@ -131,10 +131,10 @@ def _port_map(model, layout, constraints):
     bodies = [(body, port) for body in model.rigids for port in body.ports]
     owned = {}
     first = np.array([owned.setdefault(port, i) == i for i, (_, port) in enumerate(bodies)], bool)
-    ports = 6 * np.array([layout.index.points[port] for _, port in bodies], int).reshape(-1, 1) + np.arange(6)
-    centres = 6 * np.array([layout.index.rigids[body.name] for body, _ in bodies], int).reshape(-1, 1) + np.arange(6)
-    kinematics = _port_kinematics(np.array([model.points[port] for _, port in bodies], float).reshape(-1, 3),
-                                  np.array([body.com for body, _ in bodies], float).reshape(-1, 3))
+    port_nodes = np.array([layout.index.points[port] for _, port in bodies], int)
+    centre_nodes = np.array([layout.index.rigids[body.name] for body, _ in bodies], int)
+    ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
+    kinematics = _port_kinematics(layout.positions[port_nodes], layout.positions[centre_nodes])
     joined = constraints.new_rows(6 * np.count_nonzero(~first)).reshape(-1, 6, 1)
     constraints.add(joined, ports[~first][:, None, :], np.eye(6))
     constraints.add(joined, centres[~first][:, None, :], -kinematics[~first])

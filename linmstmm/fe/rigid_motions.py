@@ -95,17 +95,17 @@ def _held_directions(model, layout, segments) -> list[tuple[np.ndarray, np.ndarr
             (np.take_along_axis(cols, ascending, axis=1), np.take_along_axis(values, ascending, axis=1))]
 
 
-def _held_rows(directions, part: np.ndarray, dofs: np.ndarray, motions: np.ndarray) -> np.ndarray:
-    """(k, r) the held directions on the DOFs ``dofs`` (ascending) of the nodes ``part``
-    applied to ``motions`` (len(dofs), r): each row summed over its columns in ascending
-    order, as a sparse product does."""
-    local = np.full(dofs.max() + 1, -1)
-    local[dofs] = np.arange(len(dofs))
+def _held_rows(directions, in_part: np.ndarray, motions: np.ndarray) -> np.ndarray:
+    """(k, r) the held directions on the nodes ``in_part`` ((n_nodes,) bool) applied to
+    ``motions`` (6 per node of the part, r): each row summed over its columns in
+    ascending order, as a sparse product does."""
+    rank = np.cumsum(in_part) - 1                     # a node's place among the part's
     blocks = []
     for cols, values in directions:
-        on_part = np.isin(cols[:, 0] // 6, part)
-        block = np.zeros((np.count_nonzero(on_part), motions.shape[1]))
-        for col, value in zip(local[cols[on_part]].T, values[on_part].T):
+        on_part = in_part[cols[:, 0] // 6]
+        cols, values = cols[on_part], values[on_part]
+        block = np.zeros((len(cols), motions.shape[1]))
+        for col, value in zip((6 * rank[cols // 6] + cols % 6).T, values.T):
             block += value[:, None] * motions[col]
         blocks.append(block)
     return np.concatenate(blocks)
@@ -132,13 +132,14 @@ def _rigid_motions(model, layout) -> tuple[np.ndarray, np.ndarray]:
     directions = _held_directions(model, layout, segments)
     motions, weights = [], np.ones(6 * layout.n_nodes)
     for label in np.unique(labels):
-        nodes = np.flatnonzero(labels == label)
+        in_part = labels == label
+        nodes = np.flatnonzero(in_part)
         dofs = (6 * nodes[:, None] + np.arange(6)).ravel()
         field, size = _rigid_field(layout.positions[nodes], layout.frames[nodes],
                                    np.unique(segments[nodes], return_inverse=True)[1])
         weight = np.tile(np.r_[np.ones(3), np.full(3, size)], len(nodes))  # rotation rows of order one
         weights[dofs] = weight
-        rows = _held_rows(directions, nodes, dofs, weight[:, None] * field)
+        rows = _held_rows(directions, in_part, weight[:, None] * field)
         allowed = la.null_space(rows, rcond=REDUNDANT_CONSTRAINT) if rows.shape[0] else np.eye(field.shape[1])
         if allowed.shape[1]:
             motion = np.zeros((6 * layout.n_nodes, allowed.shape[1]))

@@ -3,96 +3,121 @@ elimination T of a meshed model (:class:`FEModel`, :func:`assemble`)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
 
 from linmstmm.fe.constraints import _drop_debris, _eliminate
-from linmstmm.fe.elements import beam_element
-from linmstmm.fe.layout import DofIndex, _layout, _spring_directions, _Triplets
+from linmstmm.fe.elements import frame_elements
+from linmstmm.fe.layout import (
+    DofIndex,
+    _beam_axes,
+    _layout,
+    _Triplets,
+    element_maps,
+    spring_rows,
+)
 from linmstmm.fe.masses import _negligible_mass_removed
 from linmstmm.fe.rigid_motions import _rigid_basis, _rigid_motions
+from linmstmm.fe.sparse import csr_of_distinct, symmetric_part
 from linmstmm.model import Model
 
 
 def beam_element_dofs(layout, beam, n):
     """(n, 12) full DOFs of the elements of ``beam`` and (n, 12, 12) their maps from
     those DOFs to the element's local ones (end nodes are inertial, interior ones local)."""
-    nodes = layout.index.beam_nodes[beam.name]
-    to_local = np.tile(np.eye(12), (n, 1, 1))
-    axes = np.asarray(beam.axes, float)
-    for block in (0, 3):
-        to_local[0, block:block + 3, block:block + 3] = axes
-        to_local[-1, 6 + block:9 + block, 6 + block:9 + block] = axes
-    dofs = np.concatenate([6 * nodes[:-1, None] + np.arange(6),
-                           6 * nodes[1:, None] + np.arange(6)], axis=1)
-    return dofs, to_local
+    dofs, to_local = element_maps(layout.index.beam_nodes[beam.name][None], np.asarray(beam.axes, float)[None])
+    return dofs[0], to_local[0]
 
 
-def _add_beams(model, layout, n, strains, stiffness, mass):
-    """Scatter every beam element (vectorised over the elements of a beam)."""
-    for beam in model.beams:
-        g, d, m, _ = beam_element(beam, beam.length / n)
-        dofs, to_local = beam_element_dofs(layout, beam, n)
-        g_elements = g @ to_local                              # (n, s, 12)
-        rows = strains.new_rows(n * len(d)).reshape(n, len(d))
-        strains.add(rows[:, :, None], dofs[:, None, :], g_elements)
-        stiffness.append(np.tile(d, n))
-        m_elements = np.swapaxes(to_local, 1, 2) @ m @ to_local
-        mass.add(dofs[:, :, None], dofs[:, None, :], m_elements)
+class _BeamElements(NamedTuple):
+    """The elements of every beam (``model.beams`` order) on a layout of n per beam.
+
+    dofs : (b, n, 12) each element's full DOFs. to_local : (b, n, 12, 12) maps from
+    them to its local ones. rows : (b, n, 6, 12) its six deformation rows on its full
+    DOFs (m or rad). d : (b, 6) their stiffnesses. strain : (b, 6) which rows are
+    strains (the others constraints). m : (b, 12, 12) local consistent masses, kg and
+    kg m² (:func:`~linmstmm.fe.elements.frame_elements`).
+    """
+
+    dofs: np.ndarray
+    to_local: np.ndarray
+    rows: np.ndarray
+    d: np.ndarray
+    strain: np.ndarray
+    m: np.ndarray
 
 
-def _add_beam_constraints(model, layout, n, constraints):
+def _beam_elements(model, layout, n) -> _BeamElements:
+    """The :class:`_BeamElements` of ``model`` on ``layout`` (``n`` elements per beam)."""
+    h = np.array([beam.length for beam in model.beams], float) / n
+    rows, d, m, strain = frame_elements(model.beams, h)
+    dofs, to_local = element_maps(layout.beam_table, _beam_axes(model.beams))
+    return _BeamElements(dofs, to_local, rows[:, None] @ to_local, d, strain, m)
+
+
+def _add_beams(elements: _BeamElements, strains, stiffness, mass):
+    """Scatter the strains and masses of every beam element (beam after beam, element
+    after element)."""
+    dofs, to_local, rows, d, strain, m = elements
+    n = dofs.shape[1]
+    kept = np.broadcast_to(strain[:, None], rows.shape[:3])
+    numbers = np.zeros(kept.shape, int)
+    numbers[kept] = strains.new_rows(np.count_nonzero(kept))
+    strains.add(numbers[kept][:, None], np.broadcast_to(dofs[:, :, None], kept.shape + (12,))[kept], rows[kept])
+    stiffness.append(np.repeat(d, n, axis=0)[np.repeat(strain, n, axis=0)])
+    mass.add(dofs[..., :, None], dofs[..., None, :], np.swapaxes(to_local, 2, 3) @ m[:, None] @ to_local)
+
+
+def _add_beam_constraints(elements: _BeamElements, constraints):
     """Directions a beam declares rigid (``axial`` or ``torsion`` False) become constraints."""
-    for beam in model.beams:
-        c = beam_element(beam, beam.length / n)[3]
-        if len(c):
-            dofs, to_local = beam_element_dofs(layout, beam, n)
-            rows = constraints.new_rows(n * len(c)).reshape(n, len(c))
-            constraints.add(rows[:, :, None], dofs[:, None, :], c @ to_local)
+    rigid = np.broadcast_to(~elements.strain[:, None], elements.rows.shape[:3])
+    if rigid.any():
+        constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None],
+                        np.broadcast_to(elements.dofs[:, :, None], rigid.shape + (12,))[rigid],
+                        elements.rows[rigid])
 
 
 def _add_springs(model, layout, strains, stiffness, constraints):
     """Finite spring directions become strains, ``inf`` ones constraints, released ones nothing
     (each kind written as one block of rows, in the springs' order)."""
-    finite, rigid = ([], [], []), ([], [])
-    for spring in model.springs:
-        for component, cols, values in _spring_directions(spring, layout.index, kept_only=True):
-            k = float(spring.k[component])
-            if np.isinf(k):
-                rigid[0].append(cols)
-                rigid[1].append(values)
-            else:
-                finite[0].append(cols)
-                finite[1].append(values)
-                finite[2].append(k)
-    if finite[0]:
-        strains.add(strains.new_rows(len(finite[0]))[:, None], np.array(finite[0]), np.array(finite[1]))
-        stiffness.append(np.array(finite[2]))
-    if rigid[0]:
-        constraints.add(constraints.new_rows(len(rigid[0]))[:, None], np.array(rigid[0]), np.array(rigid[1]))
+    owners, components, cols, values = spring_rows(model.springs, layout.index, kept_only=True)
+    k = np.array([spring.k for spring in model.springs], float).reshape(-1, 6)[owners, components]
+    rigid = np.isinf(k)
+    strains.add(strains.new_rows(np.count_nonzero(~rigid))[:, None], cols[~rigid], values[~rigid])
+    stiffness.append(k[~rigid])
+    constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None], cols[rigid], values[rigid])
 
 
 def _add_rigid_masses(model, layout, mass):
-    for body in model.rigids:
-        dofs = layout.index.rigid(body.name)
-        block = np.zeros((6, 6))
-        block[:3, :3] = body.mass * np.eye(3)
-        block[3:, 3:] = body.inertia
-        mass.add(dofs[:, None], dofs[None, :], block)
+    """Each body's mass and inertia on the DOFs of its mass centre."""
+    dofs = 6 * np.array([layout.index.rigids[body.name] for body in model.rigids], int)[:, None] + np.arange(6)
+    blocks = np.zeros((len(dofs), 6, 6))
+    blocks[:, [0, 1, 2], [0, 1, 2]] = np.array([body.mass for body in model.rigids], float)[:, None]
+    blocks[:, 3:, 3:] = np.array([body.inertia for body in model.rigids], float).reshape(-1, 3, 3)
+    mass.add(dofs[:, :, None], dofs[:, None, :], blocks)
 
 
 def _add_boundaries(model, layout, constraints):
-    for point, fixed in model.boundary.items():
-        dofs = layout.index.point(point)[np.asarray(fixed, bool)]
-        constraints.add(constraints.new_rows(len(dofs)), dofs, 1.0)
+    """Every fixed component of a point becomes a constraint row of its own."""
+    dofs = [layout.index.point(point)[np.asarray(fixed, bool)] for point, fixed in model.boundary.items()]
+    dofs = np.concatenate(dofs) if dofs else np.zeros(0, int)
+    constraints.add(constraints.new_rows(len(dofs)), dofs, 1.0)
 
 
-def _port_kinematics(port, centre) -> np.ndarray:
-    """(6, 6) map body-centre DOFs -> port DOFs: u_p = u_c + θ × (p − c), θ_p = θ."""
-    r = np.asarray(port, float) - np.asarray(centre, float)
-    block = np.eye(6)
-    block[:3, 3:] = -np.array([[0.0, -r[2], r[1]], [r[2], 0.0, -r[0]], [-r[1], r[0], 0.0]])
+def _port_kinematics(ports, centres) -> np.ndarray:
+    """(p, 6, 6) maps body-centre DOFs -> port DOFs: u_p = u_c + θ × (p − c), θ_p = θ.
+
+    ports, centres : (p, 3) positions of the ports and of their bodies' mass centres, m.
+    """
+    r = ports - centres
+    cross = np.zeros((len(r), 3, 3))
+    cross[:, [0, 0, 1, 1, 2, 2], [1, 2, 0, 2, 0, 1]] = np.stack([-r[:, 2], r[:, 1], r[:, 2], -r[:, 0],
+                                                               -r[:, 1], r[:, 0]], axis=1)
+    block = np.zeros((len(r), 6, 6))
+    block[:, np.arange(6), np.arange(6)] = 1.0
+    block[:, :3, 3:] = -cross
     return block
 
 
@@ -103,32 +128,25 @@ def _port_map(model, layout, constraints):
     further body (the bodies are rigidly joined there).
     """
     n_full = 6 * layout.n_nodes
+    bodies = [(body, port) for body in model.rigids for port in body.ports]
+    owned = {}
+    first = np.array([owned.setdefault(port, i) == i for i, (_, port) in enumerate(bodies)], bool)
+    port_nodes = np.array([layout.index.points[port] for _, port in bodies], int)
+    centre_nodes = np.array([layout.index.rigids[body.name] for body, _ in bodies], int)
+    ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
+    kinematics = _port_kinematics(layout.positions[port_nodes], layout.positions[centre_nodes])
+    joined = constraints.new_rows(6 * np.count_nonzero(~first)).reshape(-1, 6, 1)
+    constraints.add(joined, ports[~first][:, None, :], np.eye(6))
+    constraints.add(joined, centres[~first][:, None, :], -kinematics[~first])
     slaved = np.zeros(n_full, bool)
-    rows, cols, values = [], [], []
-    owner = {}
-    for body in model.rigids:
-        centre = layout.index.rigid(body.name)
-        for port in body.ports:
-            kinematics = _port_kinematics(model.points[port], body.com)
-            dofs = layout.index.point(port)
-            if port in owner:
-                constraint_rows = constraints.new_rows(6)
-                constraints.add(constraint_rows[:, None], dofs[None, :], np.eye(6))
-                constraints.add(constraint_rows[:, None], centre[None, :], -kinematics)
-                continue
-            owner[port] = body.name
-            slaved[dofs] = True
-            rows.append(np.repeat(dofs, 6))
-            cols.append(np.tile(centre, 6))
-            values.append(kinematics.ravel())
+    slaved[ports[first]] = True
     kept = np.flatnonzero(~slaved)
     column_of = np.full(n_full, -1)
     column_of[kept] = np.arange(len(kept))
-    rows.append(kept)
-    cols.append(kept)
-    values.append(np.ones(len(kept)))
-    rows, cols, values = map(np.concatenate, (rows, cols, values))
-    return sp.csr_matrix((values, (rows, column_of[cols])), shape=(n_full, len(kept))), kept
+    rows = np.concatenate([np.repeat(ports[first], 6, axis=1).ravel(), kept])
+    cols = np.concatenate([np.tile(centres[first], 6).ravel(), kept])
+    values = np.concatenate([kinematics[first].ravel(), np.ones(len(kept))])
+    return csr_of_distinct(rows, column_of[cols], values, (n_full, len(kept))), kept
 
 
 @dataclass(frozen=True, eq=False)
@@ -148,6 +166,7 @@ class ConstrainedParts:
         the strain operator on the full DOFs (growing :class:`_Triplets`) and
         their stiffnesses (list of arrays, N/m or N m/rad).
     rigid_mass : the bodies' 6 × 6 mass blocks on the full DOFs (triplets).
+    beams : the beams' elements on ``layout`` (:class:`_BeamElements`).
     """
 
     layout: object
@@ -157,6 +176,7 @@ class ConstrainedParts:
     spring_strains: _Triplets
     spring_stiffness: list
     rigid_mass: _Triplets
+    beams: _BeamElements
 
 
 def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
@@ -165,16 +185,17 @@ def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
     stiffness and mass are left to the caller)."""
     layout = _layout(model, elements_per_beam)
     n_full = 6 * layout.n_nodes
-    strains, mass, constraints = _Triplets(), _Triplets(), _Triplets()
+    strains, mass, constraints = _Triplets(), _Triplets(repeats=True), _Triplets()
     stiffness = []
-    _add_beam_constraints(model, layout, elements_per_beam, constraints)
+    beams = _beam_elements(model, layout, elements_per_beam)
+    _add_beam_constraints(beams, constraints)
     _add_springs(model, layout, strains, stiffness, constraints)
     _add_rigid_masses(model, layout, mass)
     _add_boundaries(model, layout, constraints)
     t0, q0_dofs = _port_map(model, layout, constraints)
     reduced_constraints = _drop_debris(constraints.matrix(n_full) @ t0)
     t1, masters = _eliminate(reduced_constraints)
-    return ConstrainedParts(layout, (t0 @ t1).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass)
+    return ConstrainedParts(layout, (t0 @ t1).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass, beams)
 
 
 @dataclass(frozen=True, eq=False)
@@ -246,14 +267,14 @@ def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
     parts = constrained_parts(model, n)
     layout, T, masters, n_full = parts.layout, parts.T, parts.masters, parts.n_full
     strains, mass, stiffness = _Triplets(), parts.rigid_mass, []
-    _add_beams(model, layout, n, strains, stiffness, mass)
+    _add_beams(parts.beams, strains, stiffness, mass)
     strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
     stiffness += parts.spring_stiffness
 
     G = (strains.matrix(n_full) @ T).tocsr()
     D = np.concatenate(stiffness) if stiffness else np.zeros(0)
     M = _symmetric(T.T @ mass.matrix(n_full, n_full) @ T)
-    K = _symmetric(G.T @ sp.diags(D) @ G)
+    K = _symmetric(_scaled_transpose(G, D) @ G)
     motions, weight = _rigid_motions(model, layout)
     rigid_modes, supports = _rigid_basis(motions[masters], M, weight[masters])
     return FEModel(M=M, K=K, T=T, G=G, D=D, dof_index=layout.index,
@@ -262,5 +283,11 @@ def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
                    massive=np.flatnonzero(M.diagonal()))
 
 
+def _scaled_transpose(G: sp.csr_matrix, D: np.ndarray) -> sp.csc_matrix:
+    """``G.T @ diag(D)`` without a product: G's entries times their row's D, transposed."""
+    return sp.csc_matrix((G.data * np.repeat(D, np.diff(G.indptr)), G.indices, G.indptr), shape=G.shape[::-1])
+
+
 def _symmetric(matrix) -> sp.csr_matrix:
-    return ((matrix + matrix.T) * 0.5).tocsr()
+    """(A + Aᵀ) / 2 of a sparse product A (:func:`~linmstmm.fe.sparse.symmetric_part`)."""
+    return symmetric_part(matrix)

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from linmstmm.fe.sparse import csr_of_distinct
+
 #: A substituted constraint row whose entries all fall below this fraction of
 #: the largest term that entered it is redundant (implied by earlier rows).
 REDUNDANT_CONSTRAINT = 1e-10
@@ -26,19 +28,13 @@ def _eliminate(constraints: sp.csr_matrix) -> sp.csr_matrix:
     T1 : (n, n_masters) sparse; the masters' rows are identity rows.
     masters : (n_masters,) their indices, ascending.
     """
-    n = constraints.shape[1]
     expression = {}                     # slave -> {master: coefficient}
     users = {}                          # master -> slaves that use it
     indptr, indices, data = constraints.indptr, constraints.indices, constraints.data
     for r in range(constraints.shape[0]):
-        row, scale = {}, 0.0
-        for j, c in zip(indices[indptr[r]:indptr[r + 1]].tolist(),
-                        data[indptr[r]:indptr[r + 1]].tolist()):
-            for master, e in expression.get(j, {j: 1.0}).items():
-                term = c * e
-                row[master] = row.get(master, 0.0) + term
-                scale = max(scale, abs(term))
-        largest = max((abs(v) for v in row.values()), default=0.0)
+        row, scale = _in_masters(indices[indptr[r]:indptr[r + 1]].tolist(),
+                                 data[indptr[r]:indptr[r + 1]].tolist(), expression)
+        largest = max(map(abs, row.values()), default=0.0)
         if largest <= REDUNDANT_CONSTRAINT * scale:
             continue
         row = {m: v for m, v in row.items() if abs(v) > NEGLIGIBLE_ENTRY * largest}
@@ -51,15 +47,34 @@ def _eliminate(constraints: sp.csr_matrix) -> sp.csr_matrix:
         expression[slave] = solved
         for master in solved:
             users.setdefault(master, set()).add(slave)
-    masters = np.array(sorted(set(range(n)) - set(expression)), dtype=int)
-    column = {m: i for i, m in enumerate(masters.tolist())}
-    rows, cols, values = [masters], [np.arange(len(masters))], [np.ones(len(masters))]
-    for slave, terms in expression.items():
-        rows.append(np.full(len(terms), slave))
-        cols.append(np.array([column[m] for m in terms], dtype=int))
-        values.append(np.array(list(terms.values()), float))
-    rows, cols, values = map(np.concatenate, (rows, cols, values))
-    return sp.csr_matrix((values, (rows, cols)), shape=(n, len(masters))), masters
+    return _basis(expression, constraints.shape[1])
+
+
+def _in_masters(cols: list, values: list, expression: dict) -> tuple[dict, float]:
+    """One constraint row (its columns and values) written in the current masters:
+    {master: coefficient}, and the largest term that entered it."""
+    row, scale = {}, 0.0
+    for j, c in zip(cols, values):
+        terms = expression.get(j)
+        for master, e in (((j, 1.0),) if terms is None else terms.items()):
+            term = c * e
+            row[master] = row.get(master, 0.0) + term
+            scale = max(scale, abs(term))
+    return row, scale
+
+
+def _basis(expression: dict, n: int) -> tuple[sp.csr_matrix, np.ndarray]:
+    """(n, n_masters) sparse T1 and (n_masters,) masters, ascending, from each slave's
+    ``expression`` {master: coefficient}; every other DOF is a master."""
+    slaves = np.array(list(expression), int)
+    is_master = np.ones(n, bool)
+    is_master[slaves] = False
+    masters = np.flatnonzero(is_master)
+    column = np.cumsum(is_master) - 1
+    uses = np.array([m for terms in expression.values() for m in terms], int)
+    rows = np.concatenate([masters, np.repeat(slaves, [len(terms) for terms in expression.values()])])
+    values = np.concatenate([np.ones(len(masters)), [v for terms in expression.values() for v in terms.values()]])
+    return csr_of_distinct(rows, np.concatenate([column[masters], column[uses]]), values, (n, len(masters))), masters
 
 
 def _substitute(terms, owner, slave, solved, users):

@@ -22,42 +22,71 @@ def beam_element(beam: Beam, h: float):
     c : (r, 12) constraint rows (stretch if ``axial=False``, twist if
         ``torsion=False``), each ``c q = 0``.
     """
+    rows, d, m, strain = frame_elements((beam,), np.array([h], float))
+    return rows[0][strain[0]], d[0][strain[0]], m[0], rows[0][~strain[0]]
+
+
+def frame_elements(beams, h: np.ndarray):
+    """The elements of many beams at once, each beam's six deformation rows in the
+    order bending x-y (relative rotation, chord defect), bending x-z (the same),
+    stretch, twist.
+
+    Parameters
+    ----------
+    beams : sequence of b :class:`~linmstmm.model.Beam`.
+    h : (b,) element length of each beam, m.
+
+    Returns
+    -------
+    rows : (b, 6, 12) the deformations as rows on the element's local DOFs (m or rad).
+    d : (b, 6) their stiffnesses (N m or N m/rad); those of rigid directions unused.
+    m : (b, 12, 12) consistent masses, kg and kg m².
+    strain : (b, 6) bool, True where a row is a strain, False where the beam declares
+        the direction rigid (``axial`` or ``torsion`` False: the row is a constraint).
+    """
+    E, G, rho, A, Iy, Iz, J, Ip = (np.array([getattr(beam, key) for beam in beams], float)
+                                    for key in ("E", "G", "rho", "A", "Iy", "Iz", "J", "Ip"))
+    rows = _ROWS + (1 / h)[:, None, None] * _ROWS_PER_LENGTH
+    d = np.stack([E * Iz / h, 12 * E * Iz / h, E * Iy / h, 12 * E * Iy / h, E * A / h, G * J / h], axis=1)
+    strain = np.ones((len(h), 6), bool)
+    strain[:, 4] = [beam.axial for beam in beams]
+    strain[:, 5] = [beam.torsion for beam in beams]
+    return rows, d, _frame_masses(rho * A, rho * Ip, h), strain
+
+
+def _deformation_rows() -> tuple[np.ndarray, np.ndarray]:
+    """(6, 12) the deformation rows of :func:`frame_elements` as a part that does not
+    depend on the element length and (6, 12) one to divide by it (m)."""
     u1, v1, w1, tx1, ty1, tz1, u2, v2, w2, tx2, ty2, tz2 = np.eye(12)
-    stretch, twist = u2 - u1, tx2 - tx1
-    g = [tz2 - tz1, (tz1 + tz2) / 2 - (v2 - v1) / h,      # x-y plane, EIz
-         ty2 - ty1, (ty1 + ty2) / 2 + (w2 - w1) / h]      # x-z plane, EIy (θy = -w')
-    d = [beam.E * beam.Iz / h, 12 * beam.E * beam.Iz / h,
-         beam.E * beam.Iy / h, 12 * beam.E * beam.Iy / h]
-    constraints = []
-    if beam.axial:
-        g.append(stretch)
-        d.append(beam.E * beam.A / h)
-    else:
-        constraints.append(stretch)
-    if beam.torsion:
-        g.append(twist)
-        d.append(beam.G * beam.J / h)
-    else:
-        constraints.append(twist)
-    return (np.array(g), np.array(d), _beam_element_mass(beam, h),
-            np.array(constraints).reshape(-1, 12))
+    zero = np.zeros(12)
+    fixed = np.array([tz2 - tz1, (tz1 + tz2) / 2, ty2 - ty1, (ty1 + ty2) / 2, u2 - u1, tx2 - tx1])
+    per_length = np.array([zero, v1 - v2, zero, w2 - w1, zero, zero])
+    return fixed, per_length
 
 
-def _beam_element_mass(beam: Beam, h: float) -> np.ndarray:
-    """(12, 12) consistent mass of a frame element without rotary inertia."""
-    rho_a = beam.rho * beam.A
-    m = np.zeros((12, 12))
-    bar = np.array([[2.0, 1.0], [1.0, 2.0]]) / 6.0
-    m[np.ix_([0, 6], [0, 6])] = rho_a * h * bar                   # axial
-    m[np.ix_([3, 9], [3, 9])] = beam.rho * beam.Ip * h * bar      # torsion
-    hermite = rho_a * h / 420.0 * np.array([
-        [156.0, 22 * h, 54.0, -13 * h],
-        [22 * h, 4 * h * h, 13 * h, -3 * h * h],
-        [54.0, 13 * h, 156.0, -22 * h],
-        [-13 * h, -3 * h * h, -22 * h, 4 * h * h]])
-    m[np.ix_([1, 5, 7, 11], [1, 5, 7, 11])] = hermite             # v, θz
-    flip = np.diag([1.0, -1.0, 1.0, -1.0])                         # (w, -θy)
-    m[np.ix_([2, 4, 8, 10], [2, 4, 8, 10])] = flip @ hermite @ flip
+_ROWS, _ROWS_PER_LENGTH = _deformation_rows()
+#: Cubic Hermite consistent mass (v, θz at both nodes) / (ρA h / 420): constant, h and h² parts.
+_HERMITE = (np.array([[156.0, 0, 54, 0], [0, 0, 0, 0], [54, 0, 156, 0], [0, 0, 0, 0]]),
+            np.array([[0.0, 22, 0, -13], [22, 0, 13, 0], [0, 13, 0, -22], [-13, 0, -22, 0]]),
+            np.array([[0.0, 0, 0, 0], [0, 4, 0, -3], [0, 0, 0, 0], [0, -3, 0, 4]]))
+_BAR = np.array([[2.0, 1.0], [1.0, 2.0]]) / 6.0
+_FLIP = np.outer([1.0, -1.0, 1.0, -1.0], [1.0, -1.0, 1.0, -1.0])    # (v, θz) -> (w, −θy)
+
+
+def _frame_masses(rho_a: np.ndarray, rho_ip: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """(b, 12, 12) consistent masses of frame elements without rotary inertia.
+
+    rho_a : (b,) mass per length, kg/m. rho_ip : (b,) polar inertia per length, kg m.
+    h : (b,) element lengths, m.
+    """
+    m = np.zeros((len(h), 12, 12))
+    m[:, [[0], [6]], [0, 6]] = (rho_a * h)[:, None, None] * _BAR                  # axial
+    m[:, [[3], [9]], [3, 9]] = (rho_ip * h)[:, None, None] * _BAR                 # torsion
+    h = h[:, None, None]
+    constant, linear, square = _HERMITE
+    hermite = rho_a[:, None, None] * h / 420.0 * (constant + linear * h + square * h * h)
+    m[:, [[1], [5], [7], [11]], [1, 5, 7, 11]] = hermite                           # v, θz
+    m[:, [[2], [4], [8], [10]], [2, 4, 8, 10]] = hermite * _FLIP                   # w, θy
     return m
 
 

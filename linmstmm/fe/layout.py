@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from linmstmm.fe.sparse import csr_of_distinct
 from linmstmm.model import Model
 
 
@@ -50,11 +51,16 @@ def _node_dofs(node):
 
 @dataclass(frozen=True, eq=False)
 class _Layout:
-    """Nodes of a meshed model: numbering, positions (m) and local frames."""
+    """Nodes of a meshed model: numbering, positions (m) and local frames.
+
+    beam_table : (n_beams, n+1) the nodes of each beam (``model.beams`` order), end a
+        to end b, as in ``index.beam_nodes``.
+    """
 
     index: DofIndex
     positions: np.ndarray   # (n_nodes, 3)
     frames: np.ndarray      # (n_nodes, 3, 3) rows = the node's DOF axes
+    beam_table: np.ndarray
 
     @property
     def n_nodes(self):
@@ -63,34 +69,62 @@ class _Layout:
 
 def _layout(model: Model, elements_per_beam: int) -> _Layout:
     """Number the nodes: points, rigid mass centres, interior beam nodes."""
-    points = {name: i for i, name in enumerate(model.points)}
-    positions = [np.asarray(x, float) for x in model.points.values()]
-    frames = [np.eye(3)] * len(positions)
-    rigids = {}
-    for body in model.rigids:
-        rigids[body.name] = len(positions)
-        positions.append(np.asarray(body.com, float))
-        frames.append(np.eye(3))
-    beam_nodes = {}
     n = elements_per_beam
-    for beam in model.beams:
-        a, b = (points[end] for end in beam.ends)
-        interior = len(positions) + np.arange(n - 1)
-        beam_nodes[beam.name] = np.concatenate([[a], interior, [b]])
-        xa, xb = positions[a], positions[b]
-        positions.extend(xa + (xb - xa) * (j / n) for j in range(1, n))
-        frames.extend([np.asarray(beam.axes, float)] * (n - 1))
-    return _Layout(DofIndex(points, rigids, beam_nodes),
-                   np.array(positions).reshape(-1, 3),
-                   np.array(frames).reshape(-1, 3, 3))
+    points = {name: i for i, name in enumerate(model.points)}
+    rigids = {body.name: len(points) + i for i, body in enumerate(model.rigids)}
+    placed = np.array([*model.points.values(), *(body.com for body in model.rigids)], float).reshape(-1, 3)
+    ends = np.array([[points[end] for end in beam.ends] for beam in model.beams], int).reshape(-1, 2)
+    interior = len(placed) + np.arange(len(ends) * (n - 1)).reshape(len(ends), n - 1)
+    table = np.concatenate([ends[:, :1], interior, ends[:, 1:]], axis=1)
+    xa, xb = placed[ends[:, 0]], placed[ends[:, 1]]
+    inside = xa[:, None] + (xb - xa)[:, None] * (np.arange(1, n) / n)[None, :, None]
+    axes = _beam_axes(model.beams)
+    frames = np.concatenate([np.broadcast_to(np.eye(3), (len(placed), 3, 3)), np.repeat(axes, n - 1, axis=0)])
+    return _Layout(DofIndex(points, rigids, {beam.name: nodes for beam, nodes in zip(model.beams, table)}),
+                   np.concatenate([placed, inside.reshape(-1, 3)]), frames, table)
+
+
+def _beam_axes(beams) -> np.ndarray:
+    """(n_beams, 3, 3) rows = each beam's local axes in the inertial frame."""
+    return np.array([beam.axes for beam in beams], float).reshape(-1, 3, 3)
+
+
+def element_maps(nodes: np.ndarray, axes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Full DOFs of the elements of b beams and the maps to each element's local DOFs.
+
+    Parameters
+    ----------
+    nodes : (b, n+1) each beam's nodes, end a to end b (:attr:`_Layout.beam_table`).
+    axes : (b, 3, 3) rows = each beam's local axes.
+
+    Returns
+    -------
+    dofs : (b, n, 12) the element's full DOFs, node 1 then node 2.
+    to_local : (b, n, 12, 12) maps from those DOFs to the element's local ones: the
+        end nodes' DOFs are inertial (rotated by ``axes``), interior ones local already.
+    """
+    b, n = nodes.shape[0], nodes.shape[1] - 1
+    to_local = np.zeros((b, n, 12, 12))
+    to_local[:, :, np.arange(12), np.arange(12)] = 1.0
+    for block in (0, 3):
+        to_local[:, 0, block:block + 3, block:block + 3] = axes
+        to_local[:, -1, 6 + block:9 + block, 6 + block:9 + block] = axes
+    dofs = 6 * np.stack([nodes[:, :-1], nodes[:, 1:]], axis=2)[..., None] + np.arange(6)
+    return dofs.reshape(b, n, 12), to_local
 
 
 class _Triplets:
-    """Growing COO lists (rows, cols, values) of one sparse matrix."""
+    """Growing COO lists (rows, cols, values) of one sparse matrix.
 
-    def __init__(self):
+    repeats : True where entries may fall on the same position (mass blocks that
+    share a node) and are summed; False where each position is written once
+    (strain and constraint rows), and the matrix is built without summing.
+    """
+
+    def __init__(self, repeats: bool = False):
         self.rows, self.cols, self.values = [], [], []
         self.n_rows = 0
+        self.repeats = repeats
 
     def add(self, rows, cols, values):
         rows, cols, values = np.broadcast_arrays(rows, cols, values)
@@ -111,26 +145,54 @@ class _Triplets:
         self.n_rows += other.n_rows
 
     def matrix(self, n_cols, n_rows=None) -> sp.csr_matrix:
+        """(n_rows, n_cols) canonical CSR of the entries, zeros dropped (summed first
+        where they repeat, in scipy's order); ``n_rows`` defaults to the rows numbered."""
         n_rows = self.n_rows if n_rows is None else n_rows
         if not self.rows:
             return sp.csr_matrix((n_rows, n_cols))
-        coo = sp.coo_matrix((np.concatenate(self.values),
-                             (np.concatenate(self.rows), np.concatenate(self.cols))),
-                            shape=(n_rows, n_cols))
-        matrix = coo.tocsr()
-        matrix.eliminate_zeros()
-        return matrix
+        rows, cols, values = (np.concatenate(part) for part in (self.rows, self.cols, self.values))
+        if self.repeats:
+            matrix = sp.coo_matrix((values, (rows, cols)), shape=(n_rows, n_cols)).tocsr()
+            matrix.eliminate_zeros()
+            return matrix
+        nonzero = values != 0
+        return csr_of_distinct(rows[nonzero], cols[nonzero], values[nonzero], (n_rows, n_cols))
 
 
 def _spring_directions(spring, index: DofIndex, kept_only: bool):
     """(component, cols (6,), values (6,)) per direction of ``spring``: the elongation
     (end b − end a along the spring's axis, m or rad) as a row on the full DOFs of ``index``.
     kept_only : leave out the released directions."""
-    a, b = (_node_dofs(index.points[end]) for end in spring.ends)
-    cols = (np.concatenate([a[:3], b[:3]]), np.concatenate([a[3:], b[3:]]))
-    axes = np.asarray(spring.axes, float)
-    values = np.concatenate([-axes, axes], axis=1)          # row i: direction i at a, then at b
-    skipped = set(spring.released.tolist()) if kept_only else set()
-    for component in range(6):
-        if component not in skipped:
-            yield component, cols[component // 3], values[component % 3]
+    _, components, cols, values = spring_rows((spring,), index, kept_only)
+    yield from zip(components.tolist(), cols, values)
+
+
+def spring_rows(springs, index: DofIndex, kept_only: bool):
+    """Every direction of ``springs`` as a row on the full DOFs of ``index``: the
+    elongation, end b − end a along the spring's axis (m or rad).
+
+    Parameters
+    ----------
+    springs : sequence of s :class:`~linmstmm.model.Spring`.
+    index : where their end points sit.
+    kept_only : leave out the released directions.
+
+    Returns
+    -------
+    owners : (d,) the spring of each row (its position in ``springs``).
+    components : (d,) its direction, 0..5 (x, y, z, rx, ry, rz in the spring's axes).
+    cols : (d, 6) full DOFs of the row: three at end a, then three at end b.
+    values : (d, 6) its entries, −axis at end a, +axis at end b.
+    Rows are in the springs' order, each spring's in ascending direction.
+    """
+    ends = np.array([[index.points[end] for end in spring.ends] for spring in springs], int).reshape(-1, 2)
+    block = np.array([0, 0, 0, 3, 3, 3])[:, None] + np.arange(3)                 # (6 directions, 3)
+    cols = 6 * ends[:, None, :, None] + block[None, :, None, :]                     # (s, 6, 2 ends, 3)
+    axes = np.array([spring.axes for spring in springs], float).reshape(-1, 3, 3)[:, [0, 1, 2, 0, 1, 2]]
+    values = np.concatenate([-axes, axes], axis=2)                                # (s, 6, 6)
+    kept = np.ones((len(ends), 6), bool)
+    if kept_only:
+        kept &= ~np.array([np.zeros(6, bool) if spring.release is None else spring.release
+                           for spring in springs], bool).reshape(-1, 6)
+    owners, components = np.nonzero(kept)
+    return owners, components, cols.reshape(-1, 6, 6)[kept], values[kept]

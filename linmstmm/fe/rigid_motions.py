@@ -5,33 +5,43 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.linalg as la
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 from linmstmm.fe.constraints import NEGLIGIBLE_ENTRY, REDUNDANT_CONSTRAINT
-from linmstmm.fe.layout import _spring_directions
+from linmstmm.fe.layout import spring_rows
 from linmstmm.fe.masses import MASSLESS
 
 
-def _components(model, layout, through_joints: bool = True) -> np.ndarray:
-    """(n_nodes,) label of the connected part of the model each node is in.
+def _edges(model, layout) -> tuple[np.ndarray, np.ndarray]:
+    """(e, 2) the node pairs the elements join (a body's mass centre and each port, a
+    spring's ends, the ends of every beam element) and (e,) bool, True for the springs
+    with a released direction (joints)."""
+    index = layout.index
+    ports = [(index.rigids[body.name], index.points[port]) for body in model.rigids for port in body.ports]
+    springs = [[index.points[end] for end in spring.ends] for spring in model.springs]
+    table = layout.beam_table
+    edges = np.concatenate([np.array(ports, int).reshape(-1, 2), np.array(springs, int).reshape(-1, 2),
+                            np.stack([table[:, :-1].ravel(), table[:, 1:].ravel()], axis=1)])
+    joints = np.zeros(len(edges), bool)
+    joints[len(ports):len(ports) + len(springs)] = [spring.released.size > 0 for spring in model.springs]
+    return edges, joints
 
-    through_joints : False to leave out springs with a released direction (the
-    parts are then the segments that move rigidly in a zero-energy motion).
+
+def _components(edges: np.ndarray, n_nodes: int) -> np.ndarray:
+    """(n_nodes,) label of the connected part each node is in, parts numbered in the
+    order of their lowest node; ``edges`` (e, 2) the node pairs joined.
+
+    Each node points at a lower one of its part (at first itself): every edge hooks
+    the higher of its two ends' roots onto the lower, and pointers are followed to
+    their roots, until every edge joins nodes of one root, the lowest of the part.
     """
-    edges = []
-    for body in model.rigids:
-        centre = layout.index.rigids[body.name]
-        edges.extend((centre, layout.index.points[p]) for p in body.ports)
-    for spring in model.springs:
-        if through_joints or not spring.released.size:
-            edges.append(tuple(layout.index.points[e] for e in spring.ends))
-    for nodes in layout.index.beam_nodes.values():
-        edges.extend(zip(nodes[:-1], nodes[1:]))
-    edges = np.array(edges, dtype=int).reshape(-1, 2)
-    graph = sp.coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])),
-                          shape=(layout.n_nodes, layout.n_nodes))
-    return connected_components(graph, directed=False)[1]
+    root = np.arange(n_nodes)
+    while True:
+        a, b = root[edges[:, 0]], root[edges[:, 1]]
+        if np.array_equal(a, b):
+            return np.unique(root, return_inverse=True)[1]
+        np.minimum.at(root, np.maximum(a, b), np.minimum(a, b))
+        while not np.array_equal(root[root], root):
+            root = root[root]
 
 
 def _rigid_field(positions, frames, segments) -> tuple[np.ndarray, float]:
@@ -48,14 +58,18 @@ def _rigid_field(positions, frames, segments) -> tuple[np.ndarray, float]:
     size = np.abs(arm).max()
     if size <= NEGLIGIBLE_ENTRY * np.abs(positions).max():
         arm, size = np.zeros_like(arm), 1.0
+    unit = np.eye(3)[:, None, :]                                   # (3 axes, 1, 3)
+    moment = np.stack([unit[..., 1] * arm[:, 2] - unit[..., 2] * arm[:, 1],   # unit × arm, as np.cross
+                       unit[..., 2] * arm[:, 0] - unit[..., 0] * arm[:, 2],
+                       unit[..., 0] * arm[:, 1] - unit[..., 1] * arm[:, 0]], axis=-1)
     field = np.zeros((len(positions), 6, 6))
-    for k, unit in enumerate(np.eye(3)):
-        field[:, :3, k] = frames @ unit
-        field[:, :3, 3 + k] = (frames @ np.cross(unit, arm)[:, :, None])[:, :, 0] / size
-        field[:, 3:, 3 + k] = frames @ unit / size
+    turned = frames + 0.0                                          # = frames @ unit k, column k (no −0)
+    field[:, :3, :3] = turned
+    field[:, :3, 3:] = np.moveaxis((frames @ moment[..., None])[..., 0], 0, 2) / size
+    field[:, 3:, 3:] = turned / size
     placed = np.zeros((len(positions), 6, 6 * (segments.max() + 1)))
-    for node, segment in enumerate(segments):
-        placed[node, :, 6 * segment:6 * segment + 6] = field[node]
+    columns = 6 * segments[:, None, None] + np.arange(6)
+    placed[np.arange(len(positions))[:, None, None], np.arange(6)[:, None], columns] = field
     return placed.reshape(6 * len(positions), -1), float(size)
 
 
@@ -66,10 +80,42 @@ def _across_segments(spring, layout, segments) -> bool:
     return segments[a] != segments[b]
 
 
+def _held_directions(model, layout, segments) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The directions a rigid motion must hold, as blocks of rows of one width:
+    (cols (k, w), values (k, w)) on the full DOFs, each row's columns ascending.
+    First the fixed components of the boundaries (w = 1), then the directions each
+    joint between two segments keeps (w = 6)."""
+    fixed = [layout.index.point(point)[np.asarray(components, bool)] for point, components in model.boundary.items()]
+    fixed = np.concatenate(fixed) if fixed else np.zeros(0, int)
+    joints = tuple(spring for spring in model.springs
+                   if spring.released.size and _across_segments(spring, layout, segments))
+    _, _, cols, values = spring_rows(joints, layout.index, kept_only=True)
+    ascending = np.argsort(cols, axis=1, kind="stable")
+    return [(fixed[:, None], np.ones((len(fixed), 1))),
+            (np.take_along_axis(cols, ascending, axis=1), np.take_along_axis(values, ascending, axis=1))]
+
+
+def _held_rows(directions, in_part: np.ndarray, motions: np.ndarray) -> np.ndarray:
+    """(k, r) the held directions on the nodes ``in_part`` ((n_nodes,) bool) applied to
+    ``motions`` (6 per node of the part, r): each row summed over its columns in
+    ascending order, as a sparse product does."""
+    rank = np.cumsum(in_part) - 1                     # a node's place among the part's
+    blocks = []
+    for cols, values in directions:
+        on_part = in_part[cols[:, 0] // 6]
+        cols, values = cols[on_part], values[on_part]
+        block = np.zeros((len(cols), motions.shape[1]))
+        for col, value in zip((6 * rank[cols // 6] + cols % 6).T, values.T):
+            block += value[:, None] * motions[col]
+        blocks.append(block)
+    return np.concatenate(blocks)
+
+
 def _rigid_motions(model, layout) -> tuple[np.ndarray, np.ndarray]:
     """(n_full, r) zero-energy motions of each connected part: every segment
-    (:func:`_components` without joints) moves rigidly, as far as the boundaries and
-    the directions each joint keeps allow; and (n_full,) the weight of each DOF.
+    (the parts :func:`_components` finds without the joints) moves rigidly, as far
+    as the boundaries and the directions each joint keeps allow; and (n_full,) the
+    weight of each DOF.
 
     Ports, springs and rigid axial/torsion all hold under a segment's rigid
     motion; across a joint the two segments must move alike in each direction
@@ -80,43 +126,26 @@ def _rigid_motions(model, layout) -> tuple[np.ndarray, np.ndarray]:
     other DOFs a thousand times larger, and the stiff beams' strains of these
     motions with it (a model in km lost 1e-3 of its frequencies on fine meshes).
     """
-    labels = _components(model, layout)
-    segments = _components(model, layout, through_joints=False)
-    directions = [(np.array([dof]), np.ones(1))  # (columns, values) of each held direction
-                  for point, components in model.boundary.items()
-                  for dof in layout.index.point(point)[np.asarray(components, bool)]]
-    directions += [(cols, values)
-                   for spring in model.springs if spring.released.size and _across_segments(spring, layout, segments)
-                   for _, cols, values in _spring_directions(spring, layout.index, kept_only=True)]
-    held = _rows_matrix(directions, 6 * layout.n_nodes)
+    edges, joints = _edges(model, layout)
+    labels = _components(edges, layout.n_nodes)
+    segments = _components(edges[~joints], layout.n_nodes)
+    directions = _held_directions(model, layout, segments)
     motions, weights = [], np.ones(6 * layout.n_nodes)
     for label in np.unique(labels):
-        nodes = np.flatnonzero(labels == label)
+        in_part = labels == label
+        nodes = np.flatnonzero(in_part)
         dofs = (6 * nodes[:, None] + np.arange(6)).ravel()
         field, size = _rigid_field(layout.positions[nodes], layout.frames[nodes],
                                    np.unique(segments[nodes], return_inverse=True)[1])
         weight = np.tile(np.r_[np.ones(3), np.full(3, size)], len(nodes))  # rotation rows of order one
         weights[dofs] = weight
-        rows = held[:, dofs]
-        rows = rows[np.flatnonzero(np.diff(rows.tocsr().indptr))]  # the rows on this part
-        allowed = (la.null_space(rows @ (weight[:, None] * field), rcond=REDUNDANT_CONSTRAINT)
-                   if rows.shape[0] else np.eye(field.shape[1]))
+        rows = _held_rows(directions, in_part, weight[:, None] * field)
+        allowed = la.null_space(rows, rcond=REDUNDANT_CONSTRAINT) if rows.shape[0] else np.eye(field.shape[1])
         if allowed.shape[1]:
             motion = np.zeros((6 * layout.n_nodes, allowed.shape[1]))
             motion[dofs] = la.orth(weight[:, None] * (field @ allowed)) / weight[:, None]
             motions.append(motion)
     return (np.hstack(motions) if motions else np.zeros((6 * layout.n_nodes, 0))), weights
-
-
-def _rows_matrix(rows, width: int) -> sp.csc_matrix:
-    """(len(rows), width) sparse matrix of ``rows``, each (columns, values): built at once,
-    not stacked from a matrix per row (which took most of an assembly of the launcher)."""
-    if not rows:
-        return sp.csc_matrix((0, width))
-    columns = np.concatenate([cols for cols, _ in rows])
-    values = np.concatenate([vals for _, vals in rows])
-    row_of = np.repeat(np.arange(len(rows)), [cols.size for cols, _ in rows])
-    return sp.csc_matrix((values, (row_of, columns)), shape=(len(rows), width))
 
 
 def _rigid_basis(motions, M, weight):

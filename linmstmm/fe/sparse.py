@@ -1,0 +1,69 @@
+"""Sparse matrices built straight from their entries, without scipy's general
+conversion (most of the cost of small models' assembly)."""
+from __future__ import annotations
+
+import numpy as np
+import scipy.sparse as sp
+
+
+def csr_of_distinct(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> sp.csr_matrix:
+    """The CSR matrix of entries at distinct positions (no (row, col) twice), indices
+    sorted: the same matrix as ``scipy.sparse.csr_matrix((values, (rows, cols)))``,
+    explicit zeros kept.
+
+    Parameters
+    ----------
+    rows, cols : (nnz,) int positions, each pair at most once.
+    values : (nnz,) float entries.
+    shape : (n_rows, n_cols).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix of ``shape``, canonical.
+
+    Raises
+    ------
+    ValueError
+        If a position is given twice.
+    """
+    position = rows.astype(np.int64) * shape[1] + cols
+    order = np.argsort(position)
+    position = position[order]
+    if np.any(position[1:] == position[:-1]):
+        raise ValueError("csr_of_distinct: a (row, col) position is given twice")
+    return _csr_of_sorted(position, cols[order], np.asarray(values, float)[order], shape)
+
+
+def _csr_of_sorted(position: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> sp.csr_matrix:
+    """CSR of entries at ascending distinct ``position`` = row × n_cols + col."""
+    starts = np.searchsorted(position, np.arange(shape[0] + 1) * shape[1])
+    matrix = sp.csr_matrix((values, cols, starts), shape=shape)
+    matrix.has_sorted_indices = True
+    return matrix
+
+
+def symmetric_part(matrix) -> sp.csr_matrix:
+    """(A + Aᵀ) / 2 of a square CSR or CSC matrix A without repeated positions, as
+    canonical CSR: each entry is formed as scipy's sum forms it, (a + b) * 0.5, and
+    positions where a + b is zero are dropped.
+
+    Parameters
+    ----------
+    matrix : (n, n) scipy.sparse CSR or CSC matrix.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, (n, n), symmetric bit for bit.
+    """
+    n = matrix.shape[0]
+    major = np.repeat(np.arange(n, dtype=np.int64), np.diff(matrix.indptr))
+    minor = matrix.indices.astype(np.int64)
+    rows, cols = (major, minor) if matrix.format == "csr" else (minor, major)
+    position = np.concatenate([rows * n + cols, cols * n + rows])
+    order = np.argsort(position, kind="stable")
+    position = position[order]
+    first = np.flatnonzero(np.diff(position, prepend=-1))
+    sums = np.add.reduceat(np.concatenate([matrix.data, matrix.data])[order], first)
+    kept = sums != 0
+    position = position[first][kept]
+    return _csr_of_sorted(position, position % n, sums[kept] * 0.5, (n, n))

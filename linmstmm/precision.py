@@ -129,13 +129,13 @@ def refine_roots(deduction, model, omegas, digits: int, multiplicities=None, log
             with mpmath.workdps(dps << attempt):
                 start, tolerance = mpmath.mpf(omegas[i]), mpmath.mpf(10) ** -(digits + 2)
                 try:
-                    root = (_secant(deduction, start, tolerance, slopes.get(omegas[i])) if m == 1
-                            else _multiple_newton(deduction, start, m, tolerance))
+                    members = ([_secant(deduction, start, tolerance, slopes.get(omegas[i]))] * repeats if m == 1
+                               else _cluster_members(deduction, start, m, tolerance)[:repeats])
                 except RuntimeError:
                     if attempt == PRECISION_DOUBLINGS:
                         raise
                     continue
-                refined += [+root] * repeats
+                refined += [+root for root in members]
                 break
         i += repeats
     return refined
@@ -199,7 +199,7 @@ def _multiple_newton(deduction, start, multiplicity: int, tolerance):
     next error ≈ s³/p² for relative steps p, then s), and a step that does not
     shrink is an error, not a result.
     """
-    x, previous = start, None
+    x, previous, step = start, None, 0
     for _ in range(MAX_STEPS):
         h = abs(x) * mpmath.mpf(10) ** -mpmath.mp.dps
         value = mpmath.mpc(mp_determinant(deduction, mpmath.mpc(x, h)))
@@ -214,8 +214,74 @@ def _multiple_newton(deduction, start, multiplicity: int, tolerance):
         if abs(step) <= tolerance or (previous is not None and abs(step) ** 3 <= tolerance / 1000 * previous ** 2):
             return x
         previous = abs(step)
-    raise RuntimeError(f"the {multiplicity}-fold root near {float(start):.12g} rad/s does not "
-                       f"settle in mpmath at {mpmath.mp.dps} digits")
+    raise UnsettledRoot(f"the {multiplicity}-fold root near {float(start):.12g} rad/s does not "
+                        f"settle in mpmath at {mpmath.mp.dps} digits", x, max(abs(step), previous or 0, tolerance))
+
+
+class UnsettledRoot(RuntimeError):
+    """A multiple root's Newton iteration (:func:`_multiple_newton`) that stopped converging:
+    ``at`` (mpf, rad/s) where it stopped, ``step`` (relative) the larger of its last two
+    steps, the scale of how far apart the roots it circles are."""
+
+    def __init__(self, message: str, at, step):
+        super().__init__(message)
+        self.at, self.step = at, step
+
+
+#: The circle of :func:`_split_cluster` has this many times the stalled Newton step as radius.
+CLUSTER_REACH = 10
+
+
+def _cluster_members(deduction, start, multiplicity: int, tolerance) -> list:
+    """The ``multiplicity`` roots of det Ū_all counted at ``start`` (mpf, rad/s), ascending, to
+    ``tolerance`` relative: one root repeated where they coincide at that tolerance
+    (:func:`_multiple_newton`), else each one (:func:`_split_cluster`).
+
+    A root float64 counts as multiple may be a cluster of simple roots closer than
+    float64 resolves but farther apart than ``tolerance``: Iy and Iz one ulp apart
+    (bending pairs 1.1e-16 apart), or a symmetric model turned in space, whose
+    frames and spring axes rounded to float64 split its double roots by 1e-17.
+    Raises RuntimeError (the Newton iteration's) where neither settles.
+    """
+    try:
+        return [_multiple_newton(deduction, start, multiplicity, tolerance)] * multiplicity
+    except UnsettledRoot as stall:
+        try:
+            return _split_cluster(deduction, stall.at, multiplicity, CLUSTER_REACH * stall.step * abs(stall.at),
+                                  tolerance)
+        except RuntimeError:
+            raise stall from None
+
+
+def _split_cluster(deduction, centre, multiplicity: int, radius, tolerance) -> list:
+    """The ``multiplicity`` simple roots of det Ū_all within ``radius`` (rad/s) of ``centre``
+    (mpf, rad/s), ascending, each to ``tolerance`` relative.
+
+    det is entire: its Taylor polynomial about ``centre``, to degree multiplicity + 2,
+    from its values on a circle of that radius (a discrete Fourier transform), has the
+    cluster's roots as its smallest; each is then polished by the secant method on
+    det, its second point the Newton step with the polynomial's slope. Raises
+    RuntimeError where the polynomial's roots are not real and inside the circle, or
+    two of them polish onto one root.
+    """
+    degree, points = multiplicity + 2, 4 * (multiplicity + 2)
+    turns = [mpmath.expjpi(mpmath.mpf(2 * j + 1) / points) for j in range(points)]
+    values = [mp_determinant(deduction, centre + radius * turn) for turn in turns]
+    taylor = [sum(v / turn ** k for v, turn in zip(values, turns)) / points / radius ** k
+              for k in range(degree + 1)]
+    try:
+        offsets = mpmath.polyroots(taylor[::-1], maxsteps=200, extraprec=2 * mpmath.mp.prec)
+    except mpmath.libmp.NoConvergence as error:
+        raise RuntimeError(str(error)) from None
+    offsets = sorted(offsets, key=abs)[:multiplicity]
+    if any(abs(t) >= radius or abs(mpmath.im(t)) > tolerance * abs(centre) for t in offsets):
+        raise RuntimeError("the cluster's roots are not real and inside the circle")
+    slope = lambda t: sum(k * taylor[k] * t ** (k - 1) for k in range(1, degree + 1))
+    members = sorted(_secant(deduction, centre + mpmath.re(t), tolerance, mpmath.re(slope(mpmath.re(t))))
+                     for t in offsets)
+    if any(abs(b - a) <= tolerance * abs(a) or abs(a - centre) >= radius for a, b in zip(members, members[1:])):
+        raise RuntimeError("two members of the cluster polish onto one root")
+    return members
 
 
 def separated_cluster(deduction, model, omega: float, multiplicity: int, radius: float, digits: int):

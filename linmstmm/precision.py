@@ -228,8 +228,13 @@ class UnsettledRoot(RuntimeError):
         self.at, self.step = at, step
 
 
-#: The circle of :func:`_split_cluster` has this many times the stalled Newton step as radius.
+#: The first circle of :func:`_split_cluster` has this many times the stalled Newton step
+#: as radius; where it does not hold the cluster, the next has CLUSTER_REACH² times the radius.
 CLUSTER_REACH = 10
+#: Relative radius the circles of :func:`_split_cluster` stop at: the circle about a root
+#: within which float64's tighter count (:func:`linmstmm.roots.clusters.separated`) found
+#: the whole cluster.
+CLUSTER_LIMIT = 1e-6
 
 
 def _cluster_members(deduction, start, multiplicity: int, tolerance) -> list:
@@ -246,11 +251,13 @@ def _cluster_members(deduction, start, multiplicity: int, tolerance) -> list:
     try:
         return [_multiple_newton(deduction, start, multiplicity, tolerance)] * multiplicity
     except UnsettledRoot as stall:
-        try:
-            return _split_cluster(deduction, stall.at, multiplicity, CLUSTER_REACH * stall.step * abs(stall.at),
-                                  tolerance)
-        except RuntimeError:
-            raise stall from None
+        radius = CLUSTER_REACH * stall.step * abs(stall.at)  # a stall next to one member is a short step
+        while radius <= CLUSTER_LIMIT * abs(stall.at):
+            try:
+                return _split_cluster(deduction, stall.at, multiplicity, radius, tolerance)
+            except RuntimeError:
+                radius *= CLUSTER_REACH ** 2
+        raise stall from None
 
 
 def _split_cluster(deduction, centre, multiplicity: int, radius, tolerance) -> list:
@@ -279,8 +286,9 @@ def _split_cluster(deduction, centre, multiplicity: int, radius, tolerance) -> l
     slope = lambda t: sum(k * taylor[k] * t ** (k - 1) for k in range(1, degree + 1))
     members = sorted(_secant(deduction, centre + mpmath.re(t), tolerance, mpmath.re(slope(mpmath.re(t))))
                      for t in offsets)
-    if any(abs(b - a) <= tolerance * abs(a) or abs(a - centre) >= radius for a, b in zip(members, members[1:])):
-        raise RuntimeError("two members of the cluster polish onto one root")
+    if (any(abs(a - centre) >= radius for a in members)
+            or any(b - a <= tolerance * abs(a) for a, b in zip(members, members[1:]))):
+        raise RuntimeError("the cluster's members polish onto one root, or out of the circle")
     return members
 
 

@@ -11,7 +11,9 @@ det: errors 1e-16 and 1e-12 give 1e-28, then 1e-40); a root of
 multiplicity m by Newton with the step multiplied by m, which converges
 quadratically on an m-fold zero, det and its derivative both taken from one
 evaluation at ω + ih (complex step: det is real on the real axis, so
-Im det(ω + ih) / h = det'(ω) with no cancellation). Either stops once its
+Im det(ω + ih) / h = det'(ω) with no cancellation); where the model's data split
+it into simple roots farther apart than the digits asked for, each of them
+(:func:`_cluster_members`). Either stops once its
 step is below 10^−(digits+2) of the root, or raises a RuntimeError after
 MAX_STEPS.
 

@@ -285,9 +285,9 @@ def _split_cluster(deduction, centre, multiplicity: int, radius, tolerance) -> l
     offsets = sorted(offsets, key=abs)[:multiplicity]
     if any(abs(t) >= radius or abs(mpmath.im(t)) > tolerance * abs(centre) for t in offsets):
         raise RuntimeError("the cluster's roots are not real and inside the circle")
-    slope = lambda t: sum(k * taylor[k] * t ** (k - 1) for k in range(1, degree + 1))
-    members = sorted(_secant(deduction, centre + mpmath.re(t), tolerance, mpmath.re(slope(mpmath.re(t))))
-                     for t in offsets)
+    slopes = [k * taylor[k] for k in range(degree, 0, -1)]  # det' about centre, highest power first
+    members = sorted(_secant(deduction, centre + mpmath.re(t), tolerance,
+                             mpmath.re(mpmath.polyval(slopes, mpmath.re(t)))) for t in offsets)
     if (any(abs(a - centre) >= radius for a in members)
             or any(b - a <= tolerance * abs(a) for a, b in zip(members, members[1:]))):
         raise RuntimeError("the cluster's members polish onto one root, or out of the circle")

@@ -11,7 +11,9 @@ det: errors 1e-16 and 1e-12 give 1e-28, then 1e-40); a root of
 multiplicity m by Newton with the step multiplied by m, which converges
 quadratically on an m-fold zero, det and its derivative both taken from one
 evaluation at ω + ih (complex step: det is real on the real axis, so
-Im det(ω + ih) / h = det'(ω) with no cancellation). Either stops once its
+Im det(ω + ih) / h = det'(ω) with no cancellation); where the model's data split
+it into simple roots farther apart than the digits asked for, each of them
+(:func:`_cluster_members`). Either stops once its
 step is below 10^−(digits+2) of the root, or raises a RuntimeError after
 MAX_STEPS.
 
@@ -129,13 +131,13 @@ def refine_roots(deduction, model, omegas, digits: int, multiplicities=None, log
             with mpmath.workdps(dps << attempt):
                 start, tolerance = mpmath.mpf(omegas[i]), mpmath.mpf(10) ** -(digits + 2)
                 try:
-                    root = (_secant(deduction, start, tolerance, slopes.get(omegas[i])) if m == 1
-                            else _multiple_newton(deduction, start, m, tolerance))
+                    members = ([_secant(deduction, start, tolerance, slopes.get(omegas[i]))] * repeats if m == 1
+                               else _cluster_members(deduction, start, m, tolerance)[:repeats])
                 except RuntimeError:
                     if attempt == PRECISION_DOUBLINGS:
                         raise
                     continue
-                refined += [+root] * repeats
+                refined += [+root for root in members]
                 break
         i += repeats
     return refined
@@ -199,7 +201,7 @@ def _multiple_newton(deduction, start, multiplicity: int, tolerance):
     next error ≈ s³/p² for relative steps p, then s), and a step that does not
     shrink is an error, not a result.
     """
-    x, previous = start, None
+    x, previous, step = start, None, 0
     for _ in range(MAX_STEPS):
         h = abs(x) * mpmath.mpf(10) ** -mpmath.mp.dps
         value = mpmath.mpc(mp_determinant(deduction, mpmath.mpc(x, h)))
@@ -214,8 +216,82 @@ def _multiple_newton(deduction, start, multiplicity: int, tolerance):
         if abs(step) <= tolerance or (previous is not None and abs(step) ** 3 <= tolerance / 1000 * previous ** 2):
             return x
         previous = abs(step)
-    raise RuntimeError(f"the {multiplicity}-fold root near {float(start):.12g} rad/s does not "
-                       f"settle in mpmath at {mpmath.mp.dps} digits")
+    raise UnsettledRoot(f"the {multiplicity}-fold root near {float(start):.12g} rad/s does not "
+                        f"settle in mpmath at {mpmath.mp.dps} digits", x, max(abs(step), previous or 0, tolerance))
+
+
+class UnsettledRoot(RuntimeError):
+    """A multiple root's Newton iteration (:func:`_multiple_newton`) that stopped converging:
+    ``at`` (mpf, rad/s) where it stopped, ``step`` (relative) the larger of its last two
+    steps, the scale of how far apart the roots it circles are."""
+
+    def __init__(self, message: str, at, step):
+        super().__init__(message)
+        self.at, self.step = at, step
+
+
+#: The first circle of :func:`_split_cluster` has this many times the stalled Newton step
+#: as radius; where it does not hold the cluster, the next has CLUSTER_REACH² times the radius.
+CLUSTER_REACH = 10
+#: Relative radius the circles of :func:`_split_cluster` stop at: the circle about a root
+#: within which float64's tighter count (:func:`linmstmm.roots.clusters.separated`) found
+#: the whole cluster.
+CLUSTER_LIMIT = 1e-6
+
+
+def _cluster_members(deduction, start, multiplicity: int, tolerance) -> list:
+    """The ``multiplicity`` roots of det Ū_all counted at ``start`` (mpf, rad/s), ascending, to
+    ``tolerance`` relative: one root repeated where they coincide at that tolerance
+    (:func:`_multiple_newton`), else each one (:func:`_split_cluster`).
+
+    A root float64 counts as multiple may be a cluster of simple roots closer than
+    float64 resolves but farther apart than ``tolerance``: Iy and Iz one ulp apart
+    (bending pairs 1.1e-16 apart), or a symmetric model turned in space, whose
+    frames and spring axes rounded to float64 split its double roots by 1e-17.
+    Raises RuntimeError (the Newton iteration's) where neither settles.
+    """
+    try:
+        return [_multiple_newton(deduction, start, multiplicity, tolerance)] * multiplicity
+    except UnsettledRoot as stall:
+        radius = CLUSTER_REACH * stall.step * abs(stall.at)  # a stall next to one member is a short step
+        while radius <= CLUSTER_LIMIT * abs(stall.at):
+            try:
+                return _split_cluster(deduction, stall.at, multiplicity, radius, tolerance)
+            except RuntimeError:
+                radius *= CLUSTER_REACH ** 2
+        raise stall from None
+
+
+def _split_cluster(deduction, centre, multiplicity: int, radius, tolerance) -> list:
+    """The ``multiplicity`` simple roots of det Ū_all within ``radius`` (rad/s) of ``centre``
+    (mpf, rad/s), ascending, each to ``tolerance`` relative.
+
+    det is entire: its Taylor polynomial about ``centre``, to degree multiplicity + 2,
+    from its values on a circle of that radius (a discrete Fourier transform), has the
+    cluster's roots as its smallest; each is then polished by the secant method on
+    det, its second point the Newton step with the polynomial's slope. Raises
+    RuntimeError where the polynomial's roots are not real and inside the circle, or
+    two of them polish onto one root.
+    """
+    degree, points = multiplicity + 2, 4 * (multiplicity + 2)
+    turns = [mpmath.expjpi(mpmath.mpf(2 * j + 1) / points) for j in range(points)]
+    values = [mp_determinant(deduction, centre + radius * turn) for turn in turns]
+    taylor = [sum(v / turn ** k for v, turn in zip(values, turns)) / points / radius ** k
+              for k in range(degree + 1)]
+    try:
+        offsets = mpmath.polyroots(taylor[::-1], maxsteps=200, extraprec=2 * mpmath.mp.prec)
+    except mpmath.libmp.NoConvergence as error:
+        raise RuntimeError(str(error)) from None
+    offsets = sorted(offsets, key=abs)[:multiplicity]
+    if any(abs(t) >= radius or abs(mpmath.im(t)) > tolerance * abs(centre) for t in offsets):
+        raise RuntimeError("the cluster's roots are not real and inside the circle")
+    slopes = [k * taylor[k] for k in range(degree, 0, -1)]  # det' about centre, highest power first
+    members = sorted(_secant(deduction, centre + mpmath.re(t), tolerance,
+                             mpmath.re(mpmath.polyval(slopes, mpmath.re(t)))) for t in offsets)
+    if (any(abs(a - centre) >= radius for a in members)
+            or any(b - a <= tolerance * abs(a) for a, b in zip(members, members[1:]))):
+        raise RuntimeError("the cluster's members polish onto one root, or out of the circle")
+    return members
 
 
 def separated_cluster(deduction, model, omega: float, multiplicity: int, radius: float, digits: int):

@@ -342,10 +342,12 @@ def _refined_in_mpmath(deduction, model, finder, omegas, chosen, unseparated, di
     """
     top = [omegas[-1]] if cut_by_count and len(chosen) and max(chosen) == omegas[-1] else []
     cut = {w: finder.multiplicity(w, sorted(set(omegas))) for w in top}
-    refined = dict(zip(chosen, refine_roots(deduction, model, list(chosen), digits,
-                                            {w: m for w, m in cut.items() if m},
-                                            log_det=finder.determinant.log_det)))
-    values = [refined.get(w) for w in omegas]
+    refined = {}  # root -> its refined values in order (a cluster's members differ)
+    for w, value in zip(chosen, refine_roots(deduction, model, list(chosen), digits,
+                                             {w: m for w, m in cut.items() if m},
+                                             log_det=finder.determinant.log_det)):
+        refined.setdefault(w, []).append(value)
+    values = [refined[w].pop(0) if refined.get(w) else None for w in omegas]
     distinct_refined = len(set(chosen))
     for w, (m, radius) in list(unseparated.items()):
         members = separated_cluster(deduction, model, w, m, radius, digits)

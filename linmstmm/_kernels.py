@@ -35,6 +35,7 @@ _FACTORIALS = np.array([[1.0 / math.factorial(4 * j + r) for j in range(_SERIES_
 _XY = np.array([1, 5, 8, 10])
 _XZ = np.array([2, 4, 7, 11])
 _XZ_SIGNS = np.array([1.0, -1.0, -1.0, 1.0])
+_ONES = np.ones(4)
 _BENDING_SIGNS = np.outer([1.0, 1.0, -1.0, 1.0], [1.0, 1.0, -1.0, 1.0])
 
 
@@ -63,11 +64,13 @@ def _bending(EI, rhoA, L, omega, local, indices, signs, functions):
     """The (v, θ, m, q) bending block of one plane into ``local`` at ``indices``."""
     w = rhoA * omega * omega * L ** 4 / EI
     _krylov(w, functions)
+    inverse_L = 1.0 / L
+    lengths = (inverse_L ** 3, inverse_L * inverse_L, inverse_L, 1.0, L, L * L, L ** 3)  # L**(j - i)
+    stiffness = (1.0 / EI, 1.0, EI)
     for i in range(4):
         for j in range(4):
-            value = _BENDING_SIGNS[i, j] * L ** (j - i) * functions[(j - i) % 4]
-            power = (1 if i >= 2 else 0) - (1 if j >= 2 else 0)
-            value *= EI ** power
+            value = _BENDING_SIGNS[i, j] * lengths[j - i + 3] * functions[(j - i) % 4]
+            value *= stiffness[(1 if i >= 2 else 0) - (1 if j >= 2 else 0) + 1]
             if i > j:
                 value *= w
             local[indices[i], indices[j]] = signs[i] * signs[j] * value
@@ -99,14 +102,13 @@ def beam_piece(beam, rotation, omega, length, out):
     E, G, rho, A, Iy, Iz, J, Ip = beam[0], beam[1], beam[2], beam[3], beam[4], beam[5], beam[6], beam[7]
     flags = int(beam[9])
     local = np.zeros((12, 12), dtype=out.dtype)
-    functions = np.zeros(4, dtype=out.dtype)
-    ones = np.ones(4)
-    _bending(E * Iz, rho * A, length, omega, local, _XY, ones, functions)
+    functions = np.empty(4, dtype=out.dtype)
+    _bending(E * Iz, rho * A, length, omega, local, _XY, _ONES, functions)
     _bending(E * Iy, rho * A, length, omega, local, _XZ, _XZ_SIGNS, functions)
     _rod(E * A, rho * A, length, omega, (flags & 1) == 0, local, 0, 9)
     _rod(G * J, rho * Ip, length, omega, (flags & 2) == 0, local, 3, 6)
-    temp = rotation.astype(out.dtype) @ local
-    out[:, :] = temp @ rotation.T.astype(out.dtype)
+    turned = rotation.astype(out.dtype) @ local  # as numpy's rotation @ local @ rotation.T, to the bit
+    out[:, :] = turned @ rotation.T.astype(out.dtype)
 
 
 @njit(cache=True)
@@ -156,21 +158,23 @@ def _place_add(source, target, place, sign, rows):
 
 
 @njit(cache=True)
-def _unit_scale(stacked, kinds, scale):
-    """Row scales of ``stacked`` (rows, k) into ``scale``: one per kind of row (``kinds``:
+def _unit_scale(columns, kinds, scale):
+    """Row scales of the gathered blocks ``columns`` (k, rows), one unknown's column
+    per row of the array, into ``scale`` (rows,): one per kind of row (``kinds``:
     0 displacement, 1 rotation, 2 moment, 3 force), the inverse root-mean-square size
     of all rows of that kind (:meth:`linmstmm.godunov._Orthonormaliser._unit_scale`)."""
-    rows, width = stacked.shape
-    peak = _size(stacked)
+    width, rows = columns.shape
+    peak = _size(columns)
     if peak == 0.0:
         peak = 1.0
+    scale[:] = 0.0  # the squares of each row first, relative to the peak: no overflow
+    for c in range(width):
+        for i in range(rows):
+            v = columns[c, i] / peak
+            scale[i] += v.real * v.real + v.imag * v.imag
     kind_size = np.zeros(4)
     for i in range(rows):
-        squares = 0.0
-        for c in range(width):
-            v = stacked[i, c] / peak
-            squares += v.real * v.real + v.imag * v.imag
-        kind_size[kinds[i]] += squares
+        kind_size[kinds[i]] += scale[i]
     largest = 0.0
     for k in range(4):
         kind_size[k] = math.sqrt(kind_size[k])
@@ -180,37 +184,111 @@ def _unit_scale(stacked, kinds, scale):
         scale[i] = 1.0 / (size * peak) if size > 0 else 1.0  # all rows zero: any scale
 
 
+#: A Gram–Schmidt pass that leaves a column more than this fraction of its squared
+#: norm is orthogonal to rounding; one that leaves less is repeated once ("twice is
+#: enough", Kahan and Parlett; Giraud, Langou and Rozložník 2005).
+_KEPT_ENOUGH = 0.5
+
+
 @njit(cache=True, fastmath={"reassoc", "contract"})
-def _orthonormal_columns(columns, diagonal):
+def _orthonormal_columns(columns, diagonal, projections):
     """Orthonormalise the rows of ``columns`` (k, m) in place: classical Gram–Schmidt,
-    twice (orthogonal to rounding), the QR of its transpose with R's diagonal real and
-    positive (the basis is smooth in ω). ``diagonal`` (k,) receives R's diagonal.
-    Returns False, leaving ``columns`` partly changed, if a column depends exactly on
-    the ones before it (at a root)."""
+    each column's pass repeated once where it cancelled more than half of the
+    column's squared norm (orthogonal to rounding either way), the QR of its
+    transpose with R's diagonal real and positive (the basis is smooth in ω).
+    ``diagonal`` (k,) receives R's diagonal; ``projections`` (k,) is workspace.
+    Returns False, leaving ``columns`` partly changed, if a column depends exactly
+    on the ones before it (at a root)."""
     k, m = columns.shape
     for j in range(k):
-        norm_before = 0.0
-        for i in range(m):
-            v = columns[j, i]
-            norm_before += v.real * v.real + v.imag * v.imag
-        for _ in range(2):
-            for p in range(j):
-                projection = 0.0 * columns[j, 0]
-                for i in range(m):
-                    projection += np.conj(columns[p, i]) * columns[j, i]
-                for i in range(m):
-                    columns[j, i] -= projection * columns[p, i]
         norm = 0.0
         for i in range(m):
             v = columns[j, i]
             norm += v.real * v.real + v.imag * v.imag
-        norm = math.sqrt(norm)
-        if norm == 0.0 or norm_before == 0.0:
+        if norm == 0.0:
             return False
+        for _ in range(2):
+            before = norm
+            for p in range(j):  # every projection from the same column: independent sums
+                projection = 0.0 * columns[j, 0]
+                for i in range(m):
+                    projection += np.conj(columns[p, i]) * columns[j, i]
+                projections[p] = projection
+            for p in range(j):
+                for i in range(m):
+                    columns[j, i] -= projections[p] * columns[p, i]
+            norm = 0.0
+            for i in range(m):
+                v = columns[j, i]
+                norm += v.real * v.real + v.imag * v.imag
+            if norm > _KEPT_ENOUGH * before:
+                break
+        if norm == 0.0:
+            return False
+        norm = math.sqrt(norm)
         diagonal[j] = norm
         for i in range(m):
             columns[j, i] /= norm
     return True
+
+
+@njit(cache=True)
+def _gathered(program, index, work_m, columns, kinds):
+    """The blocks of orthonormalisation record ``index`` stacked on its columns, one
+    unknown per row of ``columns`` (width, rows), and each row's kind into ``kinds``."""
+    (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
+    first, count = orthos[index, 0], orthos[index, 1]
+    row = 0
+    for b in range(first, first + count):
+        src, rows, place_index = blocks[b, 0], blocks[b, 2], blocks[b, 4]
+        source = _view(work_m, slot_offset[src], rows, slot_width[src])
+        if place_index < 0:
+            for i in range(rows):
+                for c in range(source.shape[1]):
+                    columns[c, row + i] = source[i, c]
+        else:
+            place = places[places_start[place_index]:places_start[place_index + 1]]
+            for i in range(rows):
+                for c in range(source.shape[1]):
+                    columns[place[c], row + i] = source[i, c]
+        forces = blocks[b, 5]  # a joint's row: force rows, then moment rows
+        for i in range(rows):
+            kinds[row + i] = i // 3 if forces < 0 else (3 if i < forces else 2)
+        row += rows
+
+
+@njit(cache=True)
+def _scattered(program, index, columns, scale, work_m, reference_m):
+    """Write the orthonormalised ``columns`` (width, rows) back into the record's
+    blocks, each row divided by its ``scale``; returns the log of the common power of
+    two taken out of them past :data:`FAR` (0 if none)."""
+    (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
+    first, count, width = orthos[index, 0], orthos[index, 1], orthos[index, 3]
+    back = np.empty(scale.size)
+    peak = 0.0
+    for i in range(scale.size):
+        back[i] = 1.0 / scale[i]
+    for c in range(width):
+        for i in range(scale.size):
+            v = columns[c, i] * back[i]
+            peak = max(peak, abs(v.real) + abs(v.imag))
+    log_common = 0.0
+    if peak > FAR or peak < 1 / FAR:
+        common = 2.0 ** (-np.round(np.log2(peak)))
+        log_common = math.log(common)
+        for i in range(scale.size):
+            back[i] *= common
+    row = 0
+    for b in range(first, first + count):
+        src, dst, rows, kind = blocks[b, 0], blocks[b, 1], blocks[b, 2], blocks[b, 3]
+        target = _view(work_m, slot_offset[dst], rows, width)
+        for i in range(rows):
+            for c in range(width):
+                target[i, c] = columns[c, row + i] * back[row + i]
+        if kind == STATE_BLOCK:
+            reference_m[dst] = _size(target)
+        row += rows
+    return log_common
 
 
 @njit(cache=True)
@@ -230,6 +308,24 @@ def _orthonormalise(program, index, work, reference, log_scale, group):
         if not (growth < GROWTH and growth > 1 / GROWTH):
             skip = False
             break
+    if not skip:
+        total = 0
+        for b in range(first, first + count):
+            total += blocks[b, 2]
+        columns = np.zeros((group, width, total), dtype=work.dtype)  # each unknown's column, contiguous
+        kinds = np.empty(total, dtype=np.int64)
+        scale = np.empty((group, total))
+        diagonals = np.empty((group, width))
+        projections = np.empty(width, dtype=work.dtype)
+        for m in range(group):
+            _gathered(program, index, work[m], columns[m], kinds)
+            _unit_scale(columns[m], kinds, scale[m])
+            for c in range(width):
+                for i in range(total):
+                    columns[m, c, i] *= scale[m, i]
+            if not _orthonormal_columns(columns[m], diagonals[m], projections):
+                skip = True  # exactly dependent columns (at a root) are kept as they are
+                break
     if skip:  # lay the blocks out on the plan's columns, nothing else
         for m in range(group):
             for b in range(first, first + count):
@@ -244,61 +340,10 @@ def _orthonormalise(program, index, work, reference, log_scale, group):
                 if blocks[b, 3] == STATE_BLOCK:
                     reference[m, dst] = reference[m, src]
         return
-    total = 0
-    for b in range(first, first + count):
-        total += blocks[b, 2]
-    stacked = np.zeros((group, total, width), dtype=work.dtype)
-    kinds = np.zeros(total, dtype=np.int64)
     for m in range(group):
-        row = 0
-        for b in range(first, first + count):
-            src, rows, place_index = blocks[b, 0], blocks[b, 2], blocks[b, 4]
-            source = _view(work[m], slot_offset[src], rows, slot_width[src])
-            if place_index < 0:
-                stacked[m, row:row + rows, :] = source
-            else:
-                place = places[places_start[place_index]:places_start[place_index + 1]]
-                for i in range(rows):
-                    for c in range(source.shape[1]):
-                        stacked[m, row + i, place[c]] = source[i, c]
-            forces = blocks[b, 5]  # a joint's row: force rows, then moment rows
-            for i in range(rows):
-                kinds[row + i] = i // 3 if forces < 0 else (3 if i < forces else 2)
-            row += rows
-    factors = np.zeros((group, total, width), dtype=work.dtype)
-    diagonals = np.zeros((group, width))
-    scale = np.zeros(total)
-    columns = np.empty((width, total), dtype=work.dtype)  # the scaled columns, each contiguous
-    for m in range(group):
-        _unit_scale(stacked[m], kinds, scale)
-        for i in range(total):
-            for c in range(width):
-                columns[c, i] = stacked[m, i, c] * scale[i]
-        if not _orthonormal_columns(columns, diagonals[m]):
-            skip = True
-            break
-        for i in range(total):
-            for c in range(width):
-                factors[m, i, c] = columns[c, i] / scale[i]
-    if not skip:  # exactly dependent columns (at a root) are kept as they are
-        for m in range(group):
-            for c in range(width):
-                log_scale[m] += math.log(diagonals[m, c])
-            peak = _size(factors[m])
-            if peak > FAR or peak < 1 / FAR:
-                common = 2.0 ** (-np.round(np.log2(peak)))
-                factors[m] *= common
-                log_scale[m] -= math.log(common) * width
-        stacked = factors
-    for m in range(group):
-        row = 0
-        for b in range(first, first + count):
-            src, dst, rows, kind = blocks[b, 0], blocks[b, 1], blocks[b, 2], blocks[b, 3]
-            target = _view(work[m], slot_offset[dst], rows, width)
-            target[:, :] = stacked[m, row:row + rows, :]
-            if kind == STATE_BLOCK:
-                reference[m, dst] = reference[m, src] if skip else _size(target)
-            row += rows
+        for c in range(width):
+            log_scale[m] += math.log(diagonals[m, c])
+        log_scale[m] -= _scattered(program, index, columns[m], scale[m], work[m], reference[m]) * width
 
 
 @njit(cache=True)
@@ -312,7 +357,7 @@ def _run(program, omegas, work, reference, log_scale):
     for m in range(group):
         largest = max(largest, abs(omegas[m]))
     pieces = np.ones(beams.shape[0], dtype=np.int64)
-    piece = np.zeros((group, 12, 12), dtype=omegas.dtype)
+    piece = np.empty((beams.shape[0], group, 12, 12), dtype=omegas.dtype)  # each beam's, per frequency
     for op in range(operations.shape[0]):
         code, a, b, c, d = (operations[op, 0], operations[op, 1], operations[op, 2], operations[op, 3],
                             operations[op, 4])
@@ -372,12 +417,12 @@ def _run(program, omegas, work, reference, log_scale):
                 softer = min(beam[4], beam[5])
                 beta_L = (beam[2] * beam[3] * largest ** 2 / (beam[0] * softer)) ** 0.25 * beam[8]
                 pieces[b] = max(int(math.ceil(beta_L / BEAM_PIECE_BETA_L)), 1)
-            for m in range(group):
-                beam_piece(beam, beam_rotation[b], omegas[m], beam[8] / pieces[b], piece[m])
+                for m in range(group):
+                    beam_piece(beam, beam_rotation[b], omegas[m], beam[8] / pieces[b], piece[b, m])
             for repeat in range(1 if c == 1 else pieces[b] - 1):
                 for m in range(group):
                     state = _view(work[m], slot_offset[a], 12, slot_width[a])
-                    state[:, :] = piece[m] @ state.copy()
+                    state[:, :] = piece[b, m] @ state.copy()
                 if c == 0 and d >= 0:
                     _orthonormalise(ortho_program, d, work, reference, log_scale, group)
 
@@ -386,26 +431,28 @@ def _run(program, omegas, work, reference, log_scale):
 def _assembled(root, root_row, rows, order, kept_rows, kept_columns, work_m, slot_offset, slot_width,
                slot_columns, slot_columns_start, slot_rows):
     """Ū_all (N, N) of one frequency from its workspace."""
-    full = np.zeros((order, order), dtype=work_m.dtype)
-    for slot in (root, root_row):
-        block = _view(work_m, slot_offset[slot], 12, slot_width[slot])
-        columns = slot_columns[slot_columns_start[slot]:slot_columns_start[slot + 1]]
-        for i in range(12):
-            for c in range(columns.size):
-                full[i, columns[c]] += block[i, c]
-    start = 12
-    for g in range(rows.size):
-        slot = rows[g]
+    row_of = np.full(order, -1)  # where each row and column of the full Ū_all is kept, -1: released
+    column_of = np.full(order, -1)
+    for i in range(kept_rows.size):
+        row_of[kept_rows[i]] = i
+    for j in range(kept_columns.size):
+        column_of[kept_columns[j]] = j
+    out = np.zeros((kept_rows.size, kept_columns.size), dtype=work_m.dtype)
+    start = 0
+    for g in range(-2, rows.size):
+        slot = root if g == -2 else (root_row if g == -1 else rows[g])
         block = _view(work_m, slot_offset[slot], slot_rows[slot], slot_width[slot])
         columns = slot_columns[slot_columns_start[slot]:slot_columns_start[slot + 1]]
         for i in range(slot_rows[slot]):
+            row = row_of[start + i]
+            if row < 0:
+                continue
             for c in range(columns.size):
-                full[start + i, columns[c]] = block[i, c]
-        start += slot_rows[slot]
-    out = np.empty((kept_rows.size, kept_columns.size), dtype=work_m.dtype)
-    for i in range(kept_rows.size):
-        for j in range(kept_columns.size):
-            out[i, j] = full[kept_rows[i], kept_columns[j]]
+                column = column_of[columns[c]]
+                if column >= 0:
+                    out[row, column] += block[i, c]
+        if g != -2:  # the root state and −Z_root share the first twelve rows
+            start += slot_rows[slot]
     return out
 
 

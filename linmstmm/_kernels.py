@@ -113,13 +113,25 @@ def beam_piece(beam, rotation, omega, length, out):
 
 @njit(cache=True)
 def _size(values):
-    """Largest |Re| + |Im| of ``values``."""
-    largest = 0.0
-    for v in values.ravel():
-        s = abs(v.real) + abs(v.imag)
-        if s > largest:
-            largest = s
-    return largest
+    """Largest |Re| + |Im| of ``values`` (contiguous), NaN ignored."""
+    flat = values.ravel()
+    first = second = third = fourth = 0.0  # four running maxima: no chain of comparisons
+    whole = flat.size - flat.size % 4
+    for start in range(0, whole, 4):
+        first = max(first, _magnitude(flat[start]))
+        second = max(second, _magnitude(flat[start + 1]))
+        third = max(third, _magnitude(flat[start + 2]))
+        fourth = max(fourth, _magnitude(flat[start + 3]))
+    for i in range(whole, flat.size):
+        first = max(first, _magnitude(flat[i]))
+    return max(max(first, second), max(third, fourth))
+
+
+@njit(cache=True, inline="always")
+def _magnitude(v):
+    """|Re| + |Im| of ``v``, 0 for NaN."""
+    s = abs(v.real) + abs(v.imag)
+    return s if s > 0.0 else 0.0
 
 
 @njit(cache=True)
@@ -165,12 +177,12 @@ def _unit_scale(columns, kinds, scale):
     of all rows of that kind (:meth:`linmstmm.godunov._Orthonormaliser._unit_scale`)."""
     width, rows = columns.shape
     peak = _size(columns)
-    if peak == 0.0:
-        peak = 1.0
+    peak = 2.0 ** np.round(np.log2(peak)) if peak > 0.0 else 1.0  # a power of two: exact division
+    inverse_peak = 1.0 / peak
     scale[:] = 0.0  # the squares of each row first, relative to the peak: no overflow
     for c in range(width):
         for i in range(rows):
-            v = columns[c, i] / peak
+            v = columns[c, i] * inverse_peak
             scale[i] += v.real * v.real + v.imag * v.imag
     kind_size = np.zeros(4)
     for i in range(rows):
@@ -265,30 +277,31 @@ def _scattered(program, index, columns, scale, work_m, reference_m):
     (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
     first, count, width = orthos[index, 0], orthos[index, 1], orthos[index, 3]
     back = np.empty(scale.size)
-    peak = 0.0
     for i in range(scale.size):
         back[i] = 1.0 / scale[i]
-    for c in range(width):
-        for i in range(scale.size):
-            v = columns[c, i] * back[i]
-            peak = max(peak, abs(v.real) + abs(v.imag))
-    log_common = 0.0
-    if peak > FAR or peak < 1 / FAR:
-        common = 2.0 ** (-np.round(np.log2(peak)))
-        log_common = math.log(common)
-        for i in range(scale.size):
-            back[i] *= common
+    peak = 0.0
     row = 0
     for b in range(first, first + count):
-        src, dst, rows, kind = blocks[b, 0], blocks[b, 1], blocks[b, 2], blocks[b, 3]
+        dst, rows, kind = blocks[b, 1], blocks[b, 2], blocks[b, 3]
         target = _view(work_m, slot_offset[dst], rows, width)
         for i in range(rows):
             for c in range(width):
                 target[i, c] = columns[c, row + i] * back[row + i]
+        size = _size(target)
+        peak = max(peak, size)
         if kind == STATE_BLOCK:
-            reference_m[dst] = _size(target)
+            reference_m[dst] = size
         row += rows
-    return log_common
+    if not (peak > FAR or peak < 1 / FAR):
+        return 0.0
+    common = 2.0 ** (-np.round(np.log2(peak)))  # a power of two: every entry and size scales exactly
+    for b in range(first, first + count):
+        dst, rows, kind = blocks[b, 1], blocks[b, 2], blocks[b, 3]
+        start = slot_offset[dst]
+        work_m[start:start + rows * width] *= common
+        if kind == STATE_BLOCK:
+            reference_m[dst] *= common
+    return math.log(common)
 
 
 @njit(cache=True)
@@ -303,17 +316,18 @@ def _orthonormalise(program, index, work, reference, log_scale, group):
         if math.isnan(ref) or ref == 0.0:  # no reference, or grown from nothing (numpy: inf)
             skip = False
             break
-        growth = _size(_view(work[m], slot_offset[state_src], slot_rows[state_src],
-                             slot_width[state_src])) / ref
+        start = slot_offset[state_src]
+        growth = _size(work[m, start:start + slot_rows[state_src] * slot_width[state_src]]) / ref
         if not (growth < GROWTH and growth > 1 / GROWTH):
             skip = False
             break
     if not skip:
-        total = 0
+        total = 3  # rows, padded with zeros to a multiple of four: Gram–Schmidt's sums run in whole vectors
         for b in range(first, first + count):
             total += blocks[b, 2]
+        total -= total % 4
         columns = np.zeros((group, width, total), dtype=work.dtype)  # each unknown's column, contiguous
-        kinds = np.empty(total, dtype=np.int64)
+        kinds = np.zeros(total, dtype=np.int64)
         scale = np.empty((group, total))
         diagonals = np.empty((group, width))
         projections = np.empty(width, dtype=work.dtype)
@@ -430,14 +444,15 @@ def _run(program, omegas, work, reference, log_scale):
 @njit(cache=True)
 def _assembled(root, root_row, rows, order, kept_rows, kept_columns, work_m, slot_offset, slot_width,
                slot_columns, slot_columns_start, slot_rows):
-    """Ū_all (N, N) of one frequency from its workspace."""
+    """(Ū_all (N, N) of one frequency from its workspace, whether all its entries are
+    finite). Ū_all is in Fortran order: what LAPACK factorises, without reordering."""
     row_of = np.full(order, -1)  # where each row and column of the full Ū_all is kept, -1: released
     column_of = np.full(order, -1)
     for i in range(kept_rows.size):
         row_of[kept_rows[i]] = i
     for j in range(kept_columns.size):
         column_of[kept_columns[j]] = j
-    out = np.zeros((kept_rows.size, kept_columns.size), dtype=work_m.dtype)
+    transposed = np.zeros((kept_columns.size, kept_rows.size), dtype=work_m.dtype)
     start = 0
     for g in range(-2, rows.size):
         slot = root if g == -2 else (root_row if g == -1 else rows[g])
@@ -450,10 +465,13 @@ def _assembled(root, root_row, rows, order, kept_rows, kept_columns, work_m, slo
             for c in range(columns.size):
                 column = column_of[columns[c]]
                 if column >= 0:
-                    out[row, column] += block[i, c]
+                    transposed[column, row] += block[i, c]
         if g != -2:  # the root state and −Z_root share the first twelve rows
             start += slot_rows[slot]
-    return out
+    finite = True
+    for v in transposed.ravel():
+        finite = finite and abs(v.real) < np.inf and abs(v.imag) < np.inf  # False for NaN too
+    return transposed.T, finite
 
 
 @njit(cache=True)
@@ -477,11 +495,11 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
         log_scale = np.zeros(size)
         _run(program, omegas[start:stop], work, reference, log_scale)
         for m in range(size):
-            ubar = _assembled(root, root_row, rows, order, kept_rows, kept_columns, work[m], slot_offset,
+            ubar, finite = _assembled(root, root_row, rows, order, kept_rows, kept_columns, work[m], slot_offset,
                               slot_width, slot_columns, slot_columns_start, slot_rows)
             if matrices_out.shape[0]:
                 matrices_out[start + m] = ubar
-            if np.all(np.isfinite(ubar)):
+            if finite:
                 sign, log_abs = np.linalg.slogdet(ubar)
                 sign_out[start + m] = sign
                 log_abs_out[start + m] = log_abs + log_scale[m]

@@ -20,8 +20,10 @@ from __future__ import annotations
 
 import math
 
+import llvmlite.binding
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import get_cython_function_address
 
 from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, STATE_BLOCK, TIP
 
@@ -474,6 +476,46 @@ def _assembled(root, root_row, rows, order, kept_rows, kept_columns, work_m, slo
     return transposed.T, finite
 
 
+def _lapack(name: str):
+    """LAPACK routine ``name`` (pointer arguments only) as scipy ships it, and as numba's
+    own linear algebra calls it, under a symbol of its own: found by name when cached
+    machine code is loaded."""
+    symbol = f"linmstmm_{name}"
+    llvmlite.binding.add_symbol(symbol, get_cython_function_address("scipy.linalg.cython_lapack", name))
+    return types.ExternalFunction(symbol, types.void(*[types.voidptr] * 6))
+
+
+_DGETRF, _ZGETRF = _lapack("dgetrf"), _lapack("zgetrf")
+
+
+@njit(cache=True)
+def _log_det(matrix):
+    """(sign or phase, log|det|) of ``matrix`` (N, N), Fortran-ordered and finite, which
+    it overwrites with its LU factors: what numpy's slogdet computes (LAPACK's getrf),
+    without a checked copy."""
+    n = matrix.shape[0]
+    integers = np.array([n, n, 0], dtype=np.int32)  # order, leading dimension, info
+    pivots = np.empty(n, dtype=np.int32)
+    if matrix.itemsize == 16:  # complex128
+        _ZGETRF(integers.ctypes, integers.ctypes, matrix.ctypes, integers[1:].ctypes, pivots.ctypes,
+                integers[2:].ctypes)
+    else:
+        _DGETRF(integers.ctypes, integers.ctypes, matrix.ctypes, integers[1:].ctypes, pivots.ctypes,
+                integers[2:].ctypes)
+    sign = 1.0 + 0.0 * matrix[0, 0]
+    if integers[2] > 0:  # an exactly zero pivot
+        return 0.0 * sign, -np.inf
+    for k in range(n):
+        if pivots[k] != k + 1:
+            sign = -sign
+    log_abs = 0.0
+    for k in range(n):
+        magnitude = np.abs(matrix[k, k])
+        sign = sign * (matrix[k, k] / magnitude)
+        log_abs += np.log(magnitude)
+    return sign, log_abs
+
+
 @njit(cache=True)
 def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out, log_scale_out):
     """Stable Ū_all over ``omegas`` (n,) in groups of ``group`` consecutive frequencies.
@@ -495,12 +537,12 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
         log_scale = np.zeros(size)
         _run(program, omegas[start:stop], work, reference, log_scale)
         for m in range(size):
-            ubar, finite = _assembled(root, root_row, rows, order, kept_rows, kept_columns, work[m], slot_offset,
-                              slot_width, slot_columns, slot_columns_start, slot_rows)
+            ubar, finite = _assembled(root, root_row, rows, order, kept_rows, kept_columns, work[m],
+                                      slot_offset, slot_width, slot_columns, slot_columns_start, slot_rows)
             if matrices_out.shape[0]:
                 matrices_out[start + m] = ubar
             if finite:
-                sign, log_abs = np.linalg.slogdet(ubar)
+                sign, log_abs = _log_det(ubar)
                 sign_out[start + m] = sign
                 log_abs_out[start + m] = log_abs + log_scale[m]
             else:  # numpy's slogdet answers NaN, which the root counts step round; numba's raises

@@ -446,8 +446,8 @@ def _run(program, omegas, work, reference, log_scale):
 @njit(cache=True)
 def _assembled(root, root_row, rows, order, kept_rows, kept_columns, work_m, slot_offset, slot_width,
                slot_columns, slot_columns_start, slot_rows):
-    """(Ū_all (N, N) of one frequency from its workspace, whether all its entries are
-    finite). Ū_all is in Fortran order: what LAPACK factorises, without reordering."""
+    """Ū_all (N, N) of one frequency from its workspace, in Fortran order (what LAPACK
+    factorises, without reordering)."""
     row_of = np.full(order, -1)  # where each row and column of the full Ū_all is kept, -1: released
     column_of = np.full(order, -1)
     for i in range(kept_rows.size):
@@ -470,10 +470,7 @@ def _assembled(root, root_row, rows, order, kept_rows, kept_columns, work_m, slo
                     transposed[column, row] += block[i, c]
         if g != -2:  # the root state and −Z_root share the first twelve rows
             start += slot_rows[slot]
-    finite = True
-    for v in transposed.ravel():
-        finite = finite and abs(v.real) < np.inf and abs(v.imag) < np.inf  # False for NaN too
-    return transposed.T, finite
+    return transposed.T
 
 
 def _lapack(name: str):
@@ -490,9 +487,10 @@ _DGETRF, _ZGETRF = _lapack("dgetrf"), _lapack("zgetrf")
 
 @njit(cache=True)
 def _log_det(matrix):
-    """(sign or phase, log|det|) of ``matrix`` (N, N), Fortran-ordered and finite, which
-    it overwrites with its LU factors: what numpy's slogdet computes (LAPACK's getrf),
-    without a checked copy."""
+    """(sign or phase, log|det|) of ``matrix`` (N, N), Fortran-ordered, which it
+    overwrites with its LU factors: what numpy's slogdet computes (LAPACK's getrf),
+    without a copy. (NaN, NaN) where a pivot is not finite (an entry was not: numba's
+    slogdet raises there), which the root counts step round."""
     n = matrix.shape[0]
     integers = np.array([n, n, 0], dtype=np.int32)  # order, leading dimension, info
     pivots = np.empty(n, dtype=np.int32)
@@ -503,16 +501,19 @@ def _log_det(matrix):
         _DGETRF(integers.ctypes, integers.ctypes, matrix.ctypes, integers[1:].ctypes, pivots.ctypes,
                 integers[2:].ctypes)
     sign = 1.0 + 0.0 * matrix[0, 0]
-    if integers[2] > 0:  # an exactly zero pivot
-        return 0.0 * sign, -np.inf
     for k in range(n):
         if pivots[k] != k + 1:
             sign = -sign
     log_abs = 0.0
     for k in range(n):
         magnitude = np.abs(matrix[k, k])
-        sign = sign * (matrix[k, k] / magnitude)
+        if magnitude > 0.0:
+            sign = sign * (matrix[k, k] / magnitude)
         log_abs += np.log(magnitude)
+    if math.isnan(log_abs) or log_abs == np.inf:
+        return np.nan + 0.0 * sign, np.nan
+    if integers[2] > 0:  # an exactly zero pivot
+        return sign - sign, -np.inf  # a zero of sign's type, +0
     return sign, log_abs
 
 
@@ -537,15 +538,11 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
         log_scale = np.zeros(size)
         _run(program, omegas[start:stop], work, reference, log_scale)
         for m in range(size):
-            ubar, finite = _assembled(root, root_row, rows, order, kept_rows, kept_columns, work[m],
-                                      slot_offset, slot_width, slot_columns, slot_columns_start, slot_rows)
+            ubar = _assembled(root, root_row, rows, order, kept_rows, kept_columns, work[m], slot_offset,
+                              slot_width, slot_columns, slot_columns_start, slot_rows)
             if matrices_out.shape[0]:
                 matrices_out[start + m] = ubar
-            if finite:
-                sign, log_abs = _log_det(ubar)
-                sign_out[start + m] = sign
-                log_abs_out[start + m] = log_abs + log_scale[m]
-            else:  # numpy's slogdet answers NaN, which the root counts step round; numba's raises
-                sign_out[start + m] = np.nan
-                log_abs_out[start + m] = np.nan
+            sign, log_abs = _log_det(ubar)  # NaN where not finite, which the root counts step round
+            sign_out[start + m] = sign
+            log_abs_out[start + m] = log_abs + log_scale[m]
             log_scale_out[start + m] = log_scale[m]

@@ -15,6 +15,11 @@ Frequencies are evaluated in groups of consecutive entries that take the
 same decisions (pieces per beam, orthonormalisations skipped), as one numpy
 stack does: a group of two, ω and ω + δω, gives a smooth difference of the
 orthonormalised Ū_all (Newton's pencil).
+
+Kept whole: numba invalidates cached machine code when the file that defines
+a kernel changes, not when a kernel it calls in another file does (its
+documented limit); split across files, an edit to a callee would leave its
+callers running the old code from the cache.
 """
 from __future__ import annotations
 
@@ -189,10 +194,8 @@ def _unit_scale(columns, kinds, scale):
     kind_size = np.zeros(4)
     for i in range(rows):
         kind_size[kinds[i]] += scale[i]
-    largest = 0.0
-    for k in range(4):
-        kind_size[k] = math.sqrt(kind_size[k])
-        largest = max(largest, kind_size[k])
+    kind_size = np.sqrt(kind_size)
+    largest = kind_size.max()
     for i in range(rows):
         size = kind_size[kinds[i]] if kind_size[kinds[i]] > 0 else largest
         scale[i] = 1.0 / (size * peak) if size > 0 else 1.0  # all rows zero: any scale
@@ -204,7 +207,25 @@ def _unit_scale(columns, kinds, scale):
 _KEPT_ENOUGH = 0.5
 
 
-@njit(cache=True, fastmath={"reassoc", "contract"})
+@njit(cache=True, inline="always")
+def _dot(columns, p, j):
+    """Σ conj(columns[p]) columns[j], in four interleaved partial sums added in a fixed
+    order: the same rounding wherever numba compiles it (a reassociated sum is
+    vectorised as each caller's context allows, and rounds differently)."""
+    m = columns.shape[1]
+    first = second = third = fourth = 0.0 * columns[j, 0]
+    whole = m - m % 4
+    for i in range(0, whole, 4):
+        first += np.conj(columns[p, i]) * columns[j, i]
+        second += np.conj(columns[p, i + 1]) * columns[j, i + 1]
+        third += np.conj(columns[p, i + 2]) * columns[j, i + 2]
+        fourth += np.conj(columns[p, i + 3]) * columns[j, i + 3]
+    for i in range(whole, m):
+        first += np.conj(columns[p, i]) * columns[j, i]
+    return (first + second) + (third + fourth)
+
+
+@njit(cache=True)
 def _orthonormal_columns(columns, diagonal, projections):
     """Orthonormalise the rows of ``columns`` (k, m) in place: classical Gram–Schmidt,
     each column's pass repeated once where it cancelled more than half of the
@@ -215,26 +236,17 @@ def _orthonormal_columns(columns, diagonal, projections):
     on the ones before it (at a root)."""
     k, m = columns.shape
     for j in range(k):
-        norm = 0.0
-        for i in range(m):
-            v = columns[j, i]
-            norm += v.real * v.real + v.imag * v.imag
+        norm = _dot(columns, j, j).real
         if norm == 0.0:
             return False
         for _ in range(2):
             before = norm
             for p in range(j):  # every projection from the same column: independent sums
-                projection = 0.0 * columns[j, 0]
-                for i in range(m):
-                    projection += np.conj(columns[p, i]) * columns[j, i]
-                projections[p] = projection
+                projections[p] = _dot(columns, p, j)
             for p in range(j):
                 for i in range(m):
                     columns[j, i] -= projections[p] * columns[p, i]
-            norm = 0.0
-            for i in range(m):
-                v = columns[j, i]
-                norm += v.real * v.real + v.imag * v.imag
+            norm = _dot(columns, j, j).real
             if norm > _KEPT_ENOUGH * before:
                 break
         if norm == 0.0:
@@ -278,9 +290,7 @@ def _scattered(program, index, columns, scale, work_m, reference_m):
     two taken out of them past :data:`FAR` (0 if none)."""
     (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
     first, count, width = orthos[index, 0], orthos[index, 1], orthos[index, 3]
-    back = np.empty(scale.size)
-    for i in range(scale.size):
-        back[i] = 1.0 / scale[i]
+    back = 1.0 / scale
     peak = 0.0
     row = 0
     for b in range(first, first + count):

@@ -15,13 +15,20 @@ Frequencies are evaluated in groups of consecutive entries that take the
 same decisions (pieces per beam, orthonormalisations skipped), as one numpy
 stack does: a group of two, ω and ω + δω, gives a smooth difference of the
 orthonormalised Ū_all (Newton's pencil).
+
+Kept whole: numba invalidates cached machine code when the file that defines
+a kernel changes, not when a kernel it calls in another file does (its
+documented limit); split across files, an edit to a callee would leave its
+callers running the old code from the cache.
 """
 from __future__ import annotations
 
 import math
 
+import llvmlite.binding
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import get_cython_function_address
 
 from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, STATE_BLOCK, TIP
 
@@ -35,6 +42,7 @@ _FACTORIALS = np.array([[1.0 / math.factorial(4 * j + r) for j in range(_SERIES_
 _XY = np.array([1, 5, 8, 10])
 _XZ = np.array([2, 4, 7, 11])
 _XZ_SIGNS = np.array([1.0, -1.0, -1.0, 1.0])
+_ONES = np.ones(4)
 _BENDING_SIGNS = np.outer([1.0, 1.0, -1.0, 1.0], [1.0, 1.0, -1.0, 1.0])
 
 
@@ -63,11 +71,13 @@ def _bending(EI, rhoA, L, omega, local, indices, signs, functions):
     """The (v, θ, m, q) bending block of one plane into ``local`` at ``indices``."""
     w = rhoA * omega * omega * L ** 4 / EI
     _krylov(w, functions)
+    inverse_L = 1.0 / L
+    lengths = (inverse_L ** 3, inverse_L * inverse_L, inverse_L, 1.0, L, L * L, L ** 3)  # L**(j - i)
+    stiffness = (1.0 / EI, 1.0, EI)
     for i in range(4):
         for j in range(4):
-            value = _BENDING_SIGNS[i, j] * L ** (j - i) * functions[(j - i) % 4]
-            power = (1 if i >= 2 else 0) - (1 if j >= 2 else 0)
-            value *= EI ** power
+            value = _BENDING_SIGNS[i, j] * lengths[j - i + 3] * functions[(j - i) % 4]
+            value *= stiffness[(1 if i >= 2 else 0) - (1 if j >= 2 else 0) + 1]
             if i > j:
                 value *= w
             local[indices[i], indices[j]] = signs[i] * signs[j] * value
@@ -99,25 +109,36 @@ def beam_piece(beam, rotation, omega, length, out):
     E, G, rho, A, Iy, Iz, J, Ip = beam[0], beam[1], beam[2], beam[3], beam[4], beam[5], beam[6], beam[7]
     flags = int(beam[9])
     local = np.zeros((12, 12), dtype=out.dtype)
-    functions = np.zeros(4, dtype=out.dtype)
-    ones = np.ones(4)
-    _bending(E * Iz, rho * A, length, omega, local, _XY, ones, functions)
+    functions = np.empty(4, dtype=out.dtype)
+    _bending(E * Iz, rho * A, length, omega, local, _XY, _ONES, functions)
     _bending(E * Iy, rho * A, length, omega, local, _XZ, _XZ_SIGNS, functions)
     _rod(E * A, rho * A, length, omega, (flags & 1) == 0, local, 0, 9)
     _rod(G * J, rho * Ip, length, omega, (flags & 2) == 0, local, 3, 6)
-    temp = rotation.astype(out.dtype) @ local
-    out[:, :] = temp @ rotation.T.astype(out.dtype)
+    turned = rotation.astype(out.dtype) @ local  # as numpy's rotation @ local @ rotation.T, to the bit
+    out[:, :] = turned @ rotation.T.astype(out.dtype)
 
 
 @njit(cache=True)
 def _size(values):
-    """Largest |Re| + |Im| of ``values``."""
-    largest = 0.0
-    for v in values.ravel():
-        s = abs(v.real) + abs(v.imag)
-        if s > largest:
-            largest = s
-    return largest
+    """Largest |Re| + |Im| of ``values`` (contiguous), NaN ignored."""
+    flat = values.ravel()
+    first = second = third = fourth = 0.0  # four running maxima: no chain of comparisons
+    whole = flat.size - flat.size % 4
+    for start in range(0, whole, 4):
+        first = max(first, _magnitude(flat[start]))
+        second = max(second, _magnitude(flat[start + 1]))
+        third = max(third, _magnitude(flat[start + 2]))
+        fourth = max(fourth, _magnitude(flat[start + 3]))
+    for i in range(whole, flat.size):
+        first = max(first, _magnitude(flat[i]))
+    return max(max(first, second), max(third, fourth))
+
+
+@njit(cache=True, inline="always")
+def _magnitude(v):
+    """|Re| + |Im| of ``v``, 0 for NaN."""
+    s = abs(v.real) + abs(v.imag)
+    return s if s > 0.0 else 0.0
 
 
 @njit(cache=True)
@@ -156,61 +177,143 @@ def _place_add(source, target, place, sign, rows):
 
 
 @njit(cache=True)
-def _unit_scale(stacked, kinds, scale):
-    """Row scales of ``stacked`` (rows, k) into ``scale``: one per kind of row (``kinds``:
+def _unit_scale(columns, kinds, scale):
+    """Row scales of the gathered blocks ``columns`` (k, rows), one unknown's column
+    per row of the array, into ``scale`` (rows,): one per kind of row (``kinds``:
     0 displacement, 1 rotation, 2 moment, 3 force), the inverse root-mean-square size
     of all rows of that kind (:meth:`linmstmm.godunov._Orthonormaliser._unit_scale`)."""
-    rows, width = stacked.shape
-    peak = _size(stacked)
-    if peak == 0.0:
-        peak = 1.0
+    width, rows = columns.shape
+    peak = _size(columns)
+    peak = 2.0 ** np.round(np.log2(peak)) if peak > 0.0 else 1.0  # a power of two: exact division
+    inverse_peak = 1.0 / peak
+    scale[:] = 0.0  # the squares of each row first, relative to the peak: no overflow
+    for c in range(width):
+        for i in range(rows):
+            v = columns[c, i] * inverse_peak
+            scale[i] += v.real * v.real + v.imag * v.imag
     kind_size = np.zeros(4)
     for i in range(rows):
-        squares = 0.0
-        for c in range(width):
-            v = stacked[i, c] / peak
-            squares += v.real * v.real + v.imag * v.imag
-        kind_size[kinds[i]] += squares
-    largest = 0.0
-    for k in range(4):
-        kind_size[k] = math.sqrt(kind_size[k])
-        largest = max(largest, kind_size[k])
+        kind_size[kinds[i]] += scale[i]
+    kind_size = np.sqrt(kind_size)
+    largest = kind_size.max()
     for i in range(rows):
         size = kind_size[kinds[i]] if kind_size[kinds[i]] > 0 else largest
         scale[i] = 1.0 / (size * peak) if size > 0 else 1.0  # all rows zero: any scale
 
 
-@njit(cache=True, fastmath={"reassoc", "contract"})
-def _orthonormal_columns(columns, diagonal):
+#: A Gram–Schmidt pass that leaves a column more than this fraction of its squared
+#: norm is orthogonal to rounding; one that leaves less is repeated once ("twice is
+#: enough", Kahan and Parlett; Giraud, Langou and Rozložník 2005).
+_KEPT_ENOUGH = 0.5
+
+
+@njit(cache=True, inline="always")
+def _dot(columns, p, j):
+    """Σ conj(columns[p]) columns[j], in four interleaved partial sums added in a fixed
+    order: the same rounding wherever numba compiles it (a reassociated sum is
+    vectorised as each caller's context allows, and rounds differently)."""
+    m = columns.shape[1]
+    first = second = third = fourth = 0.0 * columns[j, 0]
+    whole = m - m % 4
+    for i in range(0, whole, 4):
+        first += np.conj(columns[p, i]) * columns[j, i]
+        second += np.conj(columns[p, i + 1]) * columns[j, i + 1]
+        third += np.conj(columns[p, i + 2]) * columns[j, i + 2]
+        fourth += np.conj(columns[p, i + 3]) * columns[j, i + 3]
+    for i in range(whole, m):
+        first += np.conj(columns[p, i]) * columns[j, i]
+    return (first + second) + (third + fourth)
+
+
+@njit(cache=True)
+def _orthonormal_columns(columns, diagonal, projections):
     """Orthonormalise the rows of ``columns`` (k, m) in place: classical Gram–Schmidt,
-    twice (orthogonal to rounding), the QR of its transpose with R's diagonal real and
-    positive (the basis is smooth in ω). ``diagonal`` (k,) receives R's diagonal.
-    Returns False, leaving ``columns`` partly changed, if a column depends exactly on
-    the ones before it (at a root)."""
+    each column's pass repeated once where it cancelled more than half of the
+    column's squared norm (orthogonal to rounding either way), the QR of its
+    transpose with R's diagonal real and positive (the basis is smooth in ω).
+    ``diagonal`` (k,) receives R's diagonal; ``projections`` (k,) is workspace.
+    Returns False, leaving ``columns`` partly changed, if a column depends exactly
+    on the ones before it (at a root)."""
     k, m = columns.shape
     for j in range(k):
-        norm_before = 0.0
-        for i in range(m):
-            v = columns[j, i]
-            norm_before += v.real * v.real + v.imag * v.imag
-        for _ in range(2):
-            for p in range(j):
-                projection = 0.0 * columns[j, 0]
-                for i in range(m):
-                    projection += np.conj(columns[p, i]) * columns[j, i]
-                for i in range(m):
-                    columns[j, i] -= projection * columns[p, i]
-        norm = 0.0
-        for i in range(m):
-            v = columns[j, i]
-            norm += v.real * v.real + v.imag * v.imag
-        norm = math.sqrt(norm)
-        if norm == 0.0 or norm_before == 0.0:
+        norm = _dot(columns, j, j).real
+        if norm == 0.0:
             return False
+        for _ in range(2):
+            before = norm
+            for p in range(j):  # every projection from the same column: independent sums
+                projections[p] = _dot(columns, p, j)
+            for p in range(j):
+                for i in range(m):
+                    columns[j, i] -= projections[p] * columns[p, i]
+            norm = _dot(columns, j, j).real
+            if norm > _KEPT_ENOUGH * before:
+                break
+        if norm == 0.0:
+            return False
+        norm = math.sqrt(norm)
         diagonal[j] = norm
         for i in range(m):
             columns[j, i] /= norm
     return True
+
+
+@njit(cache=True)
+def _gathered(program, index, work_m, columns, kinds):
+    """The blocks of orthonormalisation record ``index`` stacked on its columns, one
+    unknown per row of ``columns`` (width, rows), and each row's kind into ``kinds``."""
+    (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
+    first, count = orthos[index, 0], orthos[index, 1]
+    row = 0
+    for b in range(first, first + count):
+        src, rows, place_index = blocks[b, 0], blocks[b, 2], blocks[b, 4]
+        source = _view(work_m, slot_offset[src], rows, slot_width[src])
+        if place_index < 0:
+            for i in range(rows):
+                for c in range(source.shape[1]):
+                    columns[c, row + i] = source[i, c]
+        else:
+            place = places[places_start[place_index]:places_start[place_index + 1]]
+            for i in range(rows):
+                for c in range(source.shape[1]):
+                    columns[place[c], row + i] = source[i, c]
+        forces = blocks[b, 5]  # a joint's row: force rows, then moment rows
+        for i in range(rows):
+            kinds[row + i] = i // 3 if forces < 0 else (3 if i < forces else 2)
+        row += rows
+
+
+@njit(cache=True)
+def _scattered(program, index, columns, scale, work_m, reference_m):
+    """Write the orthonormalised ``columns`` (width, rows) back into the record's
+    blocks, each row divided by its ``scale``; returns the log of the common power of
+    two taken out of them past :data:`FAR` (0 if none)."""
+    (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
+    first, count, width = orthos[index, 0], orthos[index, 1], orthos[index, 3]
+    back = 1.0 / scale
+    peak = 0.0
+    row = 0
+    for b in range(first, first + count):
+        dst, rows, kind = blocks[b, 1], blocks[b, 2], blocks[b, 3]
+        target = _view(work_m, slot_offset[dst], rows, width)
+        for i in range(rows):
+            for c in range(width):
+                target[i, c] = columns[c, row + i] * back[row + i]
+        size = _size(target)
+        peak = max(peak, size)
+        if kind == STATE_BLOCK:
+            reference_m[dst] = size
+        row += rows
+    if not (peak > FAR or peak < 1 / FAR):
+        return 0.0
+    common = 2.0 ** (-np.round(np.log2(peak)))  # a power of two: every entry and size scales exactly
+    for b in range(first, first + count):
+        dst, rows, kind = blocks[b, 1], blocks[b, 2], blocks[b, 3]
+        start = slot_offset[dst]
+        work_m[start:start + rows * width] *= common
+        if kind == STATE_BLOCK:
+            reference_m[dst] *= common
+    return math.log(common)
 
 
 @njit(cache=True)
@@ -225,11 +328,30 @@ def _orthonormalise(program, index, work, reference, log_scale, group):
         if math.isnan(ref) or ref == 0.0:  # no reference, or grown from nothing (numpy: inf)
             skip = False
             break
-        growth = _size(_view(work[m], slot_offset[state_src], slot_rows[state_src],
-                             slot_width[state_src])) / ref
+        start = slot_offset[state_src]
+        growth = _size(work[m, start:start + slot_rows[state_src] * slot_width[state_src]]) / ref
         if not (growth < GROWTH and growth > 1 / GROWTH):
             skip = False
             break
+    if not skip:
+        total = 3  # rows, padded with zeros to a multiple of four: Gram–Schmidt's sums run in whole vectors
+        for b in range(first, first + count):
+            total += blocks[b, 2]
+        total -= total % 4
+        columns = np.zeros((group, width, total), dtype=work.dtype)  # each unknown's column, contiguous
+        kinds = np.zeros(total, dtype=np.int64)
+        scale = np.empty((group, total))
+        diagonals = np.empty((group, width))
+        projections = np.empty(width, dtype=work.dtype)
+        for m in range(group):
+            _gathered(program, index, work[m], columns[m], kinds)
+            _unit_scale(columns[m], kinds, scale[m])
+            for c in range(width):
+                for i in range(total):
+                    columns[m, c, i] *= scale[m, i]
+            if not _orthonormal_columns(columns[m], diagonals[m], projections):
+                skip = True  # exactly dependent columns (at a root) are kept as they are
+                break
     if skip:  # lay the blocks out on the plan's columns, nothing else
         for m in range(group):
             for b in range(first, first + count):
@@ -244,61 +366,10 @@ def _orthonormalise(program, index, work, reference, log_scale, group):
                 if blocks[b, 3] == STATE_BLOCK:
                     reference[m, dst] = reference[m, src]
         return
-    total = 0
-    for b in range(first, first + count):
-        total += blocks[b, 2]
-    stacked = np.zeros((group, total, width), dtype=work.dtype)
-    kinds = np.zeros(total, dtype=np.int64)
     for m in range(group):
-        row = 0
-        for b in range(first, first + count):
-            src, rows, place_index = blocks[b, 0], blocks[b, 2], blocks[b, 4]
-            source = _view(work[m], slot_offset[src], rows, slot_width[src])
-            if place_index < 0:
-                stacked[m, row:row + rows, :] = source
-            else:
-                place = places[places_start[place_index]:places_start[place_index + 1]]
-                for i in range(rows):
-                    for c in range(source.shape[1]):
-                        stacked[m, row + i, place[c]] = source[i, c]
-            forces = blocks[b, 5]  # a joint's row: force rows, then moment rows
-            for i in range(rows):
-                kinds[row + i] = i // 3 if forces < 0 else (3 if i < forces else 2)
-            row += rows
-    factors = np.zeros((group, total, width), dtype=work.dtype)
-    diagonals = np.zeros((group, width))
-    scale = np.zeros(total)
-    columns = np.empty((width, total), dtype=work.dtype)  # the scaled columns, each contiguous
-    for m in range(group):
-        _unit_scale(stacked[m], kinds, scale)
-        for i in range(total):
-            for c in range(width):
-                columns[c, i] = stacked[m, i, c] * scale[i]
-        if not _orthonormal_columns(columns, diagonals[m]):
-            skip = True
-            break
-        for i in range(total):
-            for c in range(width):
-                factors[m, i, c] = columns[c, i] / scale[i]
-    if not skip:  # exactly dependent columns (at a root) are kept as they are
-        for m in range(group):
-            for c in range(width):
-                log_scale[m] += math.log(diagonals[m, c])
-            peak = _size(factors[m])
-            if peak > FAR or peak < 1 / FAR:
-                common = 2.0 ** (-np.round(np.log2(peak)))
-                factors[m] *= common
-                log_scale[m] -= math.log(common) * width
-        stacked = factors
-    for m in range(group):
-        row = 0
-        for b in range(first, first + count):
-            src, dst, rows, kind = blocks[b, 0], blocks[b, 1], blocks[b, 2], blocks[b, 3]
-            target = _view(work[m], slot_offset[dst], rows, width)
-            target[:, :] = stacked[m, row:row + rows, :]
-            if kind == STATE_BLOCK:
-                reference[m, dst] = reference[m, src] if skip else _size(target)
-            row += rows
+        for c in range(width):
+            log_scale[m] += math.log(diagonals[m, c])
+        log_scale[m] -= _scattered(program, index, columns[m], scale[m], work[m], reference[m]) * width
 
 
 @njit(cache=True)
@@ -312,7 +383,7 @@ def _run(program, omegas, work, reference, log_scale):
     for m in range(group):
         largest = max(largest, abs(omegas[m]))
     pieces = np.ones(beams.shape[0], dtype=np.int64)
-    piece = np.zeros((group, 12, 12), dtype=omegas.dtype)
+    piece = np.empty((beams.shape[0], group, 12, 12), dtype=omegas.dtype)  # each beam's, per frequency
     for op in range(operations.shape[0]):
         code, a, b, c, d = (operations[op, 0], operations[op, 1], operations[op, 2], operations[op, 3],
                             operations[op, 4])
@@ -372,12 +443,12 @@ def _run(program, omegas, work, reference, log_scale):
                 softer = min(beam[4], beam[5])
                 beta_L = (beam[2] * beam[3] * largest ** 2 / (beam[0] * softer)) ** 0.25 * beam[8]
                 pieces[b] = max(int(math.ceil(beta_L / BEAM_PIECE_BETA_L)), 1)
-            for m in range(group):
-                beam_piece(beam, beam_rotation[b], omegas[m], beam[8] / pieces[b], piece[m])
+                for m in range(group):
+                    beam_piece(beam, beam_rotation[b], omegas[m], beam[8] / pieces[b], piece[b, m])
             for repeat in range(1 if c == 1 else pieces[b] - 1):
                 for m in range(group):
                     state = _view(work[m], slot_offset[a], 12, slot_width[a])
-                    state[:, :] = piece[m] @ state.copy()
+                    state[:, :] = piece[b, m] @ state.copy()
                 if c == 0 and d >= 0:
                     _orthonormalise(ortho_program, d, work, reference, log_scale, group)
 
@@ -385,28 +456,75 @@ def _run(program, omegas, work, reference, log_scale):
 @njit(cache=True)
 def _assembled(root, root_row, rows, order, kept_rows, kept_columns, work_m, slot_offset, slot_width,
                slot_columns, slot_columns_start, slot_rows):
-    """Ū_all (N, N) of one frequency from its workspace."""
-    full = np.zeros((order, order), dtype=work_m.dtype)
-    for slot in (root, root_row):
-        block = _view(work_m, slot_offset[slot], 12, slot_width[slot])
-        columns = slot_columns[slot_columns_start[slot]:slot_columns_start[slot + 1]]
-        for i in range(12):
-            for c in range(columns.size):
-                full[i, columns[c]] += block[i, c]
-    start = 12
-    for g in range(rows.size):
-        slot = rows[g]
+    """Ū_all (N, N) of one frequency from its workspace, in Fortran order (what LAPACK
+    factorises, without reordering)."""
+    row_of = np.full(order, -1)  # where each row and column of the full Ū_all is kept, -1: released
+    column_of = np.full(order, -1)
+    for i in range(kept_rows.size):
+        row_of[kept_rows[i]] = i
+    for j in range(kept_columns.size):
+        column_of[kept_columns[j]] = j
+    transposed = np.zeros((kept_columns.size, kept_rows.size), dtype=work_m.dtype)
+    start = 0
+    for g in range(-2, rows.size):
+        slot = root if g == -2 else (root_row if g == -1 else rows[g])
         block = _view(work_m, slot_offset[slot], slot_rows[slot], slot_width[slot])
         columns = slot_columns[slot_columns_start[slot]:slot_columns_start[slot + 1]]
         for i in range(slot_rows[slot]):
+            row = row_of[start + i]
+            if row < 0:
+                continue
             for c in range(columns.size):
-                full[start + i, columns[c]] = block[i, c]
-        start += slot_rows[slot]
-    out = np.empty((kept_rows.size, kept_columns.size), dtype=work_m.dtype)
-    for i in range(kept_rows.size):
-        for j in range(kept_columns.size):
-            out[i, j] = full[kept_rows[i], kept_columns[j]]
-    return out
+                column = column_of[columns[c]]
+                if column >= 0:
+                    transposed[column, row] += block[i, c]
+        if g != -2:  # the root state and −Z_root share the first twelve rows
+            start += slot_rows[slot]
+    return transposed.T
+
+
+def _lapack(name: str):
+    """LAPACK routine ``name`` (pointer arguments only) as scipy ships it, and as numba's
+    own linear algebra calls it, under a symbol of its own: found by name when cached
+    machine code is loaded."""
+    symbol = f"linmstmm_{name}"
+    llvmlite.binding.add_symbol(symbol, get_cython_function_address("scipy.linalg.cython_lapack", name))
+    return types.ExternalFunction(symbol, types.void(*[types.voidptr] * 6))
+
+
+_DGETRF, _ZGETRF = _lapack("dgetrf"), _lapack("zgetrf")
+
+
+@njit(cache=True)
+def _log_det(matrix):
+    """(sign or phase, log|det|) of ``matrix`` (N, N), Fortran-ordered, which it
+    overwrites with its LU factors: what numpy's slogdet computes (LAPACK's getrf),
+    without a copy. (NaN, NaN) where a pivot is not finite (an entry was not: numba's
+    slogdet raises there), which the root counts step round."""
+    n = matrix.shape[0]
+    integers = np.array([n, n, 0], dtype=np.int32)  # order, leading dimension, info
+    pivots = np.empty(n, dtype=np.int32)
+    if matrix.itemsize == 16:  # complex128
+        _ZGETRF(integers.ctypes, integers.ctypes, matrix.ctypes, integers[1:].ctypes, pivots.ctypes,
+                integers[2:].ctypes)
+    else:
+        _DGETRF(integers.ctypes, integers.ctypes, matrix.ctypes, integers[1:].ctypes, pivots.ctypes,
+                integers[2:].ctypes)
+    sign = 1.0 + 0.0 * matrix[0, 0]
+    for k in range(n):
+        if pivots[k] != k + 1:
+            sign = -sign
+    log_abs = 0.0
+    for k in range(n):
+        magnitude = np.abs(matrix[k, k])
+        if magnitude > 0.0:
+            sign = sign * (matrix[k, k] / magnitude)
+        log_abs += np.log(magnitude)
+    if math.isnan(log_abs) or log_abs == np.inf:
+        return np.nan + 0.0 * sign, np.nan
+    if integers[2] > 0:  # an exactly zero pivot
+        return sign - sign, -np.inf  # a zero of sign's type, +0
+    return sign, log_abs
 
 
 @njit(cache=True)
@@ -434,11 +552,7 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
                               slot_width, slot_columns, slot_columns_start, slot_rows)
             if matrices_out.shape[0]:
                 matrices_out[start + m] = ubar
-            if np.all(np.isfinite(ubar)):
-                sign, log_abs = np.linalg.slogdet(ubar)
-                sign_out[start + m] = sign
-                log_abs_out[start + m] = log_abs + log_scale[m]
-            else:  # numpy's slogdet answers NaN, which the root counts step round; numba's raises
-                sign_out[start + m] = np.nan
-                log_abs_out[start + m] = np.nan
+            sign, log_abs = _log_det(ubar)  # NaN where not finite, which the root counts step round
+            sign_out[start + m] = sign
+            log_abs_out[start + m] = log_abs + log_scale[m]
             log_scale_out[start + m] = log_scale[m]

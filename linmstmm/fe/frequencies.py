@@ -43,11 +43,13 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
         relative error is <= ``rtol`` (at least three meshes) or the next
         mesh would exceed ``max_elements_per_beam``. An int = that mesh, no
         extrapolation; its error is estimated from one solve on half the mesh
-        unless ``estimate_error`` is False (then NaN).
+        (on twice the mesh for a mode half the mesh does not have, and for one
+        element per beam) unless ``estimate_error`` is False (then NaN, and
+        the note says the frequencies are unchecked).
     rtol : float
         Target relative error of the frequencies when refining.
     estimate_error : bool
-        With a fixed mesh: estimate the error from half the mesh.
+        With a fixed mesh: estimate the error from another mesh.
     max_elements_per_beam : int
         The finest mesh the refinement may reach.
     mode_shapes : bool
@@ -89,6 +91,8 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
     frequencies_hz, error_estimate, order = frequencies_hz[:settled], error_estimate[:settled], order[:settled]
     if refined:
         notes.append(_short_of_rtol(frequencies_hz, error_estimate, rtol, fe.elements_per_beam))
+    elif model.beams:
+        notes.append(_fixed_mesh_note(fe, len(lam), count if fmax is None else None, error_estimate))
     if not model.beams and fmax is None and len(lam) < count:
         notes.append(f"only {len(lam)} elastic natural frequencies exist (directions with mass "
                      f"less the {fe.rigid_modes.shape[1]} rigid-body modes)")
@@ -158,22 +162,50 @@ def _short_of_rtol(frequencies_hz, error_estimate, rtol, elements_per_beam) -> s
             f"elements' dispersion error on that mesh): {listed}{more}")
 
 
-def _fixed_mesh(model, elements_per_beam, count, lam_max, estimate_error):
-    """One mesh; error from the change against half the mesh, taken as if
-    second order (``|λ_n − λ_n/2| / 3``), which overestimates the h⁴ bending
-    error about fivefold.
+def _fixed_mesh_note(fe, computed: int, count, error_estimate) -> str:
+    """What a fixed mesh leaves unsaid (empty if nothing): fewer modes than the
+    ``count`` asked for (the mesh holds no more), and frequencies whose error
+    was not estimated (unchecked)."""
+    parts = []
+    if count is not None and computed < count:
+        parts.append(f"the mesh of {fe.elements_per_beam} elements per beam ({fe.n_dof} DOFs) holds only "
+                     f"{computed} of the {count} modes asked for")
+    unknown = int(np.count_nonzero(np.isnan(error_estimate)))
+    if unknown:
+        parts.append(f"the error of {unknown} frequencies is not estimated (estimate_error=False): "
+                     f"they are unchecked")
+    return "; ".join(parts)
 
-    Returns the FEModel, λ, mode vectors and relative error estimates of λ.
+
+def _fixed_mesh(model, elements_per_beam, count, lam_max, estimate_error):
+    """One mesh of n elements per beam; each λ's error estimated from its change
+    against another mesh, taken as if second order: against half the mesh
+    (``|λ_n − λ_n/2| / 3``) where that mesh exists and holds the mode, else
+    against twice the mesh (``4 |λ_n − λ_2n| / 3``, a mesh of one element per
+    beam, or a mode above those half the mesh holds). For the h⁴ bending error
+    both overestimate, about fivefold and 1.25-fold.
+
+    Returns the FEModel, λ, mode vectors and relative error estimates of λ
+    (NaN where ``estimate_error`` is False).
     """
     fe = assemble(model, elements_per_beam)
     lam, X, solver = fe_modes(fe, count, lam_max)
     lam_error = np.full(len(lam), np.nan)
-    if estimate_error and fe.elements_per_beam >= 2:
-        coarse = fe_modes(assemble(model, fe.elements_per_beam // 2),
-                          count, lam_max, at_least=len(lam))[0][:len(lam)]
-        m = len(coarse)
-        lam_error[:m] = np.abs(coarse - lam[:m]) / (3 * lam[:m])
+    if estimate_error:
+        held = 0
+        if fe.elements_per_beam >= 2:
+            coarse = _lowest(model, fe.elements_per_beam // 2, count, lam_max, len(lam))
+            held = len(coarse)
+            lam_error[:held] = np.abs(coarse - lam[:held]) / (3 * lam[:held])
+        if held < len(lam):
+            fine = _lowest(model, 2 * fe.elements_per_beam, count, lam_max, len(lam))
+            lam_error[held:] = 4 * np.abs(fine[held:len(lam)] - lam[held:]) / (3 * lam[held:])
     return fe, lam, X, np.maximum(lam_error, solver)
+
+
+def _lowest(model, elements_per_beam, count, lam_max, at_least):
+    """(m,) the lowest λ on a mesh of ``elements_per_beam``, at most ``at_least`` of them."""
+    return fe_modes(assemble(model, elements_per_beam), count, lam_max, at_least=at_least)[0][:at_least]
 
 
 def _refine(model, count, lam_max, rtol, max_elements_per_beam):

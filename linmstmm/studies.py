@@ -429,7 +429,7 @@ def determinant_scan(model: Model, fmax: float, points: int = DEFAULT_SCAN_POINT
     ModelError
         If ``fmax`` holds too many modes to search for (key-less, naming fmax).
     """
-    from linmstmm.solve import frequency_finder, search_note
+    from linmstmm.solve import frequency_finder, search_note, search_up_to
 
     check_range_request(model, fmax)
     report("deducing Ubar_all")
@@ -439,7 +439,7 @@ def determinant_scan(model: Model, fmax: float, points: int = DEFAULT_SCAN_POINT
     report("scanning det Ubar_all")
     parts = [deduction.log_det(grid[start:start + SCAN_CHUNK]) for start in range(0, grid.size, SCAN_CHUNK)]
     report("finding roots")
-    search = finder.find(None, omega_max)
+    search = search_up_to(finder, None, fmax)
     note = search_note(search, search.roots.size, search.unseparated, None, fmax)
     return ScanResult(model.name, grid, np.concatenate([p[0] for p in parts]),
                       np.concatenate([p[1] for p in parts]), search.roots, deduction.full_order,

@@ -21,6 +21,7 @@ from linmstmm.roots import MAX_XTOL, RootFinder, RootSearchResult
 from linmstmm.threads import single_blas_thread
 from linmstmm.topology import build_topology
 from linmstmm.wittrick_williams import mode_counter
+from linmstmm.wording import counted
 
 
 #: Digits float64 delivers; more are computed in mpmath.
@@ -358,9 +359,11 @@ def search_note(search: RootSearchResult, found: int, unseparated, count: int | 
              for w, (m, radius) in unseparated.items()]
     fewer = count is not None and found < count
     if search.note and (fewer or count is None):  # the search stopped short of what was asked
-        notes.append(f"only {found} elastic natural frequencies were found: {search.note}")
+        notes.append(f"only {counted(found, 'elastic natural frequency was', 'elastic natural frequencies were')} "
+                     f"found: {search.note}")
     elif fewer and fmax is None:
-        notes.append(f"only {found} elastic natural frequencies exist below {search.ceiling:.3g} rad/s")
+        notes.append(f"only {counted(found, 'elastic natural frequency exists', 'elastic natural frequencies exist')} "
+                     f"below {search.ceiling:.3g} rad/s")
     return "; ".join(notes)
 
 

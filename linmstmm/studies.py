@@ -39,6 +39,7 @@ from linmstmm.response import (
 from linmstmm.results import Result, decode_array, encode_array
 from linmstmm.solve import natural_frequencies
 from linmstmm.stages import report
+from linmstmm.wording import counted
 
 #: Frequencies in a scan and in a receptance sweep, by default.
 DEFAULT_SCAN_POINTS = 2000
@@ -285,7 +286,7 @@ def frf_text(result: FRFResult, summary: dict) -> str:
     if damping == "undamped":
         damping = "no Rayleigh damping" if direct else "undamped (unbounded at the natural frequencies)"
     route = ("direct transfer-matrix solve, spring dashpots acting" if direct
-             else f"{summary['modes_in_sum']} elastic modes in the sum")
+             else f"{counted(summary['modes_in_sum'], 'elastic mode')} in the sum")
     natural = ", ".join(f"{f:.6g}" for f in summary["frequencies_hz"]) or "none"
     lines = [(f"{summary['model']}: receptance to a unit load {load['direction']} at {load['point']} "
               f"[per {summary['load_unit']}], 0-{summary['fmax_hz']:g} Hz, {route}, {damping}"),

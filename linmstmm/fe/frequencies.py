@@ -14,6 +14,7 @@ from linmstmm.fe.result import FEResult
 from linmstmm.fe.richardson import _extrapolate
 from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
+from linmstmm.wording import counted
 
 #: A frequency whose estimated relative error is at or above this is not
 #: reported (its own estimate leaves not even its first digit assured).
@@ -94,8 +95,8 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
     elif model.beams:
         notes.append(_fixed_mesh_note(fe, len(lam), count if fmax is None else None, error_estimate))
     if not model.beams and fmax is None and len(lam) < count:
-        notes.append(f"only {len(lam)} elastic natural frequencies exist (directions with mass "
-                     f"less the {fe.rigid_modes.shape[1]} rigid-body modes)")
+        notes.append(f"only {counted(len(lam), 'elastic natural frequency exists', 'elastic natural frequencies exist')}"
+                     f" (directions with mass less the {counted(fe.rigid_modes.shape[1], 'rigid-body mode')})")
     return FEResult(model=model.name,
                     frequencies_hz=frequencies_hz,
                     rigid_body_modes=fe.rigid_modes.shape[1],
@@ -122,7 +123,7 @@ def _unsettled(frequencies_hz, error_estimate) -> str:
         return ""
     listed = ", ".join(f"{f:.6g} Hz ({e:.1e})" for f, e in zip(frequencies_hz[:5], error_estimate[:5]))
     more = f" and {len(frequencies_hz) - 5} more" if len(frequencies_hz) > 5 else ""
-    return (f"{len(frequencies_hz)} computed values not reported as frequencies, from the first whose "
+    return (f"{counted(len(frequencies_hz), 'computed value')} not reported as frequencies, from the first whose "
             f"estimated relative error is {UNSETTLED:.0%} or more: {listed}{more}")
 
 
@@ -157,8 +158,8 @@ def _short_of_rtol(frequencies_hz, error_estimate, rtol, elements_per_beam) -> s
         return ""
     listed = ", ".join(f"{frequencies_hz[i]:.6g} Hz ({error_estimate[i]:.1e})" for i in short[:5])
     more = f" and {len(short) - 5} more" if len(short) > 5 else ""
-    return (f"mesh refinement stopped at {elements_per_beam} elements per beam (max_elements_per_beam) "
-            f"with {len(short)} frequencies above rtol = {rtol:.0e} (estimated relative error, at least the "
+    return (f"mesh refinement stopped at {counted(elements_per_beam, 'element')} per beam (max_elements_per_beam) "
+            f"with {counted(len(short), 'frequency', 'frequencies')} above rtol = {rtol:.0e} (estimated relative error, at least the "
             f"elements' dispersion error on that mesh): {listed}{more}")
 
 
@@ -168,12 +169,12 @@ def _fixed_mesh_note(fe, computed: int, count, error_estimate) -> str:
     was not estimated (unchecked)."""
     parts = []
     if count is not None and computed < count:
-        parts.append(f"the mesh of {fe.elements_per_beam} elements per beam ({fe.n_dof} DOFs) holds only "
-                     f"{computed} of the {count} modes asked for")
+        parts.append(f"the mesh of {counted(fe.elements_per_beam, 'element')} per beam ({fe.n_dof} DOFs) holds only "
+                     f"{computed} of the {counted(count, 'mode')} asked for")
     unknown = int(np.count_nonzero(np.isnan(error_estimate)))
     if unknown:
-        parts.append(f"the error of {unknown} frequencies is not estimated (estimate_error=False): "
-                     f"they are unchecked")
+        parts.append(f"the error of {counted(unknown, 'frequency', 'frequencies')} is not estimated "
+                     f"(estimate_error=False): {'it is' if unknown == 1 else 'they are'} unchecked")
     return "; ".join(parts)
 
 

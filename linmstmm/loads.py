@@ -25,7 +25,8 @@ Load file (TOML)
     [output]                         # optional
     points = ["tip", "root"]         # response points (default: every point)
     duration = 1.0                   # s, default 1
-    step = 1e-3                      # s, default duration / 1000
+    step = 1e-3                      # s, default duration / 1000; at most duration, and
+                                     # at most MAX_RESPONSE_VALUES values in the response
     modes = 20                       # elastic modes in the sum, default 20
 
 Time kinds, g(t) with τ = t − start (g = 0 before ``start``, default 0 s):
@@ -57,6 +58,10 @@ from linmstmm.model_file import _did_you_mean, _read_toml, _Table
 DEFAULT_DURATION = 1.0
 DEFAULT_STEPS = 1000
 DEFAULT_MODES = 20
+#: The most values a response may hold: its output times × (18 per response
+#: point: displacement, velocity, acceleration × 6 components, and 3 per mode
+#: in the sum), 80 MB in float64; a load file asking for more is refused.
+MAX_RESPONSE_VALUES = 10_000_000
 
 
 @dataclass(frozen=True, eq=False)
@@ -204,7 +209,25 @@ def load_loads(path, model: Model) -> LoadCase:
     if isinstance(modes, bool) or not isinstance(modes, int) or modes < 1:
         raise output.error("modes", f"must be a positive integer, got {modes!r}")
     names = output.point_names("points", points) if "points" in output else None
-    return LoadCase(loads, np.arange(int(np.floor(duration / dt + 1e-9)) + 1) * dt, names, modes)
+    times = _output_times(output, duration, dt, len(points) if names is None else len(names), modes)
+    return LoadCase(loads, times, names, modes)
+
+
+def _output_times(output: _Table, duration: float, dt: float, n_points: int, modes: int) -> np.ndarray:
+    """(n_t,) s: 0, dt, 2 dt, ... up to ``duration``, after checking that ``dt`` fits in
+    ``duration`` and that the response of ``n_points`` points and ``modes`` elastic modes
+    at those times holds no more than MAX_RESPONSE_VALUES values (ModelError on key ``step``)."""
+    if dt > duration:
+        raise output.error("step", f"{dt:g} s is longer than the duration {duration:g} s: "
+                                   f"the response would have the single time 0")
+    count = np.floor(duration / dt + 1e-9) + 1  # float: a huge count is not built
+    values = count * (18 * n_points + 3 * modes)
+    if values > MAX_RESPONSE_VALUES:
+        raise output.error("step", f"{count:,.0f} output times ({duration:g} s in steps of {dt:g} s) for "
+                                   f"{n_points} points and {modes} modes make {values:.3g} values, more than "
+                                   f"the {MAX_RESPONSE_VALUES:,} a response may hold: give a longer step, a "
+                                   f"shorter duration or fewer points")
+    return np.arange(int(count)) * dt
 
 
 def _check_load(t: _Table, points) -> PointLoad:

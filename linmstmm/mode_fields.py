@@ -92,11 +92,11 @@ class _Fields:
     # -- the body operators ---------------------------------------------------
     def mass_gram(self, axis_weights=np.ones(3)) -> np.ndarray:
         """(n, n) ⟨M V^k, V^p⟩; ``axis_weights`` (3,) scale the translational mass along x, y, z."""
-        return _gram(self._mass_measures(np.asarray(axis_weights, float)))
+        return _gram(self._mass_measures(np.asarray(axis_weights, float)), self.zbar.shape[0])
 
     def stiffness_gram(self) -> np.ndarray:
         """(n, n) ⟨K V^k, V^p⟩ from the strain energy of springs and beams."""
-        return _gram(self._stiffness_measures())
+        return _gram(self._stiffness_measures(), self.zbar.shape[0])
 
     def _mass_measures(self, axis_weights):
         for element in self.topology.elements:
@@ -153,9 +153,10 @@ class _Fields:
                 yield element.record, self.quadrature[element.name]
 
 
-def _gram(measures) -> np.ndarray:
-    """Σ X diag(w) Xᵀ over the (X (n, d), w (d,)) measures."""
-    return sum(np.einsum("kd,pd,d->kp", X, X, w) for X, w in measures)
+def _gram(measures, n: int) -> np.ndarray:
+    """(n, n) Σ X diag(w) Xᵀ over the (X (n, d), w (d,)) measures; zeros if there are none
+    (no spring or beam strains under a lone rigid body)."""
+    return sum((np.einsum("kd,pd,d->kp", X, X, w) for X, w in measures), np.zeros((n, n)))
 
 
 def _element_states(deduction: Deduction, omega: np.ndarray, zbar: np.ndarray) -> list:

@@ -224,7 +224,8 @@ def _pieces(result: ModalResult, model: Model, k: int):
 
 def _mode_title(result: ModalResult, model: Model, k: int, scale: float, size: float) -> str:
     kind = "rigid-body mode" if result.omega[k] == 0 else f"f = {result.frequencies_hz[k]:.6g} Hz"
-    mass = f"modal mass {result.modal_mass[k]:.4g} kg ({result.normalization} normalisation)"
+    mass = (f"modal mass {result.modal_mass[k]:.4g} {result.modal_mass_units[k].replace('^2', '²')} "
+            f"({result.normalization} normalisation)")
     drawing = (f"displacements drawn × {scale:.3g}: the largest as {AMPLITUDE:g} × the model's size "
                f"({size:.3g} m)" if scale else "rotation only, drawn undeformed")
     return f"{model.name}\nmode {k + 1}: {kind}, {mass}\n{drawing}"

@@ -23,6 +23,8 @@ docs/model-format.md. The keys of a file, in brief:
   directions the joint leaves free, no force or moment there);
 * ``[boundary]``: ``point = "free" | "fixed" | "pinned"`` or a list drawn
   from x, y, z, rx, ry, rz (the fixed components);
+* the elements form one connected structure: each reached from every other
+  through shared points (a boundary condition joins nothing);
 * ``[damping]``: ``alpha`` 1/s, ``beta`` s of C = alpha M + beta K (each
   optional, default 0).
 
@@ -35,6 +37,8 @@ import math
 import tomllib
 
 import numpy as np
+
+from linmstmm.connected import unreached
 
 #: Names of the six displacement components, in state-vector order.
 COMPONENTS = ("x", "y", "z", "rx", "ry", "rz")
@@ -256,6 +260,7 @@ def _validate(data, file):
     for point in points:
         if point not in used:
             raise points_table.error(point, "point is not used by any element")
+    _check_connected(file, elements, owners)
 
     total_mass = (sum(f["mass"] for f in elements["rigid"])
                   + sum(f["rho"] * f["A"] * f["length"] for f in elements["beam"]))
@@ -265,6 +270,23 @@ def _validate(data, file):
     return {"name": name, "description": description, "points": points,
             "rigids": elements["rigid"], "beams": elements["beam"],
             "springs": elements["spring"], "boundary": boundary, "damping": damping}
+
+
+def _check_connected(file, elements, labels):
+    """ModelError unless the elements form one structure (:func:`linmstmm.connected.unreached`).
+
+    elements : kind -> list of constructor fields; labels : element name -> "kind 'name'".
+    """
+    joined = [(f["name"], f["ports"] if kind == "rigid" else f["ends"])
+              for kind in ("rigid", "beam", "spring") for f in elements[kind]]
+    apart = unreached(joined)
+    if apart:
+        name, ends = apart[0]
+        raise ModelError(file, f"not connected to {labels[joined[0][0]]}: no chain of elements joins its points "
+                               f"{', '.join(ends)} to it ({len(apart)} of {len(joined)} elements apart); a model is "
+                               f"one connected structure (a boundary condition joins nothing): give each part its "
+                               f"own model", element=labels[name],
+                         key="ports" if labels[name].startswith("rigid") else "ends")
 
 
 def _length_tol(points):

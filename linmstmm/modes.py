@@ -91,6 +91,9 @@ class ModalResult(Result):
     normalization : "mass" or "max" (largest translation of each mode = 1 m).
     note : what the search must say ("" if nothing; see :func:`linmstmm.solve.search_note`), and
         which shapes float64 did not form to SHAPE_ACCURACY.
+    without_translation : (n,) bool, the modes without translation (a pure
+        rotation); with "max" they are scaled to a largest rotation of 1 rad, so
+        their modal mass is a moment of inertia (``modal_mass_units``).
     """
 
     model: str
@@ -108,8 +111,39 @@ class ModalResult(Result):
     beam_fields: dict[str, BeamField]
     normalization: str
     note: str = ""
+    without_translation: np.ndarray | None = None
 
     kind = "modes"
+
+    @property
+    def modal_mass_units(self) -> list[str]:
+        """The unit of each modal mass.
+
+        Returns
+        -------
+        list of str, length n
+            "kg", or "kg m^2" for a mode scaled to a largest rotation of 1 rad
+            ("max" normalisation of a mode without translation). Mass-normalised
+            modes have M_k = 1 kg, their amplitudes per √kg.
+        """
+        return ["kg m^2" if by_rotation else "kg" for by_rotation in self._scaled_by_rotation()]
+
+    @property
+    def modal_stiffness_units(self) -> list[str]:
+        """The unit of each modal stiffness (K_k = ω_k² M_k).
+
+        Returns
+        -------
+        list of str, length n
+            "N/m", or "N m/rad" where the modal mass is in kg m^2.
+        """
+        return ["N m/rad" if by_rotation else "N/m" for by_rotation in self._scaled_by_rotation()]
+
+    def _scaled_by_rotation(self) -> np.ndarray:
+        """(n,) bool: the modes whose scale is a rotation of 1 rad."""
+        if self.normalization != "max" or self.without_translation is None:
+            return np.zeros(self.omega.size, bool)
+        return np.asarray(self.without_translation, bool)
 
     @property
     def frequencies_hz(self) -> np.ndarray:
@@ -180,7 +214,8 @@ class ModalResult(Result):
         -------
         dict
             ``model``, ``frequencies_hz``, ``omega``, ``rigid_body_modes``, ``normalization``,
-            the modal masses and stiffnesses, orthogonality errors and matrices, and the
+            the modal masses and stiffnesses and their units per mode
+            (``modal_mass_units``, ``modal_stiffness_units``), orthogonality errors and matrices, and the
             displacements by point, mass centre and beam field.
         """
         return {
@@ -192,6 +227,8 @@ class ModalResult(Result):
             **({"note": self.note} if self.note else {}),
             "modal_mass": self.modal_mass.tolist(),
             "modal_stiffness": self.modal_stiffness.tolist(),
+            "modal_mass_units": self.modal_mass_units,
+            "modal_stiffness_units": self.modal_stiffness_units,
             "mass_orthogonality_error": self.mass_orthogonality_error,
             "stiffness_orthogonality_error": self.stiffness_orthogonality_error,
             "orthogonality_mass": self.orthogonality_mass.tolist(),
@@ -222,7 +259,9 @@ class ModalResult(Result):
                    decode_array(data["boundary_unknowns"], ndim=2), tuple(data["unknown_labels"]),
                    decode_arrays(data["port_states"], ndim=2), decode_arrays(data["point_displacements"], ndim=2),
                    decode_arrays(data["com_displacements"], ndim=2), fields, data["normalization"],
-                   data.get("note", ""))
+                   data.get("note", ""),
+                   np.array([unit == "kg m^2" for unit in data["modal_mass_units"]], bool)
+                   if "modal_mass_units" in data else None)
 
     def plot(self, model: Model, mode: int = 0):
         """One mode drawn over the undeformed ``model`` (:func:`linmstmm.plot.mode_shape_figure`).
@@ -345,7 +384,8 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
     raw = _Fields.of(model, deduction, omega, zbar, stations)
     gram = raw.mass_gram()
     transform = _mass_orthonormal(gram, raw.mass_gram(_AXIS_WEIGHTS), [m for _, m in eigenspaces])
-    transform = transform * _normalisation(raw.apply(transform), normalization, model)
+    factors, without_translation = _normalisation(raw.apply(transform), normalization, model)
+    transform = transform * factors
     fields = raw.apply(transform)
     mass = transform.T @ gram @ transform
     stiffness = transform.T @ raw.stiffness_gram() @ transform
@@ -359,7 +399,7 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         {beam.name: BeamField(raw.stations[beam.name], _station_positions(model, beam, raw),
                               fields.station_states[beam.name][..., :6])
          for beam in model.beams},
-        normalization, note)
+        normalization, note, without_translation)
 
 
 def _accuracy_note(omega: np.ndarray, mass: np.ndarray, stiffness: np.ndarray) -> str:
@@ -403,8 +443,9 @@ def _mass_orthonormal(gram: np.ndarray, directional: np.ndarray, sizes) -> np.nd
     return transform
 
 
-def _normalisation(fields, normalization: str, model: Model) -> np.ndarray:
-    """(n,) factors turning mass-orthonormal modes into ``normalization``, largest component > 0."""
+def _normalisation(fields, normalization: str, model: Model) -> tuple[np.ndarray, np.ndarray]:
+    """(n,) factors turning mass-orthonormal modes into ``normalization``, largest component > 0,
+    and (n,) bool: the modes without translation (scaled by their rotation with "max")."""
     samples = fields.displacement_samples()  # (n, s, 6)
     translation = samples[..., :3].reshape(samples.shape[0], -1)
     rotation = samples[..., 3:].reshape(samples.shape[0], -1)
@@ -414,4 +455,4 @@ def _normalisation(fields, normalization: str, model: Model) -> np.ndarray:
              > _TRANSLATION_FLOOR * size * np.abs(rotation).max(axis=1))
     reference = np.where(moves[:, None], translation, rotation)
     largest = reference[np.arange(reference.shape[0]), np.abs(reference).argmax(axis=1)]
-    return 1 / largest if normalization == "max" else np.sign(largest)
+    return (1 / largest if normalization == "max" else np.sign(largest)), ~moves

@@ -57,13 +57,14 @@ from linmstmm.modal_dashpots import coupled_unit_response, modal_dashpots
 from linmstmm.model import Model
 from linmstmm.modes import ModalResult, mode_shapes
 from linmstmm.results import Result, decode_array, decode_arrays, encode_array
+from linmstmm.roots import CERTIFIED_STEP
 
 #: The public names, with those of the loads and the exact modal solution
 #: (:mod:`linmstmm.loads`, :mod:`linmstmm.duhamel`) this module has always offered.
-__all__ = ["DampingRatioError", "FRFResult", "LoadCase", "PointLoad", "QUANTITY_UNITS", "ResponseResult",
-           "TimeFunction", "frf", "half_sine", "harmonic", "impulse", "load_loads", "modal_damping",
-           "modal_response", "participation", "quantity_units", "respond", "step", "table",
-           "unit_response"]
+__all__ = ["DampingRatioError", "FRFResult", "LoadCase", "PointLoad", "QUANTITY_UNITS", "ResonanceError",
+           "ResponseResult", "TimeFunction", "frf", "half_sine", "harmonic", "impulse", "load_loads",
+           "modal_damping", "modal_response", "participation", "quantity_units", "respond",
+           "step", "table", "undamped_resonances", "unit_response"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -238,6 +239,40 @@ class DampingRatioError(ValueError):
     """Modal damping ratios that do not fit the modes (count, sign) or come with Rayleigh damping."""
 
 
+class ResonanceError(ValueError):
+    """An excitation frequency at an undamped natural frequency, where the receptance is unbounded."""
+
+
+#: An excitation within this relative distance of an undamped natural frequency is
+#: at it: the accuracy natural frequencies are certified to, closer than which the
+#: receptance's size and sign are not known.
+RESONANCE_RTOL = CERTIFIED_STEP
+
+
+def undamped_resonances(omega, rates, excitation_hz) -> np.ndarray:
+    """Which excitation frequencies are at a natural frequency of an undamped mode.
+
+    Parameters
+    ----------
+    omega : array_like, shape (n,)
+        ω_k, rad/s (rigid-body modes at 0).
+    rates : array_like, shape (n,)
+        Modal damping rates c_k, 1/s (:func:`modal_damping`); an undamped mode has 0.
+    excitation_hz : array_like, shape (n_f,)
+        Excitation frequencies, Hz.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_f,), bool
+        True where |Ω − ω_k| <= RESONANCE_RTOL ω_k for an undamped mode k
+        (Ω = 0 for a rigid-body mode).
+    """
+    omega = np.asarray(omega, dtype=float)
+    undamped = omega[np.asarray(rates) == 0]
+    excitation = 2 * np.pi * np.asarray(excitation_hz, dtype=float)
+    return np.any(np.abs(excitation[:, None] - undamped) <= RESONANCE_RTOL * undamped, axis=1)
+
+
 def modal_damping(omega, damping=None, damping_ratio=None) -> np.ndarray:
     """Modal damping rates c_k of q̈_k + c_k q̇_k + ω_k² q_k = p_k, 1/s.
 
@@ -369,11 +404,23 @@ def frf(modes: ModalResult, point: str, vector, excitation_hz, points=None,
     Returns
     -------
     FRFResult
+
+    Raises
+    ------
+    ResonanceError
+        For an excitation frequency at the natural frequency of an undamped
+        mode (:func:`undamped_resonances`), where the receptance is unbounded.
+    DampingRatioError
+        For damping ratios that do not fit the modes.
     """
     excitation_hz = np.asarray(excitation_hz, dtype=float)
     points = tuple(modes.point_displacements) if points is None else tuple(points)
     Omega = 2 * np.pi * excitation_hz[:, None]
     rate = modal_damping(modes.omega, damping, damping_ratio)
+    resonant = excitation_hz[undamped_resonances(modes.omega, rate, excitation_hz)]
+    if resonant.size:
+        raise ResonanceError(f"the undamped receptance is unbounded at {', '.join(f'{f:.10g}' for f in resonant)} "
+                             f"Hz, a natural frequency: leave it out of excitation_hz, or give damping")
     loading = participation(modes, point, vector)
     modal = loading / (modes.omega**2 - Omega**2 + 1j * Omega * rate)
     shapes = np.stack([modes.point_displacements[p] for p in points], axis=1)

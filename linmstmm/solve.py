@@ -21,6 +21,7 @@ from linmstmm.roots import MAX_XTOL, RootFinder, RootSearchResult
 from linmstmm.threads import single_blas_thread
 from linmstmm.topology import build_topology
 from linmstmm.wittrick_williams import mode_counter
+from linmstmm.wording import counted
 
 
 #: Digits float64 delivers; more are computed in mpmath.
@@ -146,6 +147,36 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     return deduction, finder, released
 
 
+def search_up_to(finder: RootFinder, count: int | None, fmax: float) -> RootSearchResult:
+    """The finder's search for the lowest ``count`` roots (None: all) up to ``fmax`` Hz.
+
+    A root within the accuracy its value is certified to (the finder's
+    ``rtol``) above ``fmax`` cannot be told from one on it, so it is listed
+    as one: the search's ceiling is 2π fmax (1 + rtol). A ceiling on a root
+    stops the search (the count of the roots below it cannot be made); a
+    root is then on 2π fmax (1 + rtol) to rounding, so the search is made
+    once more with its ceiling half ``rtol`` higher, where that root is
+    listed.
+
+    Parameters
+    ----------
+    finder : RootFinder
+        The finder of the search.
+    count : int or None
+        The lowest ``count`` roots; None: every root up to the ceiling.
+    fmax : float
+        Hz, the frequency asked for.
+
+    Returns
+    -------
+    RootSearchResult
+    """
+    try:
+        return finder.find(count, 2 * np.pi * fmax * (1 + finder.rtol))
+    except RuntimeError:  # a root on the ceiling; any other failure recurs and is raised
+        return finder.find(count, 2 * np.pi * fmax * (1 + 1.5 * finder.rtol))
+
+
 @dataclass(frozen=True, eq=False)
 class RootSolution:
     """The roots of det Ū_all a request asked for, and the system they belong to.
@@ -233,11 +264,12 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
     accuracy = {} if rtol is None else {"rtol": rtol, "xtol": min(max(XTOL_PER_RTOL * rtol, 1e-14), MAX_XTOL)}
     deduction, finder, released = frequency_finder(model, root, engine=engine, **accuracy)
     report("finding roots")
-    omega_max = None if fmax is None else 2 * np.pi * fmax
-    if guess_hz is not None and count is not None and fmax is None:
+    if fmax is not None:
+        search = search_up_to(finder, count, fmax)
+    elif guess_hz is not None and count is not None:
         search = finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count)
     else:
-        search = finder.find(count, omega_max)
+        search = finder.find(count, None)
     omegas, unseparated = search.roots, dict(search.unseparated)
     # (a root no Newton step reached has a NaN step: it is in unseparated)
     uncertain = sorted({w for w, step in search.last_steps.items() if step > finder.rtol} - set(unseparated))
@@ -268,7 +300,9 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     count : int or None
         The lowest N; None: every frequency up to ``fmax``.
     fmax : float or None
-        Hz: all up to fmax; with ``count``, whichever stops first.
+        Hz: all up to fmax; with ``count``, whichever stops first. A root
+        within ``rtol`` above fmax counts as on it and is listed
+        (:func:`search_up_to`).
     digits : int or None
         Significant digits wanted; above FLOAT64_DIGITS every root is
         refined in mpmath. Without it, roots float64 cannot certify are
@@ -325,9 +359,11 @@ def search_note(search: RootSearchResult, found: int, unseparated, count: int | 
              for w, (m, radius) in unseparated.items()]
     fewer = count is not None and found < count
     if search.note and (fewer or count is None):  # the search stopped short of what was asked
-        notes.append(f"only {found} elastic natural frequencies were found: {search.note}")
+        notes.append(f"only {counted(found, 'elastic natural frequency was', 'elastic natural frequencies were')} "
+                     f"found: {search.note}")
     elif fewer and fmax is None:
-        notes.append(f"only {found} elastic natural frequencies exist below {search.ceiling:.3g} rad/s")
+        notes.append(f"only {counted(found, 'elastic natural frequency exists', 'elastic natural frequencies exist')} "
+                     f"below {search.ceiling:.3g} rad/s")
     return "; ".join(notes)
 
 

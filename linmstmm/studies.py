@@ -28,14 +28,18 @@ from linmstmm.model import COMPONENTS, Model, ModelError
 from linmstmm.model_file import _did_you_mean
 from linmstmm.modes import ModalResult, mode_shapes
 from linmstmm.response import (
+    RESONANCE_RTOL,
     FRFResult,
     ResponseResult,
     frf,
+    modal_damping,
     quantity_units,
+    undamped_resonances,
 )
 from linmstmm.results import Result, decode_array, encode_array
 from linmstmm.solve import natural_frequencies
 from linmstmm.stages import report
+from linmstmm.wording import counted
 
 #: Frequencies in a scan and in a receptance sweep, by default.
 DEFAULT_SCAN_POINTS = 2000
@@ -94,7 +98,10 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
         route, :func:`linmstmm.response.frf`), ``rigid_body_modes``,
         ``frequencies_hz`` (modal route: the elastic natural frequencies in the
         sum; direct route: the undamped model's elastic natural frequencies up
-        to fmax; Hz), ``load_unit`` and ``receptance_units`` (per component).
+        to fmax; Hz), ``load_unit`` and ``receptance_units`` (per component);
+        where the undamped modal sum is unbounded at frequencies of the sweep
+        (at an undamped natural frequency), they are left out of the result,
+        listed in ``unbounded_hz`` (Hz) and named in ``note``.
 
     Raises
     ------
@@ -118,24 +125,38 @@ def frf_study(model: Model, point: str, direction: str, fmax: float, *,
     sweep = fmax * np.arange(1, frequencies + 1) / frequencies
     damping = damping_in_use(model, damping_ratio)
     unit = np.eye(6)[COMPONENTS.index(direction)]
+    unbounded = []
     if direct:
         result, in_sum, rigid, natural = _direct_sweep(model, point, unit, sweep, targets, fmax)
     else:
-        result, in_sum, rigid, natural = _modal_sweep(model, point, unit, sweep, targets, fmax, modes,
-                                                      damping_ratio, damping)
+        result, in_sum, rigid, natural, unbounded = _modal_sweep(model, point, unit, sweep, targets, fmax, modes,
+                                                                 damping_ratio, damping)
     load_unit = "N m" if direction.startswith("r") else "N"
     summary = {"model": model.name, "load": {"point": point, "direction": direction}, "fmax_hz": fmax,
                **damping, "route": "direct" if direct else "modal", "modes_in_sum": in_sum,
                "static_correction": not direct and rigid == 0,
                "rigid_body_modes": rigid, "frequencies_hz": natural,
-               "load_unit": load_unit, "receptance_units": receptance_units(load_unit)}
+               "load_unit": load_unit, "receptance_units": receptance_units(load_unit),
+               **({"unbounded_hz": unbounded, "note": _unbounded_note(unbounded)} if unbounded else {})}
     return result, summary
+
+
+def _unbounded_note(unbounded: list) -> str:
+    """The note of a sweep that left out the excitation frequencies ``unbounded`` (Hz)."""
+    return f"the sweep leaves out {_unbounded(unbounded)}; give damping for a finite peak"
+
+
+def _unbounded(hz) -> str:
+    """Why the excitation frequencies ``hz`` (Hz) are left out."""
+    return (f"{', '.join(f'{f:.10g}' for f in hz)} Hz: at an undamped natural frequency (to 1 part in "
+            f"{1 / RESONANCE_RTOL:.0e}) the receptance is unbounded")
 
 
 def _modal_sweep(model: Model, point: str, unit, sweep, targets, fmax: float, modes, damping_ratio,
                  damping: dict):
     """(FRFResult, elastic modes in the sum, rigid-body modes, the elastic natural frequencies
-    in the sum, Hz) of the modal sum."""
+    in the sum, Hz, and the frequencies of ``sweep`` left out, Hz) of the modal sum: those at
+    an undamped mode's natural frequency (:func:`~linmstmm.response.undamped_resonances`)."""
     reach = None if modes else FRF_MODE_REACH * fmax
     if reach:
         check_range_request(model, reach, f"fmax = {fmax:g} Hz (the modal sum takes every mode "
@@ -146,9 +167,16 @@ def _modal_sweep(model: Model, point: str, unit, sweep, targets, fmax: float, mo
     report("receptance")
     static = (static_displacements(model, [(point, unit)], targets)[0] if shapes.rigid_body_modes == 0
               else None)  # a free model's K⁺f depends on the mesh (see respond)
-    result = frf(shapes, point, unit, sweep, targets, damping["damping"], damping_ratio=damping_ratio,
+    rates = modal_damping(shapes.omega, damping["damping"], damping_ratio)
+    unbounded = undamped_resonances(shapes.omega, rates, sweep)
+    if unbounded.all():
+        raise ModelError(model.source or model.name, f"every frequency of the sweep is left out, "
+                         f"{_unbounded(sweep)}: give damping, or another fmax or number of frequencies",
+                         key="fmax")
+    result = frf(shapes, point, unit, sweep[~unbounded], targets, damping["damping"], damping_ratio=damping_ratio,
                  static=static)
-    return result, int(np.count_nonzero(shapes.omega > 0)), shapes.rigid_body_modes, _elastic_hz(shapes)
+    return (result, int(np.count_nonzero(shapes.omega > 0)), shapes.rigid_body_modes, _elastic_hz(shapes),
+            sweep[unbounded].tolist())
 
 
 def _direct_sweep(model: Model, point: str, unit, sweep, targets, fmax: float):
@@ -266,7 +294,7 @@ def frf_text(result: FRFResult, summary: dict) -> str:
     if damping == "undamped":
         damping = "no Rayleigh damping" if direct else "undamped (unbounded at the natural frequencies)"
     route = ("direct transfer-matrix solve, spring dashpots acting" if direct
-             else f"{summary['modes_in_sum']} elastic modes in the sum")
+             else f"{counted(summary['modes_in_sum'], 'elastic mode')} in the sum")
     natural = ", ".join(f"{f:.6g}" for f in summary["frequencies_hz"]) or "none"
     lines = [(f"{summary['model']}: receptance to a unit load {load['direction']} at {load['point']} "
               f"[per {summary['load_unit']}], 0-{summary['fmax_hz']:g} Hz, {route}, {damping}"),
@@ -277,6 +305,8 @@ def frf_text(result: FRFResult, summary: dict) -> str:
         peak = magnitude[:, p, c].argmax()
         lines.append(f"  {result.points[p]:<20}{COMPONENTS[c]:>10}{magnitude[peak, p, c]:>14.4g}"
                      f"{summary['receptance_units'][c]:>12}{result.excitation_hz[peak]:>12.5g}")
+    if summary.get("note"):
+        lines.append(f"  note: {summary['note']}")
     return "\n".join(lines)
 
 
@@ -437,7 +467,7 @@ def determinant_scan(model: Model, fmax: float, points: int = DEFAULT_SCAN_POINT
     ModelError
         If ``fmax`` holds too many modes to search for (key-less, naming fmax).
     """
-    from linmstmm.solve import frequency_finder, search_note
+    from linmstmm.solve import frequency_finder, search_note, search_up_to
 
     check_range_request(model, fmax)
     report("deducing Ubar_all")
@@ -447,7 +477,7 @@ def determinant_scan(model: Model, fmax: float, points: int = DEFAULT_SCAN_POINT
     report("scanning det Ubar_all")
     parts = [deduction.log_det(grid[start:start + SCAN_CHUNK]) for start in range(0, grid.size, SCAN_CHUNK)]
     report("finding roots")
-    search = finder.find(None, omega_max)
+    search = search_up_to(finder, None, fmax)
     note = search_note(search, search.roots.size, search.unseparated, None, fmax)
     return ScanResult(model.name, grid, np.concatenate([p[0] for p in parts]),
                       np.concatenate([p[1] for p in parts]), search.roots, deduction.full_order,

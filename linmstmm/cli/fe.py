@@ -49,7 +49,7 @@ def run_fe(args) -> int:
     def table(data):
         print_frequency_table(f"{model.name}: natural frequencies (finite elements)", data)
         mesh = "no beams" if result.elements_per_beam is None else \
-            f"{result.elements_per_beam} elements per beam"
+            f"{result.elements_per_beam} element{'' if result.elements_per_beam == 1 else 's'} per beam"
         print(f"  mesh: {mesh}, {result.n_dof} DOFs")
         if np.isfinite(result.error_estimate).any():
             print(f"  largest estimated relative error: {np.nanmax(result.error_estimate):.1e}")

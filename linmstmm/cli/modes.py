@@ -81,29 +81,42 @@ def modes_summary(result, model) -> dict:
     """The ``modes --json`` object: frequencies, modal masses, orthogonality errors, shapes at points."""
     full = result.to_dict()
     keys = ("model", "frequencies_hz", "rigid_body_modes", "normalization", "modal_mass",
-            "modal_stiffness", "mass_orthogonality_error", "stiffness_orthogonality_error",
-            "point_displacements")
+            "modal_stiffness", "modal_mass_units", "modal_stiffness_units", "mass_orthogonality_error",
+            "stiffness_orthogonality_error", "point_displacements")
     return {key: full[key] for key in keys} | {"points": list(model.points)} | (
         {"note": result.note} if result.note else {})
 
 
 def modes_csv(data: dict) -> tuple[list[str], list[list]]:
-    """The ``--csv`` table: one row per mode, its frequency, modal mass and shape at every point."""
+    """The ``--csv`` table: one row per mode, its frequency, modal mass and shape at every point.
+
+    The modal mass column carries its unit in the header when every mode shares it
+    (kg), else a column ``modal mass unit`` follows it (kg, or kg m^2 for a mode
+    scaled to a largest rotation of 1 rad)."""
     units = SHAPE_UNITS[data["normalization"]]
-    header = ["mode", "frequency [Hz]", "modal mass [kg]"] + [
+    mass_units = data["modal_mass_units"]
+    shared = len(set(mass_units)) <= 1
+    mass_columns = [f"modal mass [{mass_units[0] if mass_units else 'kg'}]"] if shared else \
+        ["modal mass", "modal mass unit"]
+    header = ["mode", "frequency [Hz]", *mass_columns] + [
         f"{point}.{name} [{unit}]" for point in data["points"] for name, unit in zip(COMPONENTS, units)]
-    rows = [[k + 1, f, m, *np.concatenate([data["point_displacements"][p][k] for p in data["points"]])]
-            for k, (f, m) in enumerate(zip(data["frequencies_hz"], data["modal_mass"]))]
+    rows = [[k + 1, f, m, *([] if shared else [unit]),
+             *np.concatenate([data["point_displacements"][p][k] for p in data["points"]])]
+            for k, (f, m, unit) in enumerate(zip(data["frequencies_hz"], data["modal_mass"], mass_units))]
     return header, rows
 
 
 def _print_modes(data: dict) -> None:
     scaling = {"mass": "mass-normalised (modal mass 1 kg)", "max": "scaled to a largest translation of 1 m"}
     print(f"{data['model']}: modes (MSTMM), shapes {scaling[data['normalization']]}")
-    print(f"  {'mode':>4}  {'f [Hz]':>16}  {'modal mass [kg]':>16}  {'modal stiffness [N/m]':>22}")
-    for n, (f, m, k) in enumerate(zip(data["frequencies_hz"], data["modal_mass"], data["modal_stiffness"]),
-                                  start=1):
-        print(f"  {n:>4}  {f:>16.10g}  {m:>16.6g}  {k:>22.6g}")
+    if "kg m^2" in data["modal_mass_units"]:
+        print("  (a mode without translation is scaled to a largest rotation of 1 rad: modal mass in kg m^2, "
+              "modal stiffness in N m/rad)")
+    print(f"  {'mode':>4}  {'f [Hz]':>16}  {'modal mass':>22}  {'modal stiffness':>24}")
+    for n, (f, m, k, mass_unit, stiffness_unit) in enumerate(zip(
+            data["frequencies_hz"], data["modal_mass"], data["modal_stiffness"], data["modal_mass_units"],
+            data["modal_stiffness_units"]), start=1):
+        print(f"  {n:>4}  {f:>16.10g}  {m:>14.6g} {mass_unit:<7}  {k:>16.6g} {stiffness_unit}")
     print(f"  rigid-body modes: {data['rigid_body_modes']}")
     print(f"  orthogonality error (largest off-diagonal, mass-normalised): "
           f"mass {data['mass_orthogonality_error']:.2e}, stiffness {data['stiffness_orthogonality_error']:.2e}")

@@ -82,4 +82,5 @@ def response_csv(result) -> tuple[list[str], np.ndarray]:
 
 def _modes_used_text(used: int, asked: int) -> str:
     """"6 elastic modes" and, when fewer than asked exist, "(20 asked: the model has no more)"."""
-    return f"{used} elastic modes" + (f" ({asked} asked: the model has no more)" if used < asked else "")
+    return (f"{used} elastic mode{'' if used == 1 else 's'}"
+            + (f" ({asked} asked: the model has no more)" if used < asked else ""))

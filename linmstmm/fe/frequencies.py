@@ -14,6 +14,7 @@ from linmstmm.fe.result import FEResult
 from linmstmm.fe.richardson import _extrapolate
 from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
+from linmstmm.wording import counted
 
 #: A frequency whose estimated relative error is at or above this is not
 #: reported (its own estimate leaves not even its first digit assured).
@@ -43,11 +44,13 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
         relative error is <= ``rtol`` (at least three meshes) or the next
         mesh would exceed ``max_elements_per_beam``. An int = that mesh, no
         extrapolation; its error is estimated from one solve on half the mesh
-        unless ``estimate_error`` is False (then NaN).
+        (on twice the mesh for a mode half the mesh does not have, and for one
+        element per beam) unless ``estimate_error`` is False (then NaN, and
+        the note says the frequencies are unchecked).
     rtol : float
         Target relative error of the frequencies when refining.
     estimate_error : bool
-        With a fixed mesh: estimate the error from half the mesh.
+        With a fixed mesh: estimate the error from another mesh.
     max_elements_per_beam : int
         The finest mesh the refinement may reach.
     mode_shapes : bool
@@ -89,9 +92,11 @@ def fe_frequencies(model: Model, count=10, fmax=None, elements_per_beam=None,
     frequencies_hz, error_estimate, order = frequencies_hz[:settled], error_estimate[:settled], order[:settled]
     if refined:
         notes.append(_short_of_rtol(frequencies_hz, error_estimate, rtol, fe.elements_per_beam))
+    elif model.beams:
+        notes.append(_fixed_mesh_note(fe, len(lam), count if fmax is None else None, error_estimate))
     if not model.beams and fmax is None and len(lam) < count:
-        notes.append(f"only {len(lam)} elastic natural frequencies exist (directions with mass "
-                     f"less the {fe.rigid_modes.shape[1]} rigid-body modes)")
+        notes.append(f"only {counted(len(lam), 'elastic natural frequency exists', 'elastic natural frequencies exist')}"
+                     f" (directions with mass less the {counted(fe.rigid_modes.shape[1], 'rigid-body mode')})")
     return FEResult(model=model.name,
                     frequencies_hz=frequencies_hz,
                     rigid_body_modes=fe.rigid_modes.shape[1],
@@ -118,7 +123,7 @@ def _unsettled(frequencies_hz, error_estimate) -> str:
         return ""
     listed = ", ".join(f"{f:.6g} Hz ({e:.1e})" for f, e in zip(frequencies_hz[:5], error_estimate[:5]))
     more = f" and {len(frequencies_hz) - 5} more" if len(frequencies_hz) > 5 else ""
-    return (f"{len(frequencies_hz)} computed values not reported as frequencies, from the first whose "
+    return (f"{counted(len(frequencies_hz), 'computed value')} not reported as frequencies, from the first whose "
             f"estimated relative error is {UNSETTLED:.0%} or more: {listed}{more}")
 
 
@@ -153,27 +158,55 @@ def _short_of_rtol(frequencies_hz, error_estimate, rtol, elements_per_beam) -> s
         return ""
     listed = ", ".join(f"{frequencies_hz[i]:.6g} Hz ({error_estimate[i]:.1e})" for i in short[:5])
     more = f" and {len(short) - 5} more" if len(short) > 5 else ""
-    return (f"mesh refinement stopped at {elements_per_beam} elements per beam (max_elements_per_beam) "
-            f"with {len(short)} frequencies above rtol = {rtol:.0e} (estimated relative error, at least the "
+    return (f"mesh refinement stopped at {counted(elements_per_beam, 'element')} per beam (max_elements_per_beam) "
+            f"with {counted(len(short), 'frequency', 'frequencies')} above rtol = {rtol:.0e} (estimated relative error, at least the "
             f"elements' dispersion error on that mesh): {listed}{more}")
 
 
-def _fixed_mesh(model, elements_per_beam, count, lam_max, estimate_error):
-    """One mesh; error from the change against half the mesh, taken as if
-    second order (``|λ_n − λ_n/2| / 3``), which overestimates the h⁴ bending
-    error about fivefold.
+def _fixed_mesh_note(fe, computed: int, count, error_estimate) -> str:
+    """What a fixed mesh leaves unsaid (empty if nothing): fewer modes than the
+    ``count`` asked for (the mesh holds no more), and frequencies whose error
+    was not estimated (unchecked)."""
+    parts = []
+    if count is not None and computed < count:
+        parts.append(f"the mesh of {counted(fe.elements_per_beam, 'element')} per beam ({fe.n_dof} DOFs) holds only "
+                     f"{computed} of the {counted(count, 'mode')} asked for")
+    unknown = int(np.count_nonzero(np.isnan(error_estimate)))
+    if unknown:
+        parts.append(f"the error of {counted(unknown, 'frequency', 'frequencies')} is not estimated "
+                     f"(estimate_error=False): {'it is' if unknown == 1 else 'they are'} unchecked")
+    return "; ".join(parts)
 
-    Returns the FEModel, λ, mode vectors and relative error estimates of λ.
+
+def _fixed_mesh(model, elements_per_beam, count, lam_max, estimate_error):
+    """One mesh of n elements per beam; each λ's error estimated from its change
+    against another mesh, taken as if second order: against half the mesh
+    (``|λ_n − λ_n/2| / 3``) where that mesh exists and holds the mode, else
+    against twice the mesh (``4 |λ_n − λ_2n| / 3``, a mesh of one element per
+    beam, or a mode above those half the mesh holds). For the h⁴ bending error
+    both overestimate, about fivefold and 1.25-fold.
+
+    Returns the FEModel, λ, mode vectors and relative error estimates of λ
+    (NaN where ``estimate_error`` is False).
     """
     fe = assemble(model, elements_per_beam)
     lam, X, solver = fe_modes(fe, count, lam_max)
     lam_error = np.full(len(lam), np.nan)
-    if estimate_error and fe.elements_per_beam >= 2:
-        coarse = fe_modes(assemble(model, fe.elements_per_beam // 2),
-                          count, lam_max, at_least=len(lam))[0][:len(lam)]
-        m = len(coarse)
-        lam_error[:m] = np.abs(coarse - lam[:m]) / (3 * lam[:m])
+    if estimate_error:
+        held = 0
+        if fe.elements_per_beam >= 2:
+            coarse = _lowest(model, fe.elements_per_beam // 2, count, lam_max, len(lam))
+            held = len(coarse)
+            lam_error[:held] = np.abs(coarse - lam[:held]) / (3 * lam[:held])
+        if held < len(lam):
+            fine = _lowest(model, 2 * fe.elements_per_beam, count, lam_max, len(lam))
+            lam_error[held:] = 4 * np.abs(fine[held:len(lam)] - lam[held:]) / (3 * lam[held:])
     return fe, lam, X, np.maximum(lam_error, solver)
+
+
+def _lowest(model, elements_per_beam, count, lam_max, at_least):
+    """(m,) the lowest λ on a mesh of ``elements_per_beam``, at most ``at_least`` of them."""
+    return fe_modes(assemble(model, elements_per_beam), count, lam_max, at_least=at_least)[0][:at_least]
 
 
 def _refine(model, count, lam_max, rtol, max_elements_per_beam):

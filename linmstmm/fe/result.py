@@ -16,7 +16,8 @@ class FEResult(Result):
         repeated per multiplicity.
     rigid_body_modes : number of zero-frequency modes (not in the list).
     error_estimate : (m,) estimated relative error of each frequency
-        (discretisation and solver); NaN where it could not be estimated.
+        (discretisation and solver); NaN where it was not estimated
+        (``estimate_error=False``; null in :meth:`to_dict`, and the note says so).
     elements_per_beam : finest mesh used (None for a model without beams).
     n_dof : reduced DOFs of that mesh. seconds : wall time of the whole solve.
     mode_shapes : (n_full, m) mass-normalised full vectors on that mesh (see
@@ -26,7 +27,8 @@ class FEResult(Result):
         above them; the frequencies less accurate than asked where the
         refinement stopped at ``max_elements_per_beam`` with their estimated
         error above ``rtol``; that a model without beams has fewer elastic
-        modes than asked for.
+        modes than asked for; that a fixed mesh holds fewer modes than asked
+        for, or that its errors were not estimated.
     """
 
     model: str
@@ -55,7 +57,7 @@ class FEResult(Result):
                 "rigid_body_modes": int(self.rigid_body_modes),
                 "n_dof": int(self.n_dof),
                 "elements_per_beam": self.elements_per_beam,
-                "error_estimate": [float(e) for e in self.error_estimate],
+                "error_estimate": [float(e) if np.isfinite(e) else None for e in self.error_estimate],
                 "seconds": float(self.seconds),
                 "method": "fe",
                 **({"note": self.note} if self.note else {})}

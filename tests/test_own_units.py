@@ -53,3 +53,17 @@ def test_balanced_matrix_does_not_depend_on_the_units(length, mass, time):
     model = lm.load_model(LAUNCHER)
     np.testing.assert_allclose(balanced_singular_values(in_units(model, length, mass, time)),
                                balanced_singular_values(model), rtol=1e-9, atol=1e-14)
+
+
+def test_launcher_modes_in_micrometres_picograms_and_microseconds():
+    """Mode shapes: the null space at each root is read in the model's own units too
+    (its shapes were noted as not accurate in float64, Rayleigh quotients 22 % off,
+    mass orthogonality 9e-2). Each modal stiffness over modal mass is ω² of the
+    SI launcher, scaled, and the shapes are mass-orthogonal."""
+    model = lm.load_model(LAUNCHER)
+    si = 2 * np.pi * lm.natural_frequencies(model, count=4).frequencies_hz
+    modes = lm.mode_shapes(in_units(model, 1e6, 1e15, 1e6), count=4)
+    assert not modes.note
+    np.testing.assert_allclose(np.asarray(modes.modal_stiffness) / np.asarray(modes.modal_mass) * 1e12,
+                               si ** 2, rtol=1e-8)
+    assert modes.mass_orthogonality_error <= 1e-9

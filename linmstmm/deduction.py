@@ -228,12 +228,17 @@ class Deduction:
                 _RELEASE_ROW_KIND[record.released]]
 
     def kinds(self):
-        """(rows (N,), columns (N,)): what each row and unknown of Ū_all (as it stands,
-        less released ones) is: 0 a displacement, 1 a rotation, 2 a moment, 3 a force.
+        """What each row and unknown of Ū_all (as it stands, less released ones) is.
 
         The main equation's rows are the root's state, a geometric equation's a
         displacement and a rotation, a joint's the force or moment it releases
-        (those the orthonormaliser weighs rows by, :func:`~linmstmm.godunov._row_kinds`).
+        (those the orthonormaliser weighs rows by, :func:`~linmstmm.godunov._row_kinds`);
+        an unknown is a boundary end's or a cut's state component, or a joint's jump.
+
+        Returns
+        -------
+        rows, columns : numpy.ndarray of int, shape (N,)
+            0 a displacement, 1 a rotation, 2 a moment, 3 a force.
         """
         if self._row_kinds is None:
             _, rows, _ = self._carry(np.ones(1), stable=False)

@@ -43,14 +43,29 @@ def equilibration(matrix: np.ndarray, sweeps: int = 4, start=None):
 
 
 def own_units_start(deduction):
-    """(rows (N,), cols (N,)): the scales that write Ū_all of ``deduction`` (as it stands,
-    plain) in the model's own units (:func:`linmstmm.own_units.unit_sizes` at its lowest
-    :func:`characteristic_frequencies`), to start :func:`equilibration` from.
+    """The scales that write Ū_all in the model's own units, to start :func:`equilibration` from.
 
-    Balanced from unit scales, the launcher written in µm, pg and µs kept singular
+    Each row and unknown of the plain Ū_all is divided, or multiplied, by the
+    size of its kind (:meth:`~linmstmm.deduction.Deduction.kinds`) in the
+    model's own units (:func:`linmstmm.own_units.unit_sizes` at its lowest
+    :func:`characteristic_frequencies`): so scaled, Ū_all is the same matrix
+    whatever units the model is written in, and so is its balance. Balanced
+    from unit scales, the launcher written in µm, pg and µs kept singular
     values of 1e-13 of the largest at every probe (1e-3 to 1e-6 in SI) and was
     taken for a mechanism: max-balancing stops at a balance that depends on
     where it starts.
+
+    Parameters
+    ----------
+    deduction : linmstmm.deduction.Deduction
+        The deduced system, as it stands (less released unknowns).
+
+    Returns
+    -------
+    rows : numpy.ndarray, shape (N,)
+        1 / size of each row's kind.
+    cols : numpy.ndarray, shape (N,)
+        Size of each unknown's kind (m, rad, N m or N in the model's units).
     """
     sizes = unit_sizes(deduction.topology, min(characteristic_frequencies(deduction.topology)))
     row_kinds, column_kinds = deduction.kinds()

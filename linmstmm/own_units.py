@@ -12,21 +12,43 @@ import numpy as np
 
 
 def extent(topology) -> float:
-    """The largest distance between two ports of ``topology``'s elements (model length
-    unit), 0 for a model whose ports all coincide."""
+    """The largest distance between two ports of the model's elements.
+
+    Parameters
+    ----------
+    topology : linmstmm.topology.Topology
+        The model's deduced structure.
+
+    Returns
+    -------
+    float
+        Model length unit; 0 for a model whose ports all coincide.
+    """
     positions = np.array([port.position for element in topology.elements for port in element.ports], float)
     return float(np.linalg.norm(positions.max(axis=0) - positions.min(axis=0))) if positions.size else 0.0
 
 
 def unit_sizes(topology, frequency: float) -> np.ndarray:
-    """(4,) sizes of a displacement, a rotation, a moment and a force in the model's own units.
+    """The sizes of a displacement, a rotation, a moment and a force in the model's own units.
 
     A length L: the model's :func:`extent`, or where every port coincides the
     radius of gyration of its rigid bodies (1 where neither exists); a force
     F = m L ω² for the model's whole mass m (rigid bodies and beams) moved by L
-    at ``frequency`` ω (rad/s, the model's own scale); 1 where that vanishes.
-    Returns [L, 1, F L, F], in the units the model is written in; each moves
-    with them (L with the length unit, F with mass × length / time²).
+    at ω (1 where that vanishes). Each moves with the units the model is
+    written in: L with the length unit, F with mass × length / time².
+
+    Parameters
+    ----------
+    topology : linmstmm.topology.Topology
+        The model's deduced structure.
+    frequency : float
+        ω, rad/s: the model's own frequency scale
+        (:func:`linmstmm.nullspace.characteristic_frequencies`).
+
+    Returns
+    -------
+    numpy.ndarray, shape (4,)
+        [L, 1, F L, F]: m, rad, N m and N in the model's units.
     """
     records = [element.record for element in topology.elements if element.record is not None]
     mass = sum(record.mass for record in records if record.kind in ("rigid", "beam"))

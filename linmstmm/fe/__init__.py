@@ -34,9 +34,7 @@ D holds the element stiffnesses. Then
 * the flexibility solve ``K y = f`` goes through the mixed (force–displacement)
   system ``[[-D⁻¹, G], [Gᵀ, 0]] [s; y] = [0; f]``, whose pivots are
   element-level quantities, so equilibrium and compatibility are solved
-  without the ε·λ_max cancellation; it is factorised with the strains
-  weighted by D^½ and each DOF's column scaled to largest entry 1, the same
-  system whatever units the model is written in;
+  without the ε·λ_max cancellation;
 * every Rayleigh quotient is an energy computed from strains,
   ``λ = |D^½ G x|² / xᵀ M x``, never from ``xᵀ K x``; the strains are those
   of each solve's displacements before the rigid-body modes are deflated,

@@ -27,8 +27,8 @@ class _Flexibility:
         self.n_strain = len(fe.D)
         self.lu = None
         if len(self.free):
-            g, self.scale = _balanced_equilibrium(fe.G[:, self.free], fe.D)
-            mixed = sp.bmat([[-sp.identity(self.n_strain), g], [g.T, None]], format="csc")
+            g = fe.G[:, self.free]
+            mixed = sp.bmat([[sp.diags(-1.0 / fe.D), g], [g.T, None]], format="csc")
             try:
                 self.lu = splu(mixed)
             except RuntimeError as error:
@@ -69,27 +69,11 @@ class _Flexibility:
         y = np.zeros_like(loads)
         if self.lu is not None:
             rhs = np.zeros((self.n_strain + len(self.free), loads.shape[1]))
-            rhs[self.n_strain:] = self.scale[:, None] * loads[self.free]
-            y[self.free] = self.scale[:, None] * self.lu.solve(rhs)[self.n_strain:]
+            rhs[self.n_strain:] = loads[self.free]
+            y[self.free] = self.lu.solve(rhs)[self.n_strain:]
         strains = np.sqrt(fe.D)[:, None] * (fe.G @ y)
         y -= modes @ (modes.T @ (fe.M @ y))
         return y, strains
-
-
-def _balanced_equilibrium(g: sp.spmatrix, stiffness: np.ndarray):
-    """(D^½ g Σ, Σ): the equilibrium matrix ``g`` (n_strain, n_free) in energy-weighted
-    strains, its columns scaled to largest entry 1 by the diagonal Σ (n_free,).
-
-    The mixed system then reads ``[[-I, D^½ g Σ], [Σ gᵀ D^½, 0]] [D^-½ s; Σ⁻¹ y] = [0; Σ f]``:
-    every entry of a column has the same unit (√(N m) per m or per rad of its DOF),
-    so the scaled system is the same whatever units the model is written in.
-    Unscaled, the launcher in µm, pg and µs lost up to 8 % of its frequencies to
-    the pivoting of the factorisation.
-    """
-    weighted = sp.diags(np.sqrt(stiffness)) @ g
-    largest = abs(weighted).max(axis=0).toarray().ravel()
-    scale = 1.0 / np.where(largest > 0, largest, 1.0)
-    return (weighted @ sp.diags(scale)).tocsc(), scale
 
 
 def static_displacements(model: Model, loads, points, elements_per_beam: int = 1) -> np.ndarray:

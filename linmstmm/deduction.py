@@ -41,7 +41,7 @@ from linmstmm.elements.rigid import (
     rigid_transfer_parts,
 )
 from linmstmm.elements.spring import joint_force, joint_jump, spring_transfer
-from linmstmm.godunov import PortState, _Orthonormaliser
+from linmstmm.godunov import PortState, _Orthonormaliser, _row_kinds
 from linmstmm.load_jumps import _Loads
 from linmstmm.model import COMPONENTS
 from linmstmm.numeric import (
@@ -93,14 +93,15 @@ class Deduction:
         self._layouts: dict[tuple, tuple] = {}  # see _combined
         self._boundary_columns = {}
         self._cut_columns = {}
-        labels = []
+        labels, state_rows = [], []  # state_rows: the state vector's row each unknown stands in
         names = ["X", "Y", "Z", "Θx", "Θy", "Θz", "Mx", "My", "Mz", "Qx", "Qy", "Qz"]
         for b, boundary in enumerate(topology.boundaries):
             self._boundary_columns[b] = np.arange(len(labels), len(labels) + 6)
-            labels += [f"{boundary.label}.{names[FORCE_INDEX[c] if boundary.fixed[c] else c]}"
-                       for c in range(6)]
+            state_rows += [FORCE_INDEX[c] if boundary.fixed[c] else c for c in range(6)]
+            labels += [f"{boundary.label}.{names[row]}" for row in state_rows[-6:]]
         for c, cut in enumerate(topology.cuts):
             self._cut_columns[c] = np.arange(len(labels), len(labels) + 12)
+            state_rows += list(range(12))
             labels += [f"cut {cut.point}.{name}" for name in names]
         #: element -> columns of the jumps across its released directions
         self.jump_columns: dict[int, np.ndarray] = {}
@@ -109,7 +110,10 @@ class Deduction:
                 released = element.record.released
                 self.jump_columns[e] = np.arange(len(labels), len(labels) + released.size)
                 labels += [f"{element.name}.Δ{COMPONENTS[d]}" for d in released]
+                state_rows += list(released)  # a jump is a displacement (m) or a rotation (rad)
         self.columns = labels
+        self._column_kinds = np.array(state_rows, dtype=int) // 3
+        self._row_kinds = None
         self.full_order = self.order = len(labels)
         self.released_columns = self.released_rows = np.zeros(0, dtype=int)
         n_geometric = sum(max(len(el.inputs) - 1, 0) for el in topology.elements)
@@ -222,6 +226,26 @@ class Deduction:
         force = joint_force(record.axes, record.released)
         return [f"{record.name} released", state.columns, constant_times(force, state.matrix),
                 _RELEASE_ROW_KIND[record.released]]
+
+    def kinds(self):
+        """What each row and unknown of Ū_all (as it stands, less released ones) is.
+
+        The main equation's rows are the root's state, a geometric equation's a
+        displacement and a rotation, a joint's the force or moment it releases
+        (those the orthonormaliser weighs rows by, :func:`~linmstmm.godunov._row_kinds`);
+        an unknown is a boundary end's or a cut's state component, or a joint's jump.
+
+        Returns
+        -------
+        rows, columns : numpy.ndarray of int, shape (N,)
+            0 a displacement, 1 a rotation, 2 a moment, 3 a force.
+        """
+        if self._row_kinds is None:
+            _, rows, _ = self._carry(np.ones(1), stable=False)
+            self._row_kinds = np.concatenate([np.arange(12) // 3]
+                                             + [_row_kinds(("row", row, row[1], row[2])) for row in rows[1:]])
+        return (np.delete(self._row_kinds, self.released_rows),
+                np.delete(self._column_kinds, self.released_columns))
 
     def release(self, columns, rows) -> None:
         """Drop statically indeterminate unknowns and the as many dependent rows.

@@ -13,26 +13,63 @@ import numpy as np
 import scipy.linalg
 
 from linmstmm.numeric import power_of_two_scale
+from linmstmm.own_units import extent, unit_sizes
 
 #: A singular value below this fraction of the largest counts as zero.
 NULL_TOLERANCE = 1e-8
 
 
-def equilibration(matrix: np.ndarray, sweeps: int = 4):
+def equilibration(matrix: np.ndarray, sweeps: int = 4, start=None):
     """Row and column scales (powers of two) giving every row and column max |a| ~ 1.
 
     matrix : (N, M) or a stack (n, N, M). Returns (rows (…, N), cols (…, M))
     with ``rows[..., :, None] * matrix * cols[..., None, :]`` balanced.
     Keeps the null space (up to column scaling) and makes singular values
     comparable across the mixed units of Ū_all (m, rad, N, N m).
+    start : (rows (N,), cols (M,)) to balance from, default ones (then the
+    scales are powers of two, exact). The balance reached depends on where it
+    starts: from Ū_all in the model's own units (:func:`own_units_start`) it is
+    the same whatever units the model is written in.
     """
     size = np.abs(matrix)
     rows = np.ones(matrix.shape[:-1])
     cols = np.ones(matrix.shape[:-2] + matrix.shape[-1:])
+    if start is not None:
+        rows, cols = rows * start[0], cols * start[1]
     for _ in range(sweeps):
         rows *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-1))
         cols *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-2))
     return rows, cols
+
+
+def own_units_start(deduction):
+    """The scales that write Ū_all in the model's own units, to start :func:`equilibration` from.
+
+    Each row and unknown of the plain Ū_all is divided, or multiplied, by the
+    size of its kind (:meth:`~linmstmm.deduction.Deduction.kinds`) in the
+    model's own units (:func:`linmstmm.own_units.unit_sizes` at its lowest
+    :func:`characteristic_frequencies`): so scaled, Ū_all is the same matrix
+    whatever units the model is written in, and so is its balance. Balanced
+    from unit scales, the launcher written in µm, pg and µs kept singular
+    values of 1e-13 of the largest at every probe (1e-3 to 1e-6 in SI) and was
+    taken for a mechanism: max-balancing stops at a balance that depends on
+    where it starts.
+
+    Parameters
+    ----------
+    deduction : linmstmm.deduction.Deduction
+        The deduced system, as it stands (less released unknowns).
+
+    Returns
+    -------
+    rows : numpy.ndarray, shape (N,)
+        1 / size of each row's kind.
+    cols : numpy.ndarray, shape (N,)
+        Size of each unknown's kind (m, rad, N m or N in the model's units).
+    """
+    sizes = unit_sizes(deduction.topology, min(characteristic_frequencies(deduction.topology)))
+    row_kinds, column_kinds = deduction.kinds()
+    return 1 / sizes[row_kinds], sizes[column_kinds]
 
 
 def nullity(matrix: np.ndarray, tolerance: float = NULL_TOLERANCE, scales=None) -> int:
@@ -101,14 +138,13 @@ def _torsion_scales(topology, records, mass) -> list[float]:
     model's whole mass m at its extent d (the largest distance between ports), rad/s:
     the scale of a model whose only compliance is rotational (rods on pins with
     torsion springs); empty where there is none."""
-    positions = np.array([port.position for element in topology.elements for port in element.ports], float)
-    extent = np.linalg.norm(positions.max(axis=0) - positions.min(axis=0)) if positions.size else 0.0
+    size = extent(topology)
     scales = []
     for record in records:
-        if record.kind == "spring" and mass > 0 and extent > 0:
+        if record.kind == "spring" and mass > 0 and size > 0:
             finite = record.k[3:][np.isfinite(record.k[3:]) & (record.k[3:] > 0)]
             if finite.size:
-                scales.append(np.sqrt(finite.min() / (mass * extent ** 2)))
+                scales.append(np.sqrt(finite.min() / (mass * size ** 2)))
     return scales
 
 
@@ -168,10 +204,11 @@ def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINAT
                 continue
         probe = np.asarray(PROBES) * scales[-1]
     probe = np.asarray(probe, dtype=float)
-    if screen is not None and _clearly_regular(screen(probe), SCREEN_MARGIN * tolerance):
+    start = own_units_start(deduction)
+    if screen is not None and _clearly_regular(screen(probe), SCREEN_MARGIN * tolerance, start):
         return 0
     samples = deduction.matrix(probe)
-    rows, cols = equilibration(samples[0])
+    rows, cols = equilibration(samples[0], start=start)
     samples = rows[:, None] * samples * cols
     r = _common_nullity(samples, tolerance)
     if r == 0:
@@ -192,10 +229,12 @@ def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINAT
     return r
 
 
-def _clearly_regular(samples: np.ndarray, threshold: float) -> bool:
-    """True where every one of ``samples`` (n, N, N) is finite and the first, balanced,
-    has no singular value below ``threshold`` times its largest (:func:`nullity`)."""
-    return bool(np.all(np.isfinite(samples))) and nullity(samples[0], threshold) == 0
+def _clearly_regular(samples: np.ndarray, threshold: float, start) -> bool:
+    """True where every one of ``samples`` (n, N, N) is finite and the first, balanced
+    from ``start`` (:func:`equilibration`), has no singular value below ``threshold``
+    times its largest (:func:`nullity`)."""
+    return bool(np.all(np.isfinite(samples))) and nullity(
+        samples[0], threshold, equilibration(samples[0], start=start)) == 0
 
 
 def _common_nullity(samples: np.ndarray, tolerance: float) -> int:

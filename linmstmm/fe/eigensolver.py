@@ -13,6 +13,9 @@ from linmstmm.fe.flexibility import _Flexibility
 
 #: Reduced systems at most this large take the dense eigensolver.
 DENSE_LIMIT = 120
+#: A direction of a subspace whose M-norm, as its basis is orthonormalised, is at most
+#: this fraction of the largest is rounding, and dropped (:func:`_mass_orthonormal`).
+INDEPENDENT = 1e-13
 #: Polishing sweeps stop when no wanted λ changes by more than this (relative).
 SWEEP_TOLERANCE = 1e-14
 
@@ -27,22 +30,39 @@ def _rayleigh_ritz(fe: FEModel, Y: np.ndarray, strains: np.ndarray):
     Returns ascending λ (rad²/s²) and mass-normalised vectors (n_dof, m);
     directions of span(Y) without mass are dropped.
     """
-    MY = fe.M @ Y
-    norms = np.sqrt(np.maximum(np.einsum("ij,ij->j", Y, MY), 0.0))
-    keep = norms > 0.0
-    Y, strains = Y[:, keep] / norms[keep], strains[:, keep] / norms[keep]
-    gram = Y.T @ (fe.M @ Y)
-    weights, directions = la.eigh(0.5 * (gram + gram.T))
-    keep = weights > 1e-12 * weights[-1]          # drop numerically dependent directions
-    combination = directions[:, keep] / np.sqrt(weights[keep])
-    Z, strains = Y @ combination, strains @ combination
+    for independent in (INDEPENDENT, 0.0):  # the second pass makes the first's basis orthonormal to rounding
+        Y, strains = _mass_orthonormal(fe, Y, strains, independent)
     _, C = la.eigh(strains.T @ strains)
-    X, strains = Z @ C, strains @ C
+    X, strains = Y @ C, strains @ C
     masses = np.sqrt(np.einsum("ij,ij->j", X, fe.M @ X))
     X, strains = X / masses, strains / masses
     lam = np.sum(strains ** 2, axis=0)
     order = np.argsort(lam)
     return lam[order], X[:, order]
+
+
+def _mass_orthonormal(fe: FEModel, Y: np.ndarray, strains: np.ndarray, independent: float):
+    """(Y @ B, strains @ B): span(Y) in a basis nearly orthonormal in M, directions whose
+    M-norm is at most ``independent`` times the largest dropped (rounding of the others).
+
+    The directions are the eigenvectors of the Gram matrix Yᵀ M Y of the columns
+    normalised; each is normalised by its own M-norm, computed from the combined
+    vector, not by the Gram eigenvalue: that is the norm squared, lost under
+    rounding below 1e-16 of the largest. Inverse iteration shrinks a stiff
+    direction by λ_soft/λ_stiff per sweep (1e-11 for two masses on springs
+    1e11 apart): the eigenvalue read 4e-16 where 1e-22 was right, and a cut of
+    the eigenvalues at 1e-12 dropped the stiff mode.
+    """
+    norms = np.sqrt(np.maximum(np.einsum("ij,ij->j", Y, fe.M @ Y), 0.0))
+    keep = norms > 0.0
+    Y, strains = Y[:, keep] / norms[keep], strains[:, keep] / norms[keep]
+    gram = Y.T @ (fe.M @ Y)
+    _, directions = la.eigh(0.5 * (gram + gram.T))
+    Z = Y @ directions
+    norms = np.sqrt(np.maximum(np.einsum("ij,ij->j", Z, fe.M @ Z), 0.0))
+    keep = norms > independent * norms.max(initial=0.0)
+    combination = directions[:, keep] / norms[keep]
+    return Y @ combination, strains @ combination
 
 
 def _lanczos_start(fe: FEModel, flexibility, block: int) -> np.ndarray:

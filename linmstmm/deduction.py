@@ -247,6 +247,13 @@ class Deduction:
         return (np.delete(self._row_kinds, self.released_rows),
                 np.delete(self._column_kinds, self.released_columns))
 
+    def adopt_row_kinds(self, row_kinds: np.ndarray) -> None:
+        """Take the kinds of Ū_all's rows before release (0 a displacement, 1 a rotation,
+        2 a moment, 3 a force; (full_order,) int) from a program compiled from this
+        deduction (:attr:`linmstmm.program.Program.row_kinds`), so that :meth:`kinds`
+        needs no carry of its own (1.5 ms on the launcher)."""
+        self._row_kinds = np.asarray(row_kinds, dtype=int)
+
     def release(self, columns, rows) -> None:
         """Drop statically indeterminate unknowns and the as many dependent rows.
 

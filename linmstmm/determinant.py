@@ -119,6 +119,7 @@ class CompiledDeterminant:
         self.deduction = deduction
         self._released = deduction.released_columns  # the unknowns compiled for
         self.program = compile_program(deduction)
+        deduction.adopt_row_kinds(self.program.row_kinds)
         p = self.program
         self._operations = _kernel_operations(p, p.orthos)
         self._layout = (p.slot_offset, p.slot_width, p.slot_columns, p.slot_columns_start, p.workspace,

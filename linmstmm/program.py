@@ -92,6 +92,9 @@ class Program:
     geometric_rows : (g,) slots of the geometric and joint rows, in Ū_all's row order.
     order, kept_rows, kept_columns : order of Ū_all before release, and the rows and
         columns that remain after it.
+    row_kinds : (order,) int64 what each row of Ū_all before release is (0 a
+        displacement, 1 a rotation, 2 a moment, 3 a force), as
+        :meth:`~linmstmm.deduction.Deduction.kinds` has it.
     """
 
     slot_offset: np.ndarray
@@ -115,6 +118,7 @@ class Program:
     order: int
     kept_rows: np.ndarray
     kept_columns: np.ndarray
+    row_kinds: np.ndarray
 
 
 class _Planner:
@@ -315,7 +319,18 @@ def compile_program(deduction: Deduction) -> Program:
         order=order,
         kept_rows=np.setdiff1d(np.arange(order), deduction.released_rows).astype(np.int64),
         kept_columns=np.setdiff1d(np.arange(order), deduction.released_columns).astype(np.int64),
+        row_kinds=np.concatenate([_row_kinds(count, forces) for _, _, count, forces in rows]).astype(np.int64),
     )
+
+
+def _row_kinds(count: int, forces: int) -> np.ndarray:
+    """Kinds of a row block of ``count`` rows (0 displacement, 1 rotation, 2 moment, 3
+    force): a joint's ``forces`` force rows, then moment rows; any other block (the
+    root's state, a geometric equation) three rows per kind (as
+    :func:`linmstmm.godunov._row_kinds` weighs them)."""
+    if forces >= 0:
+        return np.r_[np.full(forces, 3), np.full(count - forces, 2)]
+    return np.arange(count) // 3
 
 
 def _joint(plan: _Planner, deduction: Deduction, e: int, state: int, rows: list) -> int:

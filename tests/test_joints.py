@@ -254,6 +254,23 @@ def test_the_compiled_engine_gives_the_same_frequencies():
                                    natural_frequencies(model, count=3, engine="numpy").frequencies_hz, rtol=1e-12)
 
 
+def test_the_compiled_program_knows_the_kinds_of_the_rows_the_numpy_carry_finds():
+    """What each row of Ū_all is (displacement, rotation, moment, force: the scales of the
+    release in the model's own units) from the compiled program's rows, as the numpy
+    carry labels them: joints' force and moment rows, geometric rows, bundled models."""
+    from builders import BUNDLED_MODELS
+
+    from linmstmm.deduction import Deduction
+    from linmstmm.program import compile_program
+
+    models = [four_bar(), pinned_bars(k0=3e3), hinged_chain(), beam_on_joint(["rx", "ry", "rz"]), sliding_carts()]
+    for model in models + [load_model(path) for path in BUNDLED_MODELS]:
+        carried = Deduction(build_topology(model)).kinds()[0]
+        adopted = Deduction(build_topology(model))
+        adopted.adopt_row_kinds(compile_program(adopted).row_kinds)
+        np.testing.assert_array_equal(adopted.kinds()[0], carried, err_msg=model.name)
+
+
 SPRING = """name = "m"
 [points]
 g = [0, 0, 0]

@@ -108,7 +108,9 @@ def coupled_unit_response(omega, rates, coupling, participation, function: TimeF
     omega, rates = np.asarray(omega, dtype=float), np.asarray(rates, dtype=float)
     coupling, participation = np.asarray(coupling, dtype=float), np.asarray(participation, dtype=float)
     touched = _touched(coupling)
-    histories = np.stack(unit_response(omega, rates, function, times)) * participation
+    histories = np.zeros((3, np.size(times), omega.size))
+    alone = ~touched  # modes no dashpot moves: their own equations
+    histories[:, :, alone] = np.stack(unit_response(omega[alone], rates[alone], function, times)) * participation[alone]
     if not touched.any():
         return tuple(histories)
     w, c, p = omega[touched], rates[touched], participation[touched]

@@ -35,11 +35,17 @@ def write_csv(path: Path, header, rows) -> Path:
     return path
 
 
-def test_two_values_are_recovered_from_the_frequencies_freqs_gives(perturbed, tmp_path):
-    status, out, err = run_cli("freqs", perturbed, "--count", 6, "--json")
+def own_frequencies(model_file, folder: Path) -> tuple[list, Path]:
+    """(the lowest 6 frequencies ``linmstmm freqs`` gives for ``model_file``, Hz; a
+    measured-frequency CSV of them in ``folder``)."""
+    status, out, err = run_cli("freqs", model_file, "--count", 6, "--json")
     assert status == 0, err
     measured = json.loads(out)["frequencies_hz"]
-    csv_file = write_csv(tmp_path / "measured.csv", ["frequency [Hz]"], [[repr(float(f))] for f in measured])
+    return measured, write_csv(folder / "measured.csv", ["frequency [Hz]"], [[repr(float(f))] for f in measured])
+
+
+def test_two_values_are_recovered_from_the_frequencies_freqs_gives(perturbed, tmp_path):
+    measured, csv_file = own_frequencies(perturbed, tmp_path)
     status, out, err = run_cli("fit", CHAIN, csv_file, "--vary", "rigid.m2.mass=1:4",
                                "--vary", "spring.k2.k[0]=200:5000", "--json")
     assert status == 0, err
@@ -162,10 +168,7 @@ def test_values_the_frequencies_do_not_separate_have_no_interval(tmp_path):
     text = (MODELS / "cantilever_tip_mass.toml").read_text()
     bare = tmp_path / "bare.toml"
     bare.write_text(text[:text.index("[[rigid]]")] + text[text.index("[boundary]"):])
-    status, out, err = run_cli("freqs", bare, "--count", 6, "--json")
-    assert status == 0, err
-    measured = json.loads(out)["frequencies_hz"]
-    csv_file = write_csv(tmp_path / "measured.csv", ["frequency [Hz]"], [[repr(float(f))] for f in measured])
+    _, csv_file = own_frequencies(bare, tmp_path)
     status, out, err = run_cli("fit", bare, csv_file, "--vary", "beam.arm.E=1e11:3e11",
                                "--vary", "beam.arm.rho=5000:9000", "--json")
     assert status == 0, err

@@ -25,11 +25,10 @@ from __future__ import annotations
 
 import math
 
-import llvmlite.binding
 import numpy as np
-from numba import njit, types
-from numba.extending import get_cython_function_address
+from numba import njit
 
+from linmstmm._lapack import lapack_routine
 from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, STATE_BLOCK, TIP
 
 #: See linmstmm.deduction: beam pieces, growth between orthonormalisations, far scale.
@@ -483,16 +482,7 @@ def _assembled(root, root_row, rows, order, kept_rows, kept_columns, work_m, slo
     return transposed.T
 
 
-def _lapack(name: str):
-    """LAPACK routine ``name`` (pointer arguments only) as scipy ships it, and as numba's
-    own linear algebra calls it, under a symbol of its own: found by name when cached
-    machine code is loaded."""
-    symbol = f"linmstmm_{name}"
-    llvmlite.binding.add_symbol(symbol, get_cython_function_address("scipy.linalg.cython_lapack", name))
-    return types.ExternalFunction(symbol, types.void(*[types.voidptr] * 6))
-
-
-_DGETRF, _ZGETRF = _lapack("dgetrf"), _lapack("zgetrf")
+_DGETRF, _ZGETRF = lapack_routine("dgetrf", 6), lapack_routine("zgetrf", 6)
 
 
 @njit(cache=True)

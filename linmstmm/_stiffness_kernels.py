@@ -7,7 +7,12 @@ the test oracle (tests/test_wittrick_williams.py compares them):
 * :func:`assembled` — :func:`linmstmm.dynamic_stiffness.clamped_counts` and
   :meth:`linmstmm.wittrick_williams.ModeCounter.matrix`: J₀(ω) and the reduced
   exact dynamic stiffness D(ω) with the scale of its terms;
-* :func:`block_inertia` — :func:`linmstmm.wittrick_williams._block_inertia`.
+* :func:`block_inertia` — :func:`linmstmm.wittrick_williams._block_inertia`;
+* :func:`count` — :meth:`linmstmm.wittrick_williams.ModeCounter._numpy`: the
+  whole count J(ω) in one call (J₀, D(ω), its equilibration and two LDLᵀ
+  factorisations by LAPACK's ``dsytrf``), without releasing a Python object:
+  compiled ``nogil``, so that counts at several frequencies can run on
+  threads side by side.
 """
 from __future__ import annotations
 
@@ -16,6 +21,7 @@ import math
 import numpy as np
 from numba import njit
 
+from linmstmm._lapack import lapack_routine
 from linmstmm.dynamic_stiffness import POLE, SERIES_BELOW, SERIES_COEFFICIENTS, SERIES_TERMS
 
 #: Columns of the beam table the kernels take (see :func:`beam_columns`).
@@ -23,6 +29,10 @@ EA, GJ, EIY, EIZ, RHO_A, RHO_IP, LENGTH, AXIAL, TORSION = range(9)
 _X_Y = np.array([1, 5, 7, 11])
 _X_Z = np.array([2, 4, 8, 10])
 _FLIP = np.array([1.0, -1.0, 1.0, -1.0])
+_DSYTRF = lapack_routine("dsytrf", 8)
+#: Workspace LAPACK's dsytrf is given per unknown: its block size (64), with which
+#: it factorises blocked, as scipy's wrapper lets it.
+WORK_PER_UNKNOWN = 64
 
 
 def beam_columns(beams) -> np.ndarray:
@@ -186,3 +196,64 @@ def block_inertia(factor, pivots, singular):
                 negatives += 1
         k += 2
     return negatives
+
+
+@njit(cache=True)
+def _ldlt_inertia(transposed, singular, pivots, work, integers):
+    """Negative eigenvalues of a symmetric matrix, −1 where a pivot is below ``singular``.
+
+    transposed : (n, n) C-ordered: the matrix's transpose, which LAPACK (column
+    major) reads as the matrix itself, lower triangle; overwritten by the factors
+    of ``dsytrf`` (Bunch–Kaufman LDLᵀ). pivots : (n,) int32; work : float64,
+    its workspace; integers : (4,) int32 scratch.
+    """
+    n = transposed.shape[0]
+    uplo = np.array([76], dtype=np.uint8)  # "L"
+    integers[0], integers[1], integers[2], integers[3] = n, n, work.size, 0
+    _DSYTRF(uplo.ctypes, integers[0:].ctypes, transposed.ctypes, integers[1:].ctypes, pivots.ctypes,
+            work.ctypes, integers[2:].ctypes, integers[3:].ctypes)
+    if integers[3] != 0:  # > 0: an exactly zero pivot
+        return -1
+    return block_inertia(transposed.T, pivots, singular)
+
+
+@njit(cache=True, nogil=True)
+def count(omega, beams, maps, columns, static, mass, singular_pivot, matrix, magnitude, work):
+    """J(ω): natural frequencies below ``omega`` (rad/s), −1 where float64 cannot decide.
+
+    The arguments of :func:`assembled`, and singular_pivot: a pivot below this
+    fraction of the largest equilibrated term is rounding
+    (:data:`linmstmm.wittrick_williams.SINGULAR_PIVOT`); work : (n · WORK_PER_UNKNOWN,)
+    float64. D(ω) is equilibrated by the diagonal of |D|(ω) and factorised in two
+    orders, which must agree (:func:`linmstmm.wittrick_williams._negative_eigenvalues`,
+    the same numbers in the same order of operations).
+    """
+    clamped = assembled(omega, beams, maps, columns, static, mass, matrix, magnitude)
+    n = static.shape[0]
+    if clamped < 0:
+        return -1
+    for i in range(n):
+        for j in range(n):
+            if not math.isfinite(matrix[i, j]):
+                return -1
+    if n == 0:
+        return clamped
+    weights = np.empty(n)
+    for i in range(n):
+        if not magnitude[i, i] > 0:
+            return -1  # a DOF with neither stiffness nor mass
+        weights[i] = 1.0 / math.sqrt(magnitude[i, i])
+    first, second = np.empty((n, n)), np.empty((n, n))  # transposed, as LAPACK reads them
+    largest = 0.0
+    for i in range(n):
+        for j in range(n):
+            equilibrated = matrix[i, j] * weights[i] * weights[j]
+            first[j, i] = equilibrated
+            second[n - 1 - j, n - 1 - i] = equilibrated
+            largest = max(largest, magnitude[i, j] * weights[i] * weights[j])
+    singular = singular_pivot * largest
+    pivots, integers = np.empty(n, dtype=np.int32), np.empty(4, dtype=np.int32)
+    negatives = _ldlt_inertia(first, singular, pivots, work, integers)
+    if negatives < 0 or negatives != _ldlt_inertia(second, singular, pivots, work, integers):
+        return -1  # the two orders pivot differently: where rounding decides a sign, they disagree
+    return clamped + negatives

@@ -107,24 +107,20 @@ class ModeCounter:
         matrix, magnitude = self.matrix(omega)
         if not np.all(np.isfinite(matrix)):
             return None
-        negatives = _negative_eigenvalues(matrix, magnitude, _block_inertia)
+        negatives = _negative_eigenvalues(matrix, magnitude)
         return None if negatives is None else clamped + negatives
 
     def _compiled(self, omega: float) -> int | None:
-        """:meth:`__call__` with J₀ and D(ω) assembled by the compiled kernel."""
+        """:meth:`__call__` by the compiled kernel (:func:`linmstmm._stiffness_kernels.count`)."""
         from linmstmm import _stiffness_kernels as kernels
 
         if self._table is None:
             self._table = kernels.beam_columns(self._beams)
+            self._work = np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN)
         matrix, magnitude = self._buffers
-        clamped = kernels.assembled(omega, self._table, self._maps, self._columns, self._static, self._mass,
-                                    matrix, magnitude)
-        n = self.n_dof
-        if clamped < 0 or not np.all(np.isfinite(matrix[:n, :n])):
-            return None
-        negatives = _negative_eigenvalues(matrix[:n, :n], magnitude[:n, :n],
-                                          lambda f, p, singular: _undecided(kernels.block_inertia(f, p, singular)))
-        return None if negatives is None else clamped + negatives
+        count = kernels.count(omega, self._table, self._maps, self._columns, self._static, self._mass,
+                              SINGULAR_PIVOT, matrix, magnitude, self._work)
+        return None if count < 0 else count
 
     def matrix(self, omega: float) -> tuple[np.ndarray, np.ndarray]:
         """(D(ω), |D|(ω)): the reduced exact dynamic stiffness (n_dof, n_dof), and the
@@ -161,11 +157,7 @@ def _beam_maps(model: Model, layout, T) -> tuple[np.ndarray, np.ndarray]:
     return stacked, padded
 
 
-def _undecided(count: int) -> int | None:
-    return None if count < 0 else count
-
-
-def _negative_eigenvalues(matrix: np.ndarray, magnitude: np.ndarray, inertia) -> int | None:
+def _negative_eigenvalues(matrix: np.ndarray, magnitude: np.ndarray) -> int | None:
     """Negative eigenvalues of the symmetric ``matrix`` (Bunch–Kaufman LDLᵀ), or None
     where a pivot is rounding. Equilibrated first by the diagonal of ``magnitude``
     (the scale of every term that entered), a congruence that a change of units
@@ -180,17 +172,17 @@ def _negative_eigenvalues(matrix: np.ndarray, magnitude: np.ndarray, inertia) ->
     equilibrated = matrix * weights[:, None] * weights[None, :]
     # rounding is relative to the largest term that entered, which may lie off the diagonal
     singular = SINGULAR_PIVOT * float((magnitude * weights[:, None] * weights[None, :]).max())
-    counts = [_factorised_inertia(ordered, inertia, singular)
+    counts = [_factorised_inertia(ordered, singular)
               for ordered in (equilibrated, equilibrated[::-1, ::-1])]
     # the two orders pivot differently: where rounding decides a sign, they disagree
     return counts[0] if counts[0] == counts[1] else None
 
 
-def _factorised_inertia(matrix: np.ndarray, inertia, singular: float) -> int | None:
+def _factorised_inertia(matrix: np.ndarray, singular: float) -> int | None:
     factor, pivots, info = lapack.dsytrf(matrix, lower=1)
     if info < 0:
         raise ValueError(f"dsytrf: argument {-info} is invalid")
-    return None if info > 0 else inertia(factor, pivots, singular)
+    return None if info > 0 else _block_inertia(factor, pivots, singular)
 
 
 def _block_inertia(factor: np.ndarray, pivots: np.ndarray, singular: float) -> int | None:

@@ -198,3 +198,15 @@ def test_a_model_too_long_for_a_dense_count_gets_no_counter():
     assert mode_counter(chain) is None
     launcher = mode_counter(load_model("models/mlrs/mlrs.toml"))
     assert launcher is not None and launcher.n_dof <= MAX_ORDER
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_compiled_count_mirrors_the_reference_beside_the_roots(kind):
+    """Within rounding of a natural frequency, where the count may be left undecided,
+    the compiled count (one kernel, LAPACK's dsytrf called from it) gives the numpy
+    reference's answer, None included."""
+    model = random_model(kind, 1)
+    omegas = 2 * np.pi * np.asarray(fe_frequencies(model, count=8, rtol=1e-8).frequencies_hz)
+    reference, compiled = ModeCounter(model, "numpy"), ModeCounter(model, "compiled")
+    near = np.outer(omegas, 1 + np.array([-1e-6, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-6])).ravel()
+    assert [reference(w) for w in near] == [compiled(w) for w in near]

@@ -517,7 +517,7 @@ def _log_det(matrix):
     return sign, log_abs
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out, log_scale_out):
     """Stable Ū_all over ``omegas`` (n,) in groups of ``group`` consecutive frequencies.
 

@@ -33,6 +33,7 @@ import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.program import compile_program
+from linmstmm.spread import spread
 
 ENGINES = ("auto", "numpy", "compiled")
 
@@ -154,14 +155,21 @@ class CompiledDeterminant:
         matrices = np.zeros((n if with_matrices else 0, order, order), dtype=omega.dtype)
         sign = np.zeros(n, dtype=omega.dtype)
         log_abs, log_scale = np.zeros(n), np.zeros(n)
-        _kernels.evaluate(operations, self._layout, omega, max(group or n, 1), matrices, sign, log_abs, log_scale)
+        if group == 1 and not with_matrices:  # each frequency on its own: shared among the cores
+            spread(lambda start, stop: _kernels.evaluate(operations, self._layout, omega[start:stop], 1, matrices,
+                                                         sign[start:stop], log_abs[start:stop],
+                                                         log_scale[start:stop]), n)
+        else:
+            _kernels.evaluate(operations, self._layout, omega, max(group or n, 1), matrices, sign, log_abs,
+                              log_scale)
         return matrices, sign, log_abs, log_scale
 
     def log_det(self, omega):
         """(sign or phase (n,), log|det Ū_all| (n,)) at each of ``omega`` (n,) rad/s, real or complex.
 
         Each frequency is evaluated on its own (the determinant does not
-        depend on the orthonormalisations chosen).
+        depend on the orthonormalisations chosen), so a batch is shared among
+        the cores (:func:`linmstmm.spread.spread`), with the same numbers.
         """
         _, sign, log_abs, _ = self._evaluate(omega, 1, False)
         return sign, log_abs

@@ -1,0 +1,47 @@
+"""Batches shared among threads (linmstmm.spread): every item evaluated once, the
+same numbers as on one thread, and a piece's error raised in the caller."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from linmstmm import spread
+from linmstmm.compiled_model import compiled_system
+from linmstmm.model import load_model
+
+
+@pytest.mark.parametrize("cores", [1, 2, 4])
+@pytest.mark.parametrize("size", [0, 1, 7, 8, 9, 100, 513])
+def test_every_item_once(monkeypatch, cores, size):
+    monkeypatch.setattr(spread, "cores", lambda: cores)
+    seen = np.zeros(size, dtype=int)
+
+    def task(start, stop):
+        seen[start:stop] += 1
+
+    spread.spread(task, size)
+    assert np.all(seen == 1)
+
+
+def test_a_piece_that_fails_raises_in_the_caller(monkeypatch):
+    monkeypatch.setattr(spread, "cores", lambda: 2)
+
+    def task(start, stop):
+        if start <= 50 < stop:
+            raise ValueError("piece failed")
+
+    with pytest.raises(ValueError, match="piece failed"):
+        spread.spread(task, 100)
+
+
+@pytest.mark.parametrize("cores", [1, 2, 3])
+def test_a_shared_batch_gives_the_bits_of_single_evaluations(monkeypatch, cores):
+    """det Ū_all of the launcher over 64 frequencies, real and complex: bit for bit
+    what one frequency at a time gives, however the batch is shared."""
+    monkeypatch.setattr(spread, "cores", lambda: cores)
+    determinant = compiled_system(load_model("models/mlrs/mlrs.toml"), engine="compiled").determinant
+    for omegas in (np.geomspace(1.0, 2e4, 64), np.geomspace(1.0, 2e4, 64) * np.exp(0.01j)):
+        sign, log_abs = determinant.log_det(omegas)
+        alone = [determinant.log_det(omega) for omega in omegas]
+        assert np.array_equal(sign, np.concatenate([s for s, _ in alone]))
+        assert np.array_equal(log_abs, np.concatenate([v for _, v in alone]))

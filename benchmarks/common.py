@@ -35,12 +35,21 @@ STEEL = dict(E=2.1e11, G=8.1e10, rho=7850.0)
 # --------------------------------------------------------------------------
 # timing and errors
 
-def best_of(function, repeats: int = 5, budget: float = 2.0):
+def best_of(function, repeats: int = 5, budget: float = 2.0, compiled: bool = False):
     """Run ``function()`` up to ``repeats`` times (at least once), stopping
     early once ``budget`` seconds have been spent. Returns (best wall time s,
-    last result, runs made, best process CPU time s)."""
+    last result, runs made, best process CPU time s).
+
+    Every run is a first solve (the models compiled by an earlier run are
+    forgotten before it, untimed: :func:`linmstmm.compiled_model.forget_compiled_models`),
+    as a new process's would be; ``compiled=True`` keeps them, to time solves of
+    models already compiled."""
+    from linmstmm.compiled_model import forget_compiled_models
+
     best, best_cpu, result, runs, spent = np.inf, np.inf, None, 0, 0.0
     while runs < repeats and (runs == 0 or spent < budget):
+        if not compiled:
+            forget_compiled_models()
         start, cpu = time.perf_counter(), time.process_time()
         result = function()
         elapsed = time.perf_counter() - start

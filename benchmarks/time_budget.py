@@ -3,6 +3,8 @@
 ``time_budget(call)`` runs ``call()`` once with the pipeline's stages wrapped
 in timers (exclusive time: a stage called inside another is subtracted from
 it) and every evaluation of det Ū_all charged to the innermost stage running.
+The stages up to the counter's build are the model's compilation
+(:mod:`linmstmm.compiled_model`), made on a model object's first solve only.
 Used by ``benchmarks/bench_speed.py``; nothing in the package depends on it.
 """
 from __future__ import annotations
@@ -11,20 +13,21 @@ import time
 from contextlib import contextmanager
 
 import linmstmm.determinant as determinant_module
-from linmstmm import predicted, roots, solve
+from linmstmm import compiled_model, predicted, roots, solve
 
 #: (module or class, attribute, stage name), in pipeline order.
 STAGES = (
-    (solve, "build_topology", "topology"),
-    (solve, "Deduction", "deduction"),
-    (solve, "determinant", "compile the program"),
-    (solve, "release_indeterminate", "indeterminate unknowns (probes)"),
-    (solve, "rigid_body_mode_count", "rigid-body count"),
+    (compiled_model, "build_topology", "topology"),
+    (compiled_model, "Deduction", "deduction"),
+    (compiled_model, "determinant", "compile the program"),
+    (compiled_model, "release_indeterminate", "indeterminate unknowns (probes)"),
+    (compiled_model, "rigid_body_mode_count", "rigid-body count"),
+    (compiled_model, "count_in_disc", "rigid-body zeros (disc count)"),
+    (compiled_model, "mode_counter", "Wittrick–Williams counter (build)"),
     (solve, "predict_frequencies", "predict (coarse FE)"),
     (predicted, "secant_roots", "polish (secant)"),
     (roots.RootFinder, "polish", "polish (pencil)"),
     (roots.RootFinder, "segment", "segment search"),
-    (solve, "mode_counter", "Wittrick–Williams counter (build)"),
     (roots.RootFinder, "other_zeros", "certify (counts)"),
     (solve, "_refined_in_mpmath", "mpmath refinement"),
 )

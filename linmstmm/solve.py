@@ -7,22 +7,17 @@ from dataclasses import dataclass, field
 import mpmath
 import numpy as np
 
+from linmstmm.coarse_prediction import predict_frequencies
+from linmstmm.compiled_model import compiled_system
 from linmstmm.deduction import Deduction
 from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
-from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
 from linmstmm.precision import refine_roots, separated_cluster
-from linmstmm.predicted import predict_frequencies
-from linmstmm.determinant import determinant
 from linmstmm.results import Result, decode_array
-from linmstmm.rigid_motion import rigid_body_mode_count
-from linmstmm.stages import report
 from linmstmm.roots import MAX_XTOL, RootFinder, RootSearchResult
+from linmstmm.stages import report
 from linmstmm.threads import single_blas_thread
-from linmstmm.topology import build_topology
-from linmstmm.wittrick_williams import mode_counter
 from linmstmm.wording import counted
-
 
 #: Digits float64 delivers; more are computed in mpmath.
 FLOAT64_DIGITS = 14
@@ -112,17 +107,20 @@ class FrequencyResult(Result):
 
 
 def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: str = "auto", **options):
-    """The deduced system of ``model`` and a root finder on its stable determinant.
+    """The deduced system of ``model`` and a new root finder on its stable determinant.
 
+    The system is compiled once per model object (:func:`~linmstmm.compiled_model.compiled_system`:
+    deduction, program, released unknowns, rigid-body modes, the counter's
+    matrices); the finder is new, and so is everything it finds.
     engine : how det Ū_all is evaluated, "auto", "numpy" or "compiled"
     (:func:`linmstmm.determinant.determinant`; kept as ``finder.determinant``
     with its count of evaluations); the deduction's own numpy carry serves
     mode shapes and the mpmath refinement either way.
     root, cut_at : see :func:`linmstmm.topology.build_topology`. options go to
-    :class:`linmstmm.roots.RootFinder` (xtol, points_per_octave, points_per_root).
-    The finder knows the rigid-body modes (counted from the model's kinematics,
-    :func:`~linmstmm.rigid_motion.rigid_body_mode_count`) and divides their zeros out of
-    det Ū_all (:meth:`~linmstmm.roots.RootFinder.divide_out_rigid_body_zeros`),
+    :class:`linmstmm.roots.RootFinder` (xtol, points_per_octave, points_per_root, rtol).
+    The finder knows the rigid-body modes (counted from the model's kinematics)
+    and, where the disc of its floor holds exactly their zeros, divides those
+    out of det Ū_all (:meth:`~linmstmm.roots.RootFinder.divide_out_rigid_body_zeros`),
     so every caller's counts see the elastic roots only. Its closing counts are
     Wittrick–Williams counts where they can decide
     (:class:`~linmstmm.wittrick_williams.ModeCounter`, by the same engine, for
@@ -132,19 +130,18 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     depends on the units the model is written in.
     Returns (deduction, finder, number of indeterminate unknowns released).
     """
-    deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
-    evaluator = determinant(deduction, engine)  # compiled first: its plain Ū_all screens the probes
-    released = release_indeterminate(deduction, screen=evaluator.plain_matrix)
-    if released:  # the program carries the unknowns it was compiled for
-        evaluator = determinant(deduction, engine)
+    system = compiled_system(model, root, cut_at, engine)
+    evaluator = system.determinant
     finder = RootFinder(evaluator.log_det, lambda omega: evaluator.matrix(omega)[0],
-                        rigid_body_modes=rigid_body_mode_count(model),
-                        predictor=lambda n: predict_frequencies(model, n),
-                        scale=min(characteristic_frequencies(deduction.topology)), **options)
+                        rigid_body_modes=system.rigid_body_modes,
+                        predictor=lambda n: predict_frequencies(model, n), scale=system.scale, **options)
     finder.determinant = evaluator
-    finder.counter = mode_counter(model, engine)
-    finder.divide_out_rigid_body_zeros(finder.rigid_body_modes())
-    return deduction, finder, released
+    finder._evaluations_reported = evaluator.evaluations  # this finder's search counts from here
+    if system.counter is not None:
+        finder.counter = system.counter.fresh()
+    if system.rigid_zeros_confirmed:
+        finder.divide_out_rigid_body_zeros()
+    return system.deduction, finder, system.released
 
 
 def search_up_to(finder: RootFinder, count: int | None, fmax: float) -> RootSearchResult:

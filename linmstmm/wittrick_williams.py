@@ -28,6 +28,8 @@ the count answers None, and callers count another way.
 """
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import scipy.linalg.lapack as lapack
 
@@ -92,6 +94,13 @@ class ModeCounter:
         self._buffers = np.empty((2, n + 1, n + 1))
         self._answers: dict[float, int | None] = {}
         self._table = None  # the beams as the compiled kernels take them, on their first call
+
+    def fresh(self) -> ModeCounter:
+        """This counter with no answers remembered: the same model's matrices (not
+        copied), for a new search to count with afresh (:func:`linmstmm.solve.frequency_finder`)."""
+        twin = copy.copy(self)
+        twin._answers = {}
+        return twin
 
     def __call__(self, omega: float) -> int | None:
         omega = float(omega)

@@ -21,7 +21,7 @@ from linmstmm.cli import main
 from linmstmm.fe import fe_frequencies
 from linmstmm.model import Model, ModelError, load_model
 from linmstmm.modes import mode_shapes
-from linmstmm.predicted import coarse_predictions
+from linmstmm.coarse_prediction import coarse_predictions
 from linmstmm.response import frf
 from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.solve import natural_frequencies

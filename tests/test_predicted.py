@@ -12,7 +12,8 @@ import pytest
 
 from linmstmm.fe import fe_frequencies
 from linmstmm.model import load_model
-from linmstmm.predicted import coarse_predictions, predict_frequencies, predicted_roots
+from linmstmm.coarse_prediction import coarse_predictions, predict_frequencies
+from linmstmm.predicted import predicted_roots
 from linmstmm.solve import frequency_finder
 
 LAUNCHER = "models/mlrs/mlrs.toml"

@@ -39,7 +39,7 @@ class RootFinder:
     zeros of det Ū_all at ω = 0 are divided out once they are confirmed
     (:meth:`divide_out_rigid_body_zeros`).
     predictor : callable n -> (m,) rad/s, the lowest n elastic roots predicted
-    (e.g. :func:`linmstmm.predicted.predict_frequencies` of the model), or None.
+    (e.g. :func:`linmstmm.coarse_prediction.predict_frequencies` of the model), or None.
     scale : rad/s, the model's own frequency scale; the floor, ceiling and scan
     chunks are multiples of it (see DEFAULT_SCALE).
     rtol : relative accuracy a root is certified to, in [MIN_RTOL, MAX_RTOL]: a root
@@ -147,19 +147,19 @@ class RootFinder:
         #: argument principle only (see :func:`linmstmm.roots.certify.other_zeros`)
         self.counter = None
 
-    def divide_out_rigid_body_zeros(self, rigid: int) -> None:
+    def divide_out_rigid_body_zeros(self) -> None:
         """Count and scan det Ū_all / ω^2r instead of det Ū_all.
 
         With r rigid-body modes det ∝ ω^2r at ω = 0: a contour that passes a
         few floors from the origin sees the phase turn 2r times faster
         than ω's own angle, and its sampling aliases (false counts of 2, 4,
         6 roots below the first elastic one). Dividing by ω^2r removes that
-        known factor exactly; the roots elsewhere are unchanged. Checked
-        first: the disc |ω| < floor must hold exactly 2r zeros.
+        known factor exactly; the roots elsewhere are unchanged. The caller
+        has confirmed that the disc |ω| < floor holds exactly 2r zeros
+        (:attr:`linmstmm.compiled_model.CompiledSystem.rigid_zeros_confirmed`).
         """
-        if rigid and count_in_disc(self.log_det, self.floor) == 2 * rigid:
-            self.log_det = deflated(self.log_det, np.zeros(rigid))
-            self._divided = True
+        self.log_det = deflated(self.log_det, np.zeros(self._rigid))
+        self._divided = True
 
     def rigid_body_modes(self) -> int:
         """Number of zero-frequency (rigid-body) modes, as given at construction."""

@@ -1,0 +1,162 @@
+"""Predicted natural frequencies: a coarse finite-element model of the same file.
+
+The first step of :mod:`linmstmm.predicted` (predict, polish, certify): the
+natural frequencies of a coarse mesh of the model, a dense eigenproblem of a
+few hundred unknowns (none above MAX_UNKNOWNS), accurate to about 1e-3 for the
+lowest and 1e-2 by the hundredth. The mesh's assembled, scaled pencil depends
+on the model alone, so it is kept per model object (:func:`coarse_pencil`).
+Completeness is never taken from these predictions: the root search certifies
+it by counts.
+"""
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.linalg
+
+from linmstmm.elements.beam import bending_wavenumber
+from linmstmm.model import Model
+
+#: Radians of a bending wave per element of the predicting mesh: its frequencies are
+#: then high by about 1/720 relative, well inside the secant's reach.
+WAVE_PER_ELEMENT = 1.0
+#: Unknowns of the predicting FE model beyond which there is no prediction (and the
+#: scan-based search runs): its dense eigenproblem grows as their cube, and a chain
+#: of 1000 bodies took 3.5 s to predict what the search finds in 0.1 s.
+MAX_UNKNOWNS = 1500
+#: A direction of the coarse (K, M) whose images are both below this fraction of
+#: their largest entries moves neither stiffness nor mass (:func:`_regular_pencil`).
+SINGULAR_PENCIL = 1e-12
+#: Unknowns of the predicting FE model above which its eigenproblem is solved sparse
+#: (see :func:`coarse_predictions`).
+DENSE_PREDICTION = 400
+#: Coarse pencils kept (:func:`coarse_pencil`; a model's meshes, least recently used dropped first).
+PENCILS_KEPT = 16
+#: Elements per beam the predicting mesh may take.
+MAX_ELEMENTS = 64
+
+
+def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
+                       shift: float | None = None) -> np.ndarray:
+    """The lowest ``count`` elastic natural frequencies, rad/s, of a coarse FE model.
+
+    elements_per_beam : Hermite elements per beam; bending frequencies come
+    out high by about (βh)⁴/720 relative, h the element length. The dense
+    generalized eigenproblem (K, M), its lowest eigenvalues only; where M is
+    singular (massless unknowns) by QZ, whose infinite eigenvalues are dropped.
+    shift : (rad/s)², below the lowest elastic eigenvalue (half a coarser mesh's
+    lowest): where every unknown carries mass and there are more than
+    DENSE_PREDICTION of them, sparse shift-invert Lanczos about −shift instead
+    (on the second launcher's 1212 unknowns 48 ms against 202 ms dense, and the
+    dense Cholesky route's lowest eigenvalue was 2.8e-3 off there, the sparse
+    one's agrees with the 636-unknown mesh to 1e-4).
+    The lowest as many as the FE model has rigid-body modes are theirs, and dropped
+    (a threshold relative to the largest would drop a soft strip's first bending
+    modes with them).
+    Returns (m,) ascending, m <= count (fewer if the model has fewer); none for
+    a model of more than MAX_UNKNOWNS unknowns.
+    """
+    nodes = len(model.points) + len(model.rigids) + (elements_per_beam - 1) * len(model.beams)
+    if 6 * nodes > MAX_UNKNOWNS:  # a dense solve would cost more than the search it saves
+        return np.zeros(0)
+    pencil = coarse_pencil(model, elements_per_beam)
+    K, M, scale, fe = pencil.K, pencil.M, pencil.scale, pencil.fe
+    wanted = min(count + fe.rigid_modes.shape[1], K.shape[0]) - 1
+    if shift is not None and fe.massive.size == fe.n_dof and wanted + 2 < fe.n_dof > DENSE_PREDICTION:
+        from scipy.sparse import diags
+        from scipy.sparse.linalg import (
+            eigsh,  # imported where used: the command line starts without it
+        )
+
+        scaling = diags(scale)
+        lam = eigsh((scaling @ fe.K @ scaling).tocsc(), k=wanted + 1, M=(scaling @ fe.M @ scaling).tocsc(),
+                    sigma=-shift, which="LM", return_eigenvectors=False,
+                    v0=np.random.default_rng(0).standard_normal(fe.n_dof))  # the same start every run
+        lam = np.sort(lam)[fe.rigid_modes.shape[1]:]
+        return np.sqrt(np.maximum(lam[:count], 0.0))
+    try:  # Cholesky of M: every unknown carries mass
+        lam = scipy.linalg.eigh(K, M, eigvals_only=True, subset_by_index=[0, wanted])
+    except np.linalg.LinAlgError:  # massless unknowns: QZ, their eigenvalues infinite
+        K, M = _regular_pencil(K, M)
+        lam = scipy.linalg.eigvals(K, M)
+        lam = np.sort(lam[np.isfinite(lam)].real)
+    lam = np.sort(lam)[fe.rigid_modes.shape[1]:]  # the rigid-body modes' zeros first
+    return np.sqrt(np.maximum(lam[:count], 0.0))
+
+
+@dataclass(frozen=True, eq=False)
+class CoarsePencil:
+    """The coarse FE model of :func:`coarse_predictions`, assembled and scaled.
+
+    Attributes
+    ----------
+    fe : linmstmm.fe.assembly.FEModel
+        The assembled model (sparse K, M; its rigid-body modes and massive unknowns).
+    K, M : numpy.ndarray, shape (n, n)
+        Dense, each unknown scaled to unit mass (or stiffness, where it has
+        none): the same eigenvalues, and a pencil that no longer depends on
+        the units (in km the translations' and rotations' entries lie 1e6
+        further apart, and the predictions were 1e-4 to 3e-2 off where in m
+        they were 1e-7 to 1e-4 off).
+    scale : numpy.ndarray, shape (n,)
+        The scaling of each unknown.
+    """
+
+    fe: object
+    K: np.ndarray
+    M: np.ndarray
+    scale: np.ndarray
+
+
+@functools.lru_cache(maxsize=PENCILS_KEPT)
+def coarse_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
+    """The :class:`CoarsePencil` of ``model`` meshed with ``elements_per_beam``: assembled
+    on the first call for this model object (about 2 ms of a launcher's 3 ms
+    prediction), the same after (a Model cannot change; see
+    :mod:`linmstmm.compiled_model`)."""
+    from linmstmm.fe.assembly import assemble
+
+    fe = assemble(model, elements_per_beam)
+    K, M = fe.K.toarray(), fe.M.toarray()
+    size = np.where(np.diag(M) > 0, np.diag(M), np.abs(np.diag(K)))
+    scale = 1 / np.sqrt(np.where(size > 0, size, 1.0))
+    for matrix in (K, M):
+        matrix *= np.outer(scale, scale)
+        matrix.setflags(write=False)  # shared by every prediction of this model
+    return CoarsePencil(fe, K, M, scale)
+
+
+def _regular_pencil(K: np.ndarray, M: np.ndarray):
+    """(K, M) less one unknown per motion with neither stiffness nor mass (a massless
+    point free to turn between two joints), which makes the pencil singular and QZ's
+    eigenvalues arbitrary. Each such motion v (K v = M v = 0, both scaled to their
+    largest entry) is removed exactly by holding the unknown it moves most (pivoted
+    QR): every vector is one that holds it plus a multiple of v.
+    """
+    stacked = np.vstack([K / max(np.abs(K).max(), np.finfo(float).tiny),
+                         M / max(np.abs(M).max(), np.finfo(float).tiny)])
+    motions = scipy.linalg.null_space(stacked, rcond=SINGULAR_PENCIL)
+    if not motions.shape[1]:
+        return K, M
+    held = scipy.linalg.qr(motions.T, pivoting=True, mode="r")[1][:motions.shape[1]]
+    kept = np.setdiff1d(np.arange(K.shape[0]), held)
+    return K[np.ix_(kept, kept)], M[np.ix_(kept, kept)]
+
+
+def predict_frequencies(model: Model, count: int) -> np.ndarray:
+    """:func:`coarse_predictions` on a mesh fine enough for the highest of them.
+
+    Two elements per beam first; where the beams' bending waves at the highest
+    prediction need more than twice as many elements for :data:`WAVE_PER_ELEMENT`
+    radians each, once more with that many (at most MAX_ELEMENTS per beam).
+    """
+    predictions = coarse_predictions(model, count, 2)
+    if not model.beams or not predictions.size:
+        return predictions
+    beta_L = max(bending_wavenumber(beam, predictions[-1]) * beam.length for beam in model.beams)
+    needed = min(int(np.ceil(beta_L / WAVE_PER_ELEMENT)), MAX_ELEMENTS)
+    if needed <= 2 * 2:
+        return predictions
+    return coarse_predictions(model, count, needed, shift=0.5 * predictions[0] ** 2)

@@ -1,0 +1,112 @@
+"""A model compiled once for the root search: everything about it that does not
+depend on ω, kept for the next solve of the same model object.
+
+Before the first evaluation of det Ū_all a solve builds the topology and its
+deduction, compiles the deduction into a program (:mod:`linmstmm.program`),
+releases statically indeterminate unknowns, counts the rigid-body modes, and
+builds the Wittrick–Williams counter's reduced matrices: on the launcher about
+6 ms, more than the search itself. A :class:`~linmstmm.model.Model` cannot
+change (it is frozen, its arrays read-only), so all of that is made once per
+model object and kept (:func:`compiled_system`); every solve still evaluates,
+polishes and counts afresh — nothing that depends on ω is kept between solves.
+The last MODELS_KEPT models are kept (a parameter sweep's thousand models do
+not pile up); :func:`forget_compiled_models` drops them all. The coarse FE
+pencil that predicts the roots is kept the same way
+(:func:`linmstmm.coarse_prediction.coarse_pencil`).
+"""
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+from linmstmm.coarse_prediction import coarse_pencil
+from linmstmm.counting import count_in_disc
+from linmstmm.deduction import Deduction
+from linmstmm.determinant import determinant, resolved_engine
+from linmstmm.model import Model
+from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
+from linmstmm.rigid_motion import rigid_body_mode_count
+from linmstmm.roots.settings import FLOOR_RATIO
+from linmstmm.topology import build_topology
+from linmstmm.wittrick_williams import ModeCounter, mode_counter
+
+#: Model objects whose compiled systems are kept (least recently used dropped first).
+MODELS_KEPT = 8
+
+
+@dataclass(frozen=True, eq=False)
+class CompiledSystem:
+    """What the root search of one model needs before its first frequency.
+
+    Attributes
+    ----------
+    deduction : Deduction
+        The deduced system, indeterminate unknowns released.
+    determinant : CompiledDeterminant or NumpyDeterminant
+        det Ū_all of ``deduction`` (:func:`linmstmm.determinant.determinant`);
+        its ``evaluations`` keep counting across solves.
+    released : int
+        Statically indeterminate unknowns released.
+    rigid_body_modes : int
+        Zero-frequency modes (:func:`~linmstmm.rigid_motion.rigid_body_mode_count`).
+    rigid_zeros_confirmed : bool
+        True where the disc of the search's floor holds exactly the rigid-body
+        modes' 2r zeros of det Ū_all, which the search then divides out
+        (:meth:`linmstmm.roots.RootFinder.divide_out_rigid_body_zeros`).
+    scale : float
+        rad/s, the model's own frequency scale (the lowest of its
+        :func:`~linmstmm.nullspace.characteristic_frequencies`).
+    counter : ModeCounter or None
+        The Wittrick–Williams counter (:func:`~linmstmm.wittrick_williams.mode_counter`).
+    """
+
+    deduction: Deduction
+    determinant: object
+    released: int
+    rigid_body_modes: int
+    rigid_zeros_confirmed: bool
+    scale: float
+    counter: ModeCounter | None
+
+
+def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: str = "auto") -> CompiledSystem:
+    """The :class:`CompiledSystem` of ``model``: made on the first call for this model
+    object (and root, cuts, engine), the same object after.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    root, cut_at : str or None, iterable of str
+        See :func:`linmstmm.topology.build_topology`.
+    engine : str
+        "auto", "numpy" or "compiled" (:func:`linmstmm.determinant.resolved_engine`;
+        "auto" is resolved first, so a system made before the kernels were loaded is
+        not taken for the compiled one).
+
+    Returns
+    -------
+    CompiledSystem
+    """
+    return _compiled(model, root, tuple(cut_at), resolved_engine(engine))
+
+
+@functools.lru_cache(maxsize=MODELS_KEPT)
+def _compiled(model: Model, root: str | None, cut_at: tuple, engine: str) -> CompiledSystem:
+    """:func:`compiled_system` made anew (a Model hashes by identity)."""
+    deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
+    evaluator = determinant(deduction, engine)  # compiled first: its plain Ū_all screens the probes
+    released = release_indeterminate(deduction, screen=evaluator.plain_matrix)
+    if released:  # the program carries the unknowns it was compiled for
+        evaluator = determinant(deduction, engine)
+    rigid = rigid_body_mode_count(model)
+    scale = min(characteristic_frequencies(deduction.topology))
+    confirmed = bool(rigid) and count_in_disc(evaluator.log_det, FLOOR_RATIO * scale) == 2 * rigid
+    return CompiledSystem(deduction, evaluator, released, rigid, confirmed, scale, mode_counter(model, engine))
+
+
+def forget_compiled_models() -> None:
+    """Drop every compiled system and coarse FE pencil kept so far: the next solve of any
+    model compiles it anew, as in a new process (the benchmarks time first solves so)."""
+    _compiled.cache_clear()
+    coarse_pencil.cache_clear()

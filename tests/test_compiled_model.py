@@ -1,0 +1,58 @@
+"""A model compiled once for the root search (linmstmm.compiled_model): a second solve of
+the same model object reuses what does not depend on ω, and finds the same roots
+with the same work, nothing found before carried over."""
+from __future__ import annotations
+
+import numpy as np
+
+from linmstmm.builders import single_beam_model
+from linmstmm.compiled_model import compiled_system, forget_compiled_models
+from linmstmm.model import load_model
+from linmstmm.solve import frequency_finder, natural_frequencies
+
+
+def test_a_second_solve_reuses_the_compilation_and_repeats_the_work():
+    model = load_model("models/mlrs/mlrs.toml")
+    forget_compiled_models()
+    first = natural_frequencies(model, count=10, engine="compiled")
+    system = compiled_system(model, engine="compiled")
+    second = natural_frequencies(model, count=10, engine="compiled")
+    assert compiled_system(model, engine="compiled") is system
+    assert np.array_equal(first.frequencies_hz, second.frequencies_hz)
+    assert second.evaluations == first.evaluations > 0  # evaluated afresh, not remembered
+
+
+def test_each_finder_counts_afresh():
+    model = load_model("models/mlrs/mlrs.toml")
+    _, finder, _ = frequency_finder(model, engine="compiled")
+    omega = 2 * np.pi * 3.0
+    finder.counter(omega)
+    _, other, _ = frequency_finder(model, engine="compiled")
+    assert other.counter is not finder.counter and omega not in other.counter._answers
+    assert other.counter(omega) == finder.counter(omega)
+
+
+def test_a_new_model_object_or_forgetting_compiles_anew():
+    model = single_beam_model()
+    system = compiled_system(model, engine="numpy")
+    assert compiled_system(single_beam_model(), engine="numpy") is not system
+    assert compiled_system(model, engine="compiled") is not system   # another engine, another program
+    forget_compiled_models()
+    assert compiled_system(model, engine="numpy") is not system
+
+
+def test_the_rigid_body_zeros_are_divided_out_on_every_solve():
+    """A free beam's six rigid-body zeros: confirmed once, divided out of each new finder,
+    and the frequencies those finders find agree with the closed form."""
+    model = single_beam_model(Iy=2e-7, Iz=5e-7, axial=False, torsion=False)
+    forget_compiled_models()
+    assert compiled_system(model).rigid_zeros_confirmed
+    finders = [frequency_finder(model)[1] for _ in range(2)]
+    assert all(finder._divided for finder in finders)
+    beam = model.beams[0]
+    lam = 4.730040744862704  # free-free: cos λ cosh λ = 1
+    lowest = (lam / beam.length) ** 2 * np.sqrt(beam.E * 2e-7 / (beam.rho * beam.A))
+    for _ in range(2):
+        result = natural_frequencies(model, count=1)
+        assert result.rigid_body_modes == 6
+        assert abs(2 * np.pi * result.frequencies_hz[0] / lowest - 1) < 1e-12

@@ -16,13 +16,15 @@ pencil that predicts the roots is kept the same way
 """
 from __future__ import annotations
 
+import contextlib
 import functools
+import gc
 from dataclasses import dataclass
 
 from linmstmm.coarse_prediction import coarse_pencil
 from linmstmm.counting import count_in_disc
 from linmstmm.deduction import Deduction
-from linmstmm.determinant import determinant, resolved_engine
+from linmstmm.determinant import determinant, kernels_loaded, resolved_engine
 from linmstmm.model import Model
 from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
 from linmstmm.rigid_motion import rigid_body_mode_count
@@ -80,20 +82,44 @@ def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: st
     root, cut_at : str or None, iterable of str
         See :func:`linmstmm.topology.build_topology`.
     engine : str
-        "auto", "numpy" or "compiled" (:func:`linmstmm.determinant.resolved_engine`;
-        "auto" is resolved first, so a system made before the kernels were loaded is
-        not taken for the compiled one).
+        "auto", "numpy" or "compiled" (:func:`linmstmm.determinant.determinant`; a
+        system made for "auto" before the kernels were loaded is not taken for one
+        made after).
 
     Returns
     -------
     CompiledSystem
     """
-    return _compiled(model, root, tuple(cut_at), resolved_engine(engine))
+    resolved_engine(engine)  # an unknown engine is refused before anything is built
+    return _compiled(model, root, tuple(cut_at), engine, kernels_loaded())
 
 
 @functools.lru_cache(maxsize=MODELS_KEPT)
-def _compiled(model: Model, root: str | None, cut_at: tuple, engine: str) -> CompiledSystem:
-    """:func:`compiled_system` made anew (a Model hashes by identity)."""
+def _compiled(model: Model, root: str | None, cut_at: tuple, engine: str, loaded: bool) -> CompiledSystem:
+    """:func:`compiled_system` made anew (a Model hashes by identity; ``loaded``: whether
+    the kernels were loaded, which "auto" follows)."""
+    with _cyclic_collector_paused():
+        return _compiled_now(model, root, cut_at, engine)
+
+
+@contextlib.contextmanager
+def _cyclic_collector_paused():
+    """Python's cyclic garbage collector paused inside (reference counting still frees
+    what is dropped; cycles are collected once it runs again). Compiling allocates
+    tens of thousands of small objects for a large model, and every few hundred of
+    them the collector walked the whole growing heap again: a 10,000-body chain's
+    topology took 169 ms with it, 70 ms without."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
+
+
+def _compiled_now(model: Model, root: str | None, cut_at: tuple, engine: str) -> CompiledSystem:
+    """The :class:`CompiledSystem` of ``model``, built."""
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
     evaluator = determinant(deduction, engine)  # compiled first: its plain Ū_all screens the probes
     released = release_indeterminate(deduction, screen=evaluator.plain_matrix)

@@ -125,13 +125,13 @@ def _link_points(model: Model, elements: list[TransferElement]) -> list[Boundary
                 boundaries.append(Boundary(port.point, port.position, np.zeros(6, dtype=bool)))
             else:
                 at_point[port.point].append((e, p))
+    held = {point for point, mask in model.boundary.items() if mask.any()}  # points with a fixed component
     for point, ends in at_point.items():
-        fixed = model.fixed_mask(point)
         if len(ends) == 1:
             e, p = ends[0]
             elements[e].ports[p].link = ("boundary", len(boundaries))
-            boundaries.append(Boundary(point, model.points[point], fixed))
-        elif len(ends) == 2 and not fixed.any():
+            boundaries.append(Boundary(point, model.points[point], model.fixed_mask(point)))
+        elif len(ends) == 2 and point not in held:
             (e, p), (f, q) = ends
             elements[e].ports[p].link = ("element", f, q)
             elements[f].ports[q].link = ("element", e, p)
@@ -142,9 +142,9 @@ def _link_points(model: Model, elements: list[TransferElement]) -> list[Boundary
             for e, p in ends:
                 elements[e].ports[p].link = ("element", j, len(junction.ports))
                 junction.ports.append(Port(point, model.points[point], ("element", e, p)))
-            if fixed.any():
+            if point in held:
                 junction.ports.append(Port(point, model.points[point], ("boundary", len(boundaries))))
-                boundaries.append(Boundary(point, model.points[point], fixed))
+                boundaries.append(Boundary(point, model.points[point], model.fixed_mask(point)))
     return boundaries
 
 

@@ -359,16 +359,22 @@ def test_a_range_above_the_last_root_is_certified_by_the_stiffness_count():
     assert result.note == ""
 
 
-def test_a_range_the_search_could_not_finish_says_where_it_stopped(monkeypatch):
+@pytest.fixture
+def argument_principle_only(monkeypatch):
+    """Models compiled without a Wittrick–Williams counter (as where it cannot decide),
+    inside the test only (tests/conftest.py: the next test compiles its models anew)."""
+    from linmstmm import compiled_model
+
+    monkeypatch.setattr(compiled_model, "mode_counter", lambda model, engine: None)
+
+
+def test_a_range_the_search_could_not_finish_says_where_it_stopped(argument_principle_only):
     """The same range counted by the argument principle alone (as where the stiffness
     count cannot decide): far above its last root det Ū_all cannot be counted, where
     inertia swamps it (above 6.6e6 rad/s, where the derivative of log det along the
     counting contour is rounding noise), so the search stops there. The 11 found are
     the FE route's 11, and the note says where it stopped, at least 100 times the
     highest root (it said nothing, as if the range had been searched to its end)."""
-    from linmstmm import solve
-
-    monkeypatch.setattr(solve, "mode_counter", lambda model, engine: None)
     result = natural_frequencies(model("ring", 5), count=None, fmax=2e7)
     np.testing.assert_allclose(result.frequencies_hz, fe_frequencies(model("ring", 5), count=80).frequencies_hz,
                                rtol=1e-9)
@@ -394,16 +400,14 @@ def test_mode_shapes_say_what_the_frequencies_say():
     assert eleven.note.startswith("the mode shapes from 589.69")
 
 
-def test_scan_says_where_its_search_stopped(tmp_path, capsys, monkeypatch):
+def test_scan_says_where_its_search_stopped(tmp_path, capsys, argument_principle_only):
     """``linmstmm scan`` of ring 5 up to 2e7 Hz counted by the argument principle alone:
     the 11 frequencies, and the note of the search that stopped at 1.05e8 rad/s (it
     printed the 11 as if the range were done)."""
     import json
 
-    from linmstmm import solve
     from linmstmm.cli import main
 
-    monkeypatch.setattr(solve, "mode_counter", lambda model, engine: None)
     path = tmp_path / "ring5.toml"
     path.write_text(to_toml(model("ring", 5)))
     assert main(["scan", str(path), "--fmax", "2e7", "--points", "50", "--plot", str(tmp_path / "s.png"),

@@ -81,8 +81,10 @@ def test_it_keeps_copies_of_what_it_was_built_from():
 
 def test_the_cantilever_roots_and_multiplicities_are_those_reported_and_fe_s(cantilever):
     _, finder, _ = frequency_finder(cantilever)
+    before = finder.determinant.evaluations  # the compiled model's determinant counts on across solves
     with one_blas_thread():  # as natural_frequencies searches: the same rounding
         search = finder.find(COUNT, None)
+    spent = finder.determinant.evaluations - before
     reported = natural_frequencies(cantilever, COUNT)
     fe = fe_frequencies(cantilever, count=COUNT)
     assert reported.precision == "float64"  # nothing refined: the roots are the search's
@@ -91,7 +93,7 @@ def test_the_cantilever_roots_and_multiplicities_are_those_reported_and_fe_s(can
     assert list(search.multiplicities) == sorted(set(search.roots.tolist()))
     assert list(search.multiplicities.values()) == grouped(fe.frequencies_hz) == grouped(reported.frequencies_hz)
     assert 2 in search.multiplicities.values()
-    assert search.evaluations == finder.determinant.evaluations == reported.evaluations
+    assert search.evaluations == spent == reported.evaluations
     assert set(search.last_steps) == set(search.multiplicities)
     assert max(search.last_steps.values()) <= CERTIFIED_STEP
     assert search.rigid_body_modes == fe.rigid_body_modes == 0

@@ -258,6 +258,5 @@ def _statically_determinate(topology) -> bool:
     spent three quarters of its solve carrying the probes that would find none)."""
     if topology.cuts or sum(bool(np.any(end.fixed)) for end in topology.boundaries) > 1:
         return False
-    springs = [element.record for element in topology.elements
-               if element.record is not None and element.record.kind == "spring"]
-    return all(np.all(np.asarray(spring.k) > 0) for spring in springs)
+    stiffness = [np.ravel(element.record.k) for element in topology.elements if element.kind == "spring"]
+    return not stiffness or bool(np.all(np.concatenate(stiffness) > 0))

@@ -36,34 +36,40 @@ GEOMETRIC_RANK = 1e-10
 MASSLESS_MOTION = 1e-13
 
 
-def connected_parts(model: Model, through_joints: bool = True) -> list[list[str]]:
-    """Point names of each connected part of ``model``, in order of first appearance.
+def connected_parts(model: Model) -> tuple[list[list[str]], list[list[str]]]:
+    """(parts, segments): the point names of each connected part of ``model``, and of
+    each segment, both in order of first appearance.
 
-    Two points are connected when an element joins them (a rigid body's ports,
-    a beam's or a spring's ends). through_joints : False to leave out springs
-    with a released direction (the parts are then the segments that move as
-    one rigid body in a zero-energy motion). The components of the graph of
-    points and elements (:func:`scipy.sparse.csgraph.connected_components`: a
-    10,000-body chain spent 0.18 s in a union–find written out in Python).
+    Two points are in one part when elements join them (a rigid body's ports,
+    a beam's or a spring's ends), in one segment when elements other than
+    springs with a released direction join them (a segment moves as one rigid
+    body in a zero-energy motion). The components of the graph of points and
+    elements (:func:`scipy.sparse.csgraph.connected_components`: a 10,000-body
+    chain spent 0.18 s in a union–find written out in Python), its edges
+    listed once for both.
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
     names = list(model.points)
     number = {name: i for i, name in enumerate(names)}
-    first, other = [], []
+    first, other, joint = [], [], []
     for element in model.elements:
-        if not through_joints and element.kind == "spring" and element.released.size:
-            continue
         ends = element.ports if element.kind == "rigid" else element.ends
         first += [number[ends[0]]] * (len(ends) - 1)
         other += [number[end] for end in ends[1:]]
-    graph = coo_matrix((np.ones(len(first)), (first, other)), shape=(len(names), len(names)))
-    _, labels = connected_components(graph, directed=False)
-    parts: dict[int, list[str]] = {}
-    for name, label in zip(names, labels):
-        parts.setdefault(int(label), []).append(name)
-    return list(parts.values())
+        joint += [element.kind == "spring" and element.released.size > 0] * (len(ends) - 1)
+    first, other, joint = np.array(first, dtype=int), np.array(other, dtype=int), np.array(joint, dtype=bool)
+
+    def components(kept: np.ndarray) -> list[list[str]]:
+        graph = coo_matrix((np.ones(kept.sum()), (first[kept], other[kept])), shape=(len(names), len(names)))
+        _, labels = connected_components(graph, directed=False)
+        grouped: dict[int, list[str]] = {}
+        for name, label in zip(names, labels.tolist()):
+            grouped.setdefault(label, []).append(name)
+        return list(grouped.values())
+
+    return components(np.ones(first.size, dtype=bool)), components(~joint)
 
 
 def unit_motions(positions: np.ndarray, centre: np.ndarray, size: float) -> np.ndarray:
@@ -130,9 +136,9 @@ def rigid_body_motions(model: Model) -> dict[str, np.ndarray]:
     """
     columns = []
     names = list(model.points)
-    segment_of = {p: s for s, segment in enumerate(connected_parts(model, through_joints=False))
-                  for p in segment}
-    for part in connected_parts(model):
+    parts, all_segments = connected_parts(model)
+    segment_of = {p: s for s, segment in enumerate(all_segments) for p in segment}
+    for part in parts:
         members = set(part)
         positions = np.array([model.points[p] for p in part])
         coms = [body.com for body in model.rigids if body.ports[0] in members]

@@ -27,6 +27,18 @@ PIECES_PER_THREAD = 3
 _pool: ThreadPoolExecutor | None = None
 
 
+def _forget_pool() -> None:
+    """Drop the pool in a forked child: its threads stayed in the parent, and a pool
+    whose threads do not exist takes work it never does (a sweep's worker processes
+    waited for ever)."""
+    global _pool
+    _pool = None
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forget_pool)
+
+
 def cores() -> int:
     """Cores this process may run on (its CPU affinity where the system tells it)."""
     if hasattr(os, "sched_getaffinity"):

@@ -2,6 +2,9 @@
 same numbers as on one thread, and a piece's error raised in the caller."""
 from __future__ import annotations
 
+import multiprocessing
+import threading
+
 import numpy as np
 import pytest
 
@@ -45,3 +48,25 @@ def test_a_shared_batch_gives_the_bits_of_single_evaluations(monkeypatch, cores)
         alone = [determinant.log_det(omega) for omega in omegas]
         assert np.array_equal(sign, np.concatenate([s for s, _ in alone]))
         assert np.array_equal(log_abs, np.concatenate([v for _, v in alone]))
+
+
+def _spread_sum(size: int) -> int:
+    """The sum of range(size), its pieces added on the threads of :func:`spread.spread`."""
+    total, lock = [0], threading.Lock()
+
+    def task(start, stop):
+        with lock:
+            total[0] += sum(range(start, stop))
+
+    spread.spread(task, size)
+    return total[0]
+
+
+def test_a_forked_child_shares_its_batches_on_threads_of_its_own(monkeypatch):
+    """A process forked after the pool started (a sweep's worker processes) gets a pool of
+    its own: the parent's threads are not in the child (it waited for ever)."""
+    monkeypatch.setattr(spread, "cores", lambda: 2)
+    assert _spread_sum(1000) == sum(range(1000))  # the pool exists in the parent now
+    context = multiprocessing.get_context("fork")
+    with context.Pool(1) as pool:
+        assert pool.apply_async(_spread_sum, (1000,)).get(timeout=60) == sum(range(1000))

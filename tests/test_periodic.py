@@ -121,3 +121,18 @@ def test_chain_with_a_heavier_middle_mass_against_its_k_and_m():
     reference = np.repeat(chain_reference_hz(masses, stiffnesses), 3)[:9]
     got = natural_frequencies(chain_along_x(masses, stiffnesses), count=9)
     np.testing.assert_allclose(got.frequencies_hz, reference, rtol=1e-9)
+
+
+def test_streaks_count_consecutive_repeats_as_a_loop_does():
+    """The consecutive-repeat counts of find_runs, computed at once, against the loop
+    they replace, on random patterns of every density (and none)."""
+    from linmstmm.periodic import _streaks
+
+    rng = np.random.default_rng(3)
+    for size in (0, 1, 2, 7, 300):
+        for density in (0.0, 0.2, 0.5, 0.9, 1.0):
+            good = rng.random(size) < density
+            looped = np.zeros(size + 1, dtype=int)
+            for j in range(size - 1, -1, -1):
+                looped[j] = looped[j + 1] + 1 if good[j] else 0
+            assert np.array_equal(_streaks(good, size + 1), looped)

@@ -16,12 +16,11 @@ pencil that predicts the roots is kept the same way
 """
 from __future__ import annotations
 
-import contextlib
 import functools
-import gc
 from dataclasses import dataclass
 
 from linmstmm.coarse_prediction import coarse_pencil
+from linmstmm.collector import collector_paused
 from linmstmm.counting import count_in_disc
 from linmstmm.deduction import Deduction
 from linmstmm.determinant import determinant, kernels_loaded, resolved_engine
@@ -98,24 +97,8 @@ def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: st
 def _compiled(model: Model, root: str | None, cut_at: tuple, engine: str, loaded: bool) -> CompiledSystem:
     """:func:`compiled_system` made anew (a Model hashes by identity; ``loaded``: whether
     the kernels were loaded, which "auto" follows)."""
-    with _cyclic_collector_paused():
+    with collector_paused():  # tens of thousands of new objects for a large model
         return _compiled_now(model, root, cut_at, engine)
-
-
-@contextlib.contextmanager
-def _cyclic_collector_paused():
-    """Python's cyclic garbage collector paused inside (reference counting still frees
-    what is dropped; cycles are collected once it runs again). Compiling allocates
-    tens of thousands of small objects for a large model, and every few hundred of
-    them the collector walked the whole growing heap again: a 10,000-body chain's
-    topology took 169 ms with it, 70 ms without."""
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()
 
 
 def _compiled_now(model: Model, root: str | None, cut_at: tuple, engine: str) -> CompiledSystem:

@@ -4,8 +4,9 @@ depend on ω, kept for the next solve of the same model object.
 Before the first evaluation of det Ū_all a solve builds the topology and its
 deduction, compiles the deduction into a program (:mod:`linmstmm.program`),
 releases statically indeterminate unknowns, counts the rigid-body modes, and
-builds the Wittrick–Williams counter's reduced matrices: on the launcher about
-6 ms, more than the search itself. A :class:`~linmstmm.model.Model` cannot
+builds the Wittrick–Williams counter's reduced matrices, and the predictions
+assemble a coarse FE model: on the launcher about 8 ms of a 13 ms solve of its
+ten lowest frequencies, twice the search itself. A :class:`~linmstmm.model.Model` cannot
 change (it is frozen, its arrays read-only), so all of that is made once per
 model object and kept (:func:`compiled_system`); every solve still evaluates,
 polishes and counts afresh — nothing that depends on ω is kept between solves.

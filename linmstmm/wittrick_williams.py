@@ -91,15 +91,22 @@ class ModeCounter:
         self._beams = BeamTable.of(model.beams)
         self._maps, self._columns = _beam_maps(model, parts.layout, T)
         self._scatter = (self._columns[:, :, None] * (n + 1) + self._columns[:, None, :]).ravel()
-        self._buffers = np.empty((2, n + 1, n + 1))
         self._answers: dict[float, int | None] = {}
         self._table = None  # the beams as the compiled kernels take them, on their first call
+        self._scratch = None  # this counter's own buffers for the compiled kernel, on its first call
 
     def fresh(self) -> ModeCounter:
         """This counter with no answers remembered: the same model's matrices (not
-        copied), for a new search to count with afresh (:func:`linmstmm.solve.frequency_finder`)."""
+        copied), for a new search to count with afresh (:func:`linmstmm.solve.frequency_finder`).
+
+        The compiled kernel writes D(ω) into buffers of the counter it is called
+        for: the twin gets its own, so that searches of the same model on two
+        threads at once (each with its own twin) do not write into each other's.
+        One counter serves one thread at a time.
+        """
         twin = copy.copy(self)
         twin._answers = {}
+        twin._scratch = None
         return twin
 
     def __call__(self, omega: float) -> int | None:
@@ -125,10 +132,13 @@ class ModeCounter:
 
         if self._table is None:
             self._table = kernels.beam_columns(self._beams)
-            self._work = np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN)
-        matrix, magnitude = self._buffers
+        if self._scratch is None:
+            size = self.n_dof + 1  # + a row for padding
+            self._scratch = (np.empty((size, size)), np.empty((size, size)),
+                             np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN))
+        matrix, magnitude, work = self._scratch
         count = kernels.count(omega, self._table, self._maps, self._columns, self._static, self._mass,
-                              SINGULAR_PIVOT, matrix, magnitude, self._work)
+                              SINGULAR_PIVOT, matrix, magnitude, work)
         return None if count < 0 else count
 
     def matrix(self, omega: float) -> tuple[np.ndarray, np.ndarray]:

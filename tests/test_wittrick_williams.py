@@ -210,3 +210,29 @@ def test_compiled_count_mirrors_the_reference_beside_the_roots(kind):
     reference, compiled = ModeCounter(model, "numpy"), ModeCounter(model, "compiled")
     near = np.outer(omegas, 1 + np.array([-1e-6, -1e-9, -1e-12, 0.0, 1e-12, 1e-9, 1e-6])).ravel()
     assert [reference(w) for w in near] == [compiled(w) for w in near]
+
+
+def test_twins_of_one_counter_count_side_by_side_on_two_threads():
+    """Two searches of the same model at once each count with a fresh twin of its
+    compiled counter (the kernel runs without Python's lock): every twin gives the
+    counts one thread alone gives (sharing the kernel's buffers, hundreds of 4,000
+    differed)."""
+    import threading
+
+    launcher = load_model("models/mlrs/mlrs.toml")
+    counter = ModeCounter(launcher, "compiled")
+    omegas = np.linspace(1.0, 2000.0, 4000)
+    alone = [counter.fresh()(w) for w in omegas]
+    side_by_side = {}
+
+    def count(thread: int) -> None:
+        twin = counter.fresh()
+        side_by_side[thread] = [twin(w) for w in omegas]
+
+    for _ in range(3):
+        threads = [threading.Thread(target=count, args=(t,)) for t in range(2)]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join()
+        assert side_by_side[0] == alone and side_by_side[1] == alone

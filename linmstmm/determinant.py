@@ -3,7 +3,7 @@
 Both engines answer the same two questions with the same numbers (to
 rounding): ``log_det(ω)`` — sign (phase, for complex ω) and log|det Ū_all| —
 and ``matrix(ω)`` — the orthonormalised Ū_all whose differences are smooth in
-ω (Newton's pencil); both count their evaluations (one per frequency), the
+ω (Newton's pencil); both count their evaluations (one per frequency, per thread), the
 cost figure the benchmarks report per root. The compiled one also gives
 ``plain_matrix(ω)``, Ū_all as the unknowns stand (no orthonormalisation, not
 counted), with which :func:`linmstmm.nullspace.release_indeterminate` screens

@@ -191,9 +191,10 @@ def _negative_eigenvalues(matrix: np.ndarray, magnitude: np.ndarray) -> int | No
     equilibrated = matrix * weights[:, None] * weights[None, :]
     # rounding is relative to the largest term that entered, which may lie off the diagonal
     singular = SINGULAR_PIVOT * float((magnitude * weights[:, None] * weights[None, :]).max())
-    counts = [_factorised_inertia(ordered, singular)
-              for ordered in (equilibrated, equilibrated[::-1, ::-1])]
-    # the two orders pivot differently: where rounding decides a sign, they disagree
+    shift = singular * np.eye(len(scale))
+    counts = [_factorised_inertia(shifted, singular) for shifted in (equilibrated + shift, equilibrated - shift)]
+    # the same count shifted both ways: no eigenvalue within rounding of zero (a small
+    # eigenvalue need not show as a small pivot)
     return counts[0] if counts[0] == counts[1] else None
 
 

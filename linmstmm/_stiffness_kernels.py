@@ -10,7 +10,7 @@ the test oracle (tests/test_wittrick_williams.py compares them):
 * :func:`block_inertia` — :func:`linmstmm.wittrick_williams._block_inertia`;
 * :func:`count` — :meth:`linmstmm.wittrick_williams.ModeCounter._numpy`: the
   whole count J(ω) in one call (J₀, D(ω), its equilibration and two LDLᵀ
-  factorisations by LAPACK's ``dsytrf``), without releasing a Python object:
+  factorisations of it shifted by LAPACK's ``dsytrf``), without releasing a Python object:
   compiled ``nogil``, so that counts at several frequencies can run on
   threads side by side.
 """
@@ -224,9 +224,10 @@ def count(omega, beams, maps, columns, static, mass, singular_pivot, matrix, mag
     The arguments of :func:`assembled`, and singular_pivot: a pivot below this
     fraction of the largest equilibrated term is rounding
     (:data:`linmstmm.wittrick_williams.SINGULAR_PIVOT`); work : (n · WORK_PER_UNKNOWN,)
-    float64. D(ω) is equilibrated by the diagonal of |D|(ω) and factorised in two
-    orders, which must agree (:func:`linmstmm.wittrick_williams._negative_eigenvalues`,
-    the same numbers in the same order of operations).
+    float64. D(ω) is equilibrated by the diagonal of |D|(ω), shifted by ± the rounding
+    level and factorised both ways, whose counts must agree
+    (:func:`linmstmm.wittrick_williams._negative_eigenvalues`, the same numbers in
+    the same order of operations).
     """
     clamped = assembled(omega, beams, maps, columns, static, mass, matrix, magnitude)
     n = static.shape[0]
@@ -249,11 +250,14 @@ def count(omega, beams, maps, columns, static, mass, singular_pivot, matrix, mag
         for j in range(n):
             equilibrated = matrix[i, j] * weights[i] * weights[j]
             first[j, i] = equilibrated
-            second[n - 1 - j, n - 1 - i] = equilibrated
+            second[j, i] = equilibrated
             largest = max(largest, magnitude[i, j] * weights[i] * weights[j])
     singular = singular_pivot * largest
+    for i in range(n):
+        first[i, i] = first[i, i] + singular
+        second[i, i] = second[i, i] - singular
     pivots, integers = np.empty(n, dtype=np.int32), np.empty(4, dtype=np.int32)
     negatives = _ldlt_inertia(first, singular, pivots, work, integers)
     if negatives < 0 or negatives != _ldlt_inertia(second, singular, pivots, work, integers):
-        return -1  # the two orders pivot differently: where rounding decides a sign, they disagree
+        return -1  # an eigenvalue within rounding of zero (a small one need not show as a small pivot)
     return clamped + negatives

@@ -3,7 +3,7 @@
 Both engines answer the same two questions with the same numbers (to
 rounding): ``log_det(ω)`` — sign (phase, for complex ω) and log|det Ū_all| —
 and ``matrix(ω)`` — the orthonormalised Ū_all whose differences are smooth in
-ω (Newton's pencil); both count their evaluations (one per frequency), the
+ω (Newton's pencil); both count their evaluations (one per frequency, per thread), the
 cost figure the benchmarks report per root. The compiled one also gives
 ``plain_matrix(ω)``, Ū_all as the unknowns stand (no orthonormalisation, not
 counted), with which :func:`linmstmm.nullspace.release_indeterminate` screens
@@ -30,6 +30,7 @@ powers.
 from __future__ import annotations
 
 import sys
+import threading
 
 import numpy as np
 
@@ -110,31 +111,52 @@ def repeated_cells_dominate(deduction: Deduction) -> bool:
     return repeated > elements / 2
 
 
-class NumpyDeterminant:
+class EvaluationCount:
+    """Evaluations of det Ū_all (one per frequency) asked for from each thread.
+
+    A compiled model's determinant serves every solve of that model, two at once
+    on two threads included; each solve reports the evaluations it took as the
+    difference of :attr:`evaluations` over its search, which counts the calling
+    thread's only.
+    """
+
+    def __init__(self):
+        self._counts = threading.local()
+
+    @property
+    def evaluations(self) -> int:
+        """Evaluations asked for from the calling thread so far."""
+        return getattr(self._counts, "total", 0)
+
+    def _count(self, omega) -> None:
+        """Count the frequencies of ``omega`` (n,) as evaluations of the calling thread."""
+        self._counts.total = self.evaluations + np.size(omega)
+
+
+class NumpyDeterminant(EvaluationCount):
     """det Ū_all by the numpy carry of ``deduction`` (stable: orthonormalised)."""
 
     def __init__(self, deduction: Deduction):
+        super().__init__()
         self.deduction = deduction
-        #: evaluations of det Ū_all so far (one per frequency)
-        self.evaluations = 0
 
     def log_det(self, omega):
         """(sign or phase (n,), log|det Ū_all| (n,)) at each of ``omega`` (n,) rad/s."""
         omega = np.atleast_1d(omega)
-        self.evaluations += omega.size
+        self._count(omega)
         return self.deduction.log_det(omega)
 
     def matrix(self, omega):
         """(Ū_all stack (n, N, N), log_scale (n,)), det Ū_all = det(matrix) · exp(log_scale)."""
         omega = np.atleast_1d(omega)
-        self.evaluations += omega.size
+        self._count(omega)
         return self.deduction.matrix(omega, stable=True)
 
     #: no faster plain Ū_all than the deduction's own, which the probes read themselves
     plain_matrix = None
 
 
-class CompiledDeterminant:
+class CompiledDeterminant(EvaluationCount):
     """det Ū_all of one deduction, evaluated by the compiled kernels.
 
     The same answers as :meth:`Deduction.log_det` and :meth:`Deduction.matrix`
@@ -144,6 +166,7 @@ class CompiledDeterminant:
     """
 
     def __init__(self, deduction: Deduction):
+        super().__init__()
         self.deduction = deduction
         self._released = deduction.released_columns  # the unknowns compiled for
         self.program = compile_program(deduction)
@@ -153,8 +176,6 @@ class CompiledDeterminant:
         self._layout = (p.slot_offset, p.slot_width, p.slot_columns, p.slot_columns_start, p.workspace,
                         p.slot_rows.size, p.root, p.root_row, p.geometric_rows, p.order, p.kept_rows,
                         p.kept_columns, p.slot_rows)
-        #: evaluations of det Ū_all so far (one per frequency)
-        self.evaluations = 0
 
     @property
     def order(self) -> int:
@@ -171,7 +192,7 @@ class CompiledDeterminant:
 
     def _evaluate(self, omega, group: int | None, with_matrices: bool):
         omega = self._frequencies(omega)
-        self.evaluations += omega.size
+        self._count(omega)
         return self._replayed(self._operations, omega, group, with_matrices)
 
     def _replayed(self, operations, omega, group: int | None, with_matrices: bool):

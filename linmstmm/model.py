@@ -149,6 +149,7 @@ class Model:
         :func:`load_model` does for the same breach in a file.
         """
         _check_records(self)
+        _freeze(self)
 
     @property
     def elements(self):
@@ -340,6 +341,47 @@ def _frozen(array):
     array = np.array(array)
     array.flags.writeable = False
     return array
+
+
+def _read_only(value):
+    """``value`` if it is a read-only array already, else a read-only copy of it."""
+    return value if isinstance(value, np.ndarray) and not value.flags.writeable else _frozen(value)
+
+
+class FrozenDict(dict):
+    """A dict that refuses every change: a :class:`Model`'s ``points`` and ``boundary``.
+
+    A model's solve is compiled once per model object
+    (:mod:`linmstmm.compiled_model`), so a model changed in place would be
+    answered for as it was; a changed model is a new one
+    (:func:`linmstmm.parameters.with_values`, :func:`dataclasses.replace`).
+    """
+
+    def _refuse(self, *args, **kwargs):
+        raise TypeError("a Model cannot be changed in place: build a new one "
+                        "(linmstmm.parameters.with_values or dataclasses.replace)")
+
+    __setitem__ = __delitem__ = __ior__ = clear = pop = popitem = setdefault = update = _refuse
+
+    def __reduce__(self):
+        """Pickled as a plain dict's items, rebuilt without a call to ``__setitem__``."""
+        return type(self), (dict(self),)
+
+
+def _freeze(model) -> None:
+    """Make ``model`` unchangeable in place: its element lists tuples, its ``points`` and
+    ``boundary`` :class:`FrozenDict` of read-only arrays, and every array of its
+    records read-only (a copy where the caller's array was writeable)."""
+    for name in ("rigids", "beams", "springs"):
+        object.__setattr__(model, name, tuple(getattr(model, name)))
+    for name in ("points", "boundary"):
+        table = getattr(model, name)
+        object.__setattr__(model, name, FrozenDict({key: _read_only(value) for key, value in table.items()}))
+    for record in model.elements:
+        for name in record.__dataclass_fields__:
+            value = getattr(record, name)
+            if isinstance(value, np.ndarray) and value.flags.writeable:
+                object.__setattr__(record, name, _frozen(value))
 
 
 def _build(cls, fields):

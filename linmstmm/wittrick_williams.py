@@ -91,15 +91,22 @@ class ModeCounter:
         self._beams = BeamTable.of(model.beams)
         self._maps, self._columns = _beam_maps(model, parts.layout, T)
         self._scatter = (self._columns[:, :, None] * (n + 1) + self._columns[:, None, :]).ravel()
-        self._buffers = np.empty((2, n + 1, n + 1))
         self._answers: dict[float, int | None] = {}
         self._table = None  # the beams as the compiled kernels take them, on their first call
+        self._scratch = None  # this counter's own buffers for the compiled kernel, on its first call
 
     def fresh(self) -> ModeCounter:
         """This counter with no answers remembered: the same model's matrices (not
-        copied), for a new search to count with afresh (:func:`linmstmm.solve.frequency_finder`)."""
+        copied), for a new search to count with afresh (:func:`linmstmm.solve.frequency_finder`).
+
+        The compiled kernel writes D(ω) into buffers of the counter it is called
+        for: the twin gets its own, so that searches of the same model on two
+        threads at once (each with its own twin) do not write into each other's.
+        One counter serves one thread at a time.
+        """
         twin = copy.copy(self)
         twin._answers = {}
+        twin._scratch = None
         return twin
 
     def __call__(self, omega: float) -> int | None:
@@ -125,10 +132,13 @@ class ModeCounter:
 
         if self._table is None:
             self._table = kernels.beam_columns(self._beams)
-            self._work = np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN)
-        matrix, magnitude = self._buffers
+        if self._scratch is None:
+            size = self.n_dof + 1  # + a row for padding
+            self._scratch = (np.empty((size, size)), np.empty((size, size)),
+                             np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN))
+        matrix, magnitude, work = self._scratch
         count = kernels.count(omega, self._table, self._maps, self._columns, self._static, self._mass,
-                              SINGULAR_PIVOT, matrix, magnitude, self._work)
+                              SINGULAR_PIVOT, matrix, magnitude, work)
         return None if count < 0 else count
 
     def matrix(self, omega: float) -> tuple[np.ndarray, np.ndarray]:
@@ -181,9 +191,10 @@ def _negative_eigenvalues(matrix: np.ndarray, magnitude: np.ndarray) -> int | No
     equilibrated = matrix * weights[:, None] * weights[None, :]
     # rounding is relative to the largest term that entered, which may lie off the diagonal
     singular = SINGULAR_PIVOT * float((magnitude * weights[:, None] * weights[None, :]).max())
-    counts = [_factorised_inertia(ordered, singular)
-              for ordered in (equilibrated, equilibrated[::-1, ::-1])]
-    # the two orders pivot differently: where rounding decides a sign, they disagree
+    shift = singular * np.eye(len(scale))
+    counts = [_factorised_inertia(shifted, singular) for shifted in (equilibrated + shift, equilibrated - shift)]
+    # the same count shifted both ways: no eigenvalue within rounding of zero (a small
+    # eigenvalue need not show as a small pivot)
     return counts[0] if counts[0] == counts[1] else None
 
 

@@ -10,14 +10,14 @@ collected once the collector runs again.
 from __future__ import annotations
 
 import contextlib
-import functools
 import gc
 
 
 @contextlib.contextmanager
 def collector_paused():
-    """Context manager: the cyclic collector paused inside (restored as it was, so
-    nested pauses and a collector the caller disabled are left alone)."""
+    """Context manager, or decorator (``@collector_paused()``): the cyclic collector
+    paused inside (restored as it was, so nested pauses and a collector the caller
+    disabled are left alone)."""
     enabled = gc.isenabled()
     gc.disable()
     try:
@@ -26,11 +26,3 @@ def collector_paused():
         if enabled:
             gc.enable()
 
-
-def with_collector_paused(function):
-    """Decorator: run ``function`` inside :func:`collector_paused`."""
-    @functools.wraps(function)
-    def wrapped(*args, **kwargs):
-        with collector_paused():
-            return function(*args, **kwargs)
-    return wrapped

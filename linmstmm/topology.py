@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from linmstmm.collector import with_collector_paused
+from linmstmm.collector import collector_paused
 from linmstmm.model import Model, ModelError
 
 
@@ -216,7 +216,7 @@ def _cut_connections(model, elements, points, cuts):
             elements[e].ports[p].link = ("cut", c, side)
 
 
-@with_collector_paused
+@collector_paused()
 def build_topology(model: Model, root: str | None = None, cut_at=()) -> Topology:
     """Deduce the directed transfer structure of ``model``.
 

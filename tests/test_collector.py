@@ -5,7 +5,7 @@ import gc
 
 import pytest
 
-from linmstmm.collector import collector_paused, with_collector_paused
+from linmstmm.collector import collector_paused
 
 
 def test_paused_inside_and_restored_after_even_on_error():
@@ -25,7 +25,7 @@ def test_a_nested_pause_and_a_collector_the_caller_disabled_are_left_alone():
     assert gc.isenabled()
     gc.disable()
     try:
-        assert with_collector_paused(gc.isenabled)() is False
+        assert collector_paused()(gc.isenabled)() is False
         assert not gc.isenabled()
     finally:
         gc.enable()

@@ -37,6 +37,7 @@ from linmstmm.determinant import resolved_engine
 from linmstmm.dynamic_stiffness import BeamTable, clamped_counts, dynamic_stiffness
 from linmstmm.fe.assembly import beam_element_dofs, constrained_parts
 from linmstmm.model import Model
+from linmstmm.spread import spread
 
 #: Largest order of D(ω) counted: its dense factorisation grows as n³ (72 unknowns:
 #: 75 µs, 120: 160 µs compiled), and a count is made twice per root; a longer model
@@ -126,20 +127,64 @@ class ModeCounter:
         negatives = _negative_eigenvalues(matrix, magnitude)
         return None if negatives is None else clamped + negatives
 
+    def prefetch(self, omegas) -> None:
+        """Count now at each of ``omegas`` (rad/s) not counted yet, for :meth:`__call__`
+        to answer from: with the compiled engine shared among the cores
+        (:func:`linmstmm.spread.spread`; each piece with buffers of its own), the same
+        answers as one by one.
+
+        Parameters
+        ----------
+        omegas : iterable of float
+            rad/s, the frequencies a search is about to count at.
+        """
+        wanted = sorted({float(omega) for omega in omegas} - set(self._answers))
+        if self.engine != "compiled":
+            for omega in wanted:
+                self(omega)
+            return
+        counts = np.empty(len(wanted), dtype=np.int64)
+        self._beam_table()  # made here, not by two pieces at once
+
+        def count_piece(start: int, stop: int) -> None:
+            scratch = self._new_scratch()
+            for i in range(start, stop):
+                counts[i] = self._kernel_count(wanted[i], scratch)
+
+        spread(count_piece, len(wanted))
+        self._answers.update((omega, None if count < 0 else int(count)) for omega, count in zip(wanted, counts))
+
     def _compiled(self, omega: float) -> int | None:
         """:meth:`__call__` by the compiled kernel (:func:`linmstmm._stiffness_kernels.count`)."""
+        if self._scratch is None:
+            self._scratch = self._new_scratch()
+        count = self._kernel_count(omega, self._scratch)
+        return None if count < 0 else count
+
+    def _new_scratch(self) -> tuple:
+        """Buffers the compiled kernel writes into: D(ω) and |D|(ω) ((n_dof + 1)², a row
+        for padding) and dsytrf's workspace."""
+        from linmstmm import _stiffness_kernels as kernels
+
+        size = self.n_dof + 1
+        return np.empty((size, size)), np.empty((size, size)), np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN)
+
+    def _beam_table(self) -> np.ndarray:
+        """The beams as the compiled kernel takes them (:func:`linmstmm._stiffness_kernels.beam_columns`),
+        made on the first call."""
         from linmstmm import _stiffness_kernels as kernels
 
         if self._table is None:
             self._table = kernels.beam_columns(self._beams)
-        if self._scratch is None:
-            size = self.n_dof + 1  # + a row for padding
-            self._scratch = (np.empty((size, size)), np.empty((size, size)),
-                             np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN))
-        matrix, magnitude, work = self._scratch
-        count = kernels.count(omega, self._table, self._maps, self._columns, self._static, self._mass,
-                              SINGULAR_PIVOT, matrix, magnitude, work)
-        return None if count < 0 else count
+        return self._table
+
+    def _kernel_count(self, omega: float, scratch: tuple) -> int:
+        """J(ω) by :func:`linmstmm._stiffness_kernels.count` in ``scratch``; −1 where undecided."""
+        from linmstmm import _stiffness_kernels as kernels
+
+        matrix, magnitude, work = scratch
+        return kernels.count(omega, self._beam_table(), self._maps, self._columns, self._static, self._mass,
+                             SINGULAR_PIVOT, matrix, magnitude, work)
 
     def matrix(self, omega: float) -> tuple[np.ndarray, np.ndarray]:
         """(D(ω), |D|(ω)): the reduced exact dynamic stiffness (n_dof, n_dof), and the

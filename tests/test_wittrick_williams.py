@@ -255,3 +255,20 @@ def test_counts_beside_the_roots_of_a_very_flat_section_are_right_or_undecided(e
         for offset in (-1e-5, -1e-6, -1e-7, -1e-8, 1e-8, 1e-7, 1e-6, 1e-5):
             omega = root * (1 + offset)
             assert counter(omega) in (int(np.sum(roots < omega)), None), (root, offset)
+
+
+@pytest.mark.parametrize("engine", ["numpy", "compiled"])
+def test_counts_made_together_are_those_made_one_by_one(monkeypatch, engine):
+    """prefetch: counts beside the roots of a random model made together, shared among
+    threads (each piece with its own buffers), answer as counts made one at a time,
+    undecided ones included."""
+    from linmstmm import spread
+
+    monkeypatch.setattr(spread, "cores", lambda: 2)
+    model = random_model("loops", 1)
+    omegas = 2 * np.pi * np.asarray(fe_frequencies(model, count=8, rtol=1e-8).frequencies_hz)
+    near = np.outer(omegas, 1 + np.array([-1e-6, -1e-9, -1e-12, 1e-12, 1e-9, 1e-6])).ravel()
+    counter = ModeCounter(model, engine)
+    together, alone = counter.fresh(), counter.fresh()
+    together.prefetch(near)
+    assert [together(w) for w in near] == [alone(w) for w in near]

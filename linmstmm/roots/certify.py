@@ -158,7 +158,18 @@ def other_zeros(finder, known: list[float], lo: float | None, hi: float) -> int 
 
 
 def stiffness_other_zeros(finder, known: list[float], lo: float | None, hi: float) -> int | None:
-    """:func:`other_zeros` by Wittrick–Williams counts alone; None where they cannot decide."""
+    """:func:`other_zeros` by Wittrick–Williams counts alone; None where they cannot decide.
+
+    The counts it will make first (at both ends, and across each known root at the
+    narrowest width it tries) are made together, shared among the cores
+    (:meth:`~linmstmm.wittrick_williams.ModeCounter.prefetch`).
+    """
+    prefetch = getattr(finder.counter, "prefetch", None)
+    if prefetch is not None:
+        start = 0.0 if lo is None else lo
+        roots = sorted({r for r in known if start < r < hi})
+        prefetch([hi] + ([] if lo is None else [lo])
+                 + [r * (1 + sign * _widths(finder, r)[0]) for r in roots for sign in (-1, 1)])
     counted = stiffness_count(finder, known, lo, hi)
     if counted is None or counted != 0:
         return counted
@@ -177,22 +188,43 @@ def misplaced(finder, known: list[float], lo: float | None, hi: float) -> int | 
     (a root of the second launcher at 13.25 krad/s, polished 1.5e-9 high, was
     reported as certified before)."""
     start, wrong = 0.0 if lo is None else lo, 0
-    for root in sorted({r for r in known if start < r < hi}):
-        first, held = None, None
-        for count, width in _counts_near(finder, root):       # narrowest first, until one holds
-            if count is None:
-                continue
-            first = first or (count, width)
-            if count == _known_within(known, root, width):
-                held = width
-                break
-        if first is None:
+    roots = sorted({r for r in known if start < r < hi})
+    first, held = _counted_widths(finder, known, roots)
+    for root in roots:
+        if root not in first:
             return None
-        if held is None:
-            wrong += abs(first[0] - _known_within(known, root, first[1]))
-        elif held > first[1]:  # a narrower count disagreed: float64 placed it that far off
-            finder.last_step[root] = max(finder.last_step.get(root, 0.0), held)
+        if root not in held:
+            wrong += abs(first[root][0] - _known_within(known, root, first[root][1]))
+        elif held[root] > first[root][1]:  # a narrower count disagreed: float64 placed it that far off
+            finder.last_step[root] = max(finder.last_step.get(root, 0.0), held[root])
     return wrong
+
+
+def _counted_widths(finder, known: list[float], roots: list[float]) -> tuple[dict, dict]:
+    """({root: (count, width)} at the narrowest width where the count across it decides,
+    {root: width} at the narrowest where it holds the ``known`` roots there), over
+    each root's :func:`_widths`, narrowest first, until one holds: what
+    :func:`_counts_near` gives root by root, counted here width by width so that
+    each width's counts for all the roots are made together
+    (:meth:`~linmstmm.wittrick_williams.ModeCounter.prefetch`, shared among the cores)."""
+    pending = {root: _widths(finder, root) for root in roots}
+    first, held, level = {}, {}, 0
+    prefetch = getattr(finder.counter, "prefetch", None)
+    while pending:
+        pending = {root: widths for root, widths in pending.items() if level < len(widths)}
+        if prefetch is not None:
+            prefetch([root * (1 + sign * widths[level]) for root, widths in pending.items() for sign in (-1, 1)])
+        for root, widths in list(pending.items()):
+            width = widths[level]
+            below, above = finder.counter(root * (1 - width)), finder.counter(root * (1 + width))
+            if below is None or above is None:
+                continue
+            first.setdefault(root, (above - below, width))
+            if above - below == _known_within(known, root, width):
+                held[root] = width
+                del pending[root]
+        level += 1
+    return first, held
 
 
 def _known_within(known: list[float], root: float, width: float) -> int:
@@ -256,11 +288,16 @@ def _counts_near(finder, root: float):
     it is refined in mpmath later), none narrower than four times that step, so it
     is counted where it may lie. A certified root is held to the narrowest (the
     second launcher's root at 4.90 krad/s, last step 7.3e-10, was 2.5e-9 off)."""
-    step = finder.last_step.get(root, 0.0)
-    least = 4 * step if step > finder.rtol else 0.0   # a certified root is held to the narrowest
-    for width in [w for w in near_widths(finder.rtol) if w >= least] or [least]:
+    for width in _widths(finder, root):
         below, above = finder.counter(root * (1 - width)), finder.counter(root * (1 + width))
         yield (None if below is None or above is None else above - below), width
+
+
+def _widths(finder, root: float) -> list[float]:
+    """The relative half-widths :func:`_counts_near` counts across ``root`` at, narrowest first."""
+    step = finder.last_step.get(root, 0.0)
+    least = 4 * step if step > finder.rtol else 0.0   # a certified root is held to the narrowest
+    return [w for w in near_widths(finder.rtol) if w >= least] or [least]
 
 
 def near_widths(rtol: float) -> list[float]:

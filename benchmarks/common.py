@@ -26,7 +26,8 @@ REPO = Path(__file__).resolve().parents[1]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
-from linmstmm.model import Beam, Model, Rigid, Spring  # noqa: E402
+from linmstmm.builders import spring_chain  # noqa: E402,F401  (the chains of the benchmarks)
+from linmstmm.model import Beam, Model  # noqa: E402
 from linmstmm.roots import RootFinder  # noqa: E402
 
 STEEL = dict(E=2.1e11, G=8.1e10, rho=7850.0)
@@ -153,29 +154,8 @@ def mstmm_solve(model: Model, count: int, **options) -> np.ndarray:
 # --------------------------------------------------------------------------
 # models
 
-def spring_chain(n: int, m: float = 1.0, k: float = 1e6) -> Model:
-    """ground–k–m–k–m–…–m (fixed–free), ``n`` point masses of 1 m spacing.
-
-    Isotropic translational springs, rotations locked by rigid rotational
-    springs: every direction repeats the 1-D chain, each frequency is triple.
-    Elements: n rigid bodies + n springs.
-    """
-    points = {"g": np.zeros(3)}
-    rigids, springs = [], []
-    for i in range(n):
-        points[f"a{i}"] = np.array([float(i), 0.0, 0.0])
-        points[f"b{i}"] = np.array([i + 1.0, 0.0, 0.0])
-        before = "g" if i == 0 else f"b{i - 1}"
-        springs.append(Spring(f"k{i}", (before, f"a{i}"), np.array([k, k, k, np.inf, np.inf, np.inf]),
-                              np.eye(3)))
-        rigids.append(Rigid(f"m{i}", (f"a{i}", f"b{i}"), m, np.array([i + 0.5, 0.0, 0.0]),
-                            np.zeros((3, 3))))
-    return Model(f"spring-mass chain N={n}", points, rigids=tuple(rigids), springs=tuple(springs),
-                 boundary={"g": np.ones(6, dtype=bool)})
-
-
 def spring_chain_reference_hz(n: int, count: int, m: float = 1.0, k: float = 1e6) -> np.ndarray:
-    """Lowest ``count`` frequencies of :func:`spring_chain` (each triple), closed form:
+    """Lowest ``count`` frequencies of :func:`linmstmm.builders.spring_chain` (each triple), closed form:
     ω_j = 2 √(k/m) sin((2j − 1) π / (2 (2N + 1)))."""
     j = np.arange(1, count // 3 + 2)
     omega = 2 * np.sqrt(k / m) * np.sin((2 * j - 1) * np.pi / (2 * (2 * n + 1)))

@@ -9,10 +9,10 @@ the test oracle (tests/test_wittrick_williams.py compares them):
   exact dynamic stiffness D(ω) with the scale of its terms;
 * :func:`block_inertia` — :func:`linmstmm.wittrick_williams._block_inertia`;
 * :func:`count` — :meth:`linmstmm.wittrick_williams.ModeCounter._numpy`: the
-  whole count J(ω) in one call (J₀, D(ω), its equilibration and two LDLᵀ
-  factorisations of it shifted by LAPACK's ``dsytrf``), without releasing a Python object:
-  compiled ``nogil``, so that counts at several frequencies can run on
-  threads side by side.
+  whole count J(ω) in one call (J₀, D(ω), its equilibration, and LDLᵀ
+  factorisations by LAPACK's ``dsytrf`` of it shifted up and down), compiled
+  ``nogil``, so that counts at several frequencies can run on threads side by
+  side.
 """
 from __future__ import annotations
 
@@ -137,7 +137,6 @@ def assembled(omega, beams, maps, columns, static, mass, matrix, magnitude):
             magnitude[i, j] = abs(static[i, j]) + omega * omega * abs(mass[i, j])
     local = np.zeros((12, 12))
     combos = np.empty(7)
-    width = maps.shape[2]
     for b in range(beams.shape[0]):
         beam = beams[b]
         count = _clamped(beam, omega)

@@ -214,3 +214,38 @@ def spring_mass_chain(k=1000.0, m=2.0, damping=None) -> Model:
         springs=(make_spring("k1", "g0", "a1", stiff), make_spring("k2", "b1", "a2", stiff),
                  make_spring("k3", "b2", "g3", stiff)),
         boundary={"g0": fixed(), "g3": fixed()}, damping=damping)
+
+
+def spring_chain(n: int, m: float = 1.0, k: float = 1e6) -> Model:
+    """ground–k–m–k–m–…–m (fixed–free), ``n`` bodies of 1 m spacing.
+
+    Isotropic translational springs, rotations locked by rigid rotational
+    springs: every direction repeats the 1-D chain, whose natural circular
+    frequencies are ω_j = 2 √(k/m) sin((2j − 1) π / (2 (2n + 1))), each three
+    times. A model of any length made of one repeated cell (2n elements).
+
+    Parameters
+    ----------
+    n : int
+        Number of bodies.
+    m : float
+        Mass of each body, kg (a point mass: no rotary inertia).
+    k : float
+        Translational stiffness of each spring, N/m.
+
+    Returns
+    -------
+    linmstmm.model.Model
+    """
+    points = {"g": np.zeros(3)}
+    rigids, springs = [], []
+    for i in range(n):
+        points[f"a{i}"] = np.array([float(i), 0.0, 0.0])
+        points[f"b{i}"] = np.array([i + 1.0, 0.0, 0.0])
+        before = "g" if i == 0 else f"b{i - 1}"
+        springs.append(Spring(f"k{i}", (before, f"a{i}"), np.array([k, k, k, np.inf, np.inf, np.inf]),
+                              np.eye(3)))
+        rigids.append(Rigid(f"m{i}", (f"a{i}", f"b{i}"), m, np.array([i + 0.5, 0.0, 0.0]),
+                            np.zeros((3, 3))))
+    return Model(f"spring-mass chain N={n}", points, rigids=tuple(rigids), springs=tuple(springs),
+                 boundary={"g": np.ones(6, dtype=bool)})

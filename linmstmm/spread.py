@@ -25,14 +25,15 @@ MIN_BATCH = 8
 PIECES_PER_THREAD = 3
 
 _pool: ThreadPoolExecutor | None = None
+_pool_threads = 0  # the pool's threads
 
 
 def _forget_pool() -> None:
     """Drop the pool in a forked child: its threads stayed in the parent, and a pool
     whose threads do not exist takes work it never does (a sweep's worker processes
     waited for ever)."""
-    global _pool
-    _pool = None
+    global _pool, _pool_threads
+    _pool, _pool_threads = None, 0
 
 
 if hasattr(os, "register_at_fork"):
@@ -68,9 +69,11 @@ def spread(task, size: int) -> None:
     if threads <= 1:
         task(0, size)
         return
-    global _pool
-    if _pool is None or _pool._max_workers < threads - 1:
-        _pool = ThreadPoolExecutor(max_workers=threads - 1, thread_name_prefix="linmstmm")
+    global _pool, _pool_threads
+    if _pool_threads < threads - 1:  # none yet, or too few: a larger one replaces it
+        if _pool is not None:
+            _pool.shutdown(wait=False)
+        _pool, _pool_threads = ThreadPoolExecutor(max_workers=threads - 1, thread_name_prefix="linmstmm"), threads - 1
     piece = max(1, math.ceil(size / (PIECES_PER_THREAD * threads)))
     lock, claimed = threading.Lock(), [0]
 

@@ -955,7 +955,7 @@ def write_report(args, command, facts, loads, elapsed, beam_model, beam_referenc
     w("## Cost against the number of elements")
     w("")
     w("Spring–mass chains: N point masses and N isotropic springs (rotations locked), fixed–free, "
-      "`benchmarks/common.py:spring_chain`; each frequency is triple; reference ω_j = 2√(k/m) "
+      "`linmstmm/builders.py:spring_chain`; each frequency is triple; reference ω_j = 2√(k/m) "
       "sin((2j−1)π/(2(2N+1))). Beam chains: a 2 m steel cantilever (Iy ≠ Iz) cut into N equal beam elements, "
       "reference = the closed-form cantilever roots (all N give the same first 20 frequencies). Determinant "
       "cost = `Deduction.log_det(omega)` (stable evaluation, as the solver uses it) for 64 frequencies spanning "

@@ -8,7 +8,7 @@ import pickle
 import numpy as np
 import pytest
 
-from linmstmm.builders import fixed, make_spring, single_beam_model
+from linmstmm.builders import fixed, single_beam_model, spring_chain
 from linmstmm.fe import fe_frequencies
 from linmstmm.compiled_model import compiled_system, forget_compiled_models
 from linmstmm.model import load_model
@@ -67,19 +67,11 @@ def test_auto_leaves_a_long_chain_to_the_numpy_carry_that_powers_its_cells():
     equal cells (its runs the numpy carry multiplies by powers of the cell matrix;
     compiled, a 10,000-body chain took 16 s instead of 0.5 s); its frequencies are
     the closed form's either way."""
-    from linmstmm.builders import make_rigid, make_spring, fixed
     from linmstmm.determinant import CompiledDeterminant, NumpyDeterminant, load_kernels
-    from linmstmm.model import Model
 
     load_kernels()
     n, k, m = 300, 1e6, 1.0
-    points = {"ground": np.zeros(3)}
-    for i in range(n):  # body i from x = i to i + 1, joined to the one before by a spring
-        points[f"a{i}"], points[f"b{i}"] = np.array([float(i), 0.0, 0.0]), np.array([i + 1.0, 0.0, 0.0])
-    bodies = tuple(make_rigid(f"m{i}", [f"a{i}", f"b{i}"], m, [i + 0.5, 0.0, 0.0]) for i in range(n))
-    springs = tuple(make_spring(f"k{i}", "ground" if i == 0 else f"b{i - 1}", f"a{i}", [k, k, k] + [np.inf] * 3)
-                    for i in range(n))
-    chain = Model("chain", points, rigids=bodies, springs=springs, boundary={"ground": fixed()})
+    chain = spring_chain(n, m, k)
     assert isinstance(compiled_system(chain).determinant, NumpyDeterminant)
     launcher = load_model("models/mlrs/mlrs.toml")
     assert isinstance(compiled_system(launcher).determinant, CompiledDeterminant)

@@ -158,18 +158,7 @@ def other_zeros(finder, known: list[float], lo: float | None, hi: float) -> int 
 
 
 def stiffness_other_zeros(finder, known: list[float], lo: float | None, hi: float) -> int | None:
-    """:func:`other_zeros` by Wittrick–Williams counts alone; None where they cannot decide.
-
-    The counts it will make first (at both ends, and across each known root at the
-    narrowest width it tries) are made together, shared among the cores
-    (:meth:`~linmstmm.wittrick_williams.ModeCounter.prefetch`).
-    """
-    prefetch = getattr(finder.counter, "prefetch", None)
-    if prefetch is not None:
-        start = 0.0 if lo is None else lo
-        roots = sorted({r for r in known if start < r < hi})
-        prefetch([hi] + ([] if lo is None else [lo])
-                 + [r * (1 + sign * _widths(finder, r)[0]) for r in roots for sign in (-1, 1)])
+    """:func:`other_zeros` by Wittrick–Williams counts alone; None where they cannot decide."""
     counted = stiffness_count(finder, known, lo, hi)
     if counted is None or counted != 0:
         return counted

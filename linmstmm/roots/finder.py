@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.counting import count_in_disc, deflated
+from linmstmm.counting import deflated
 from linmstmm.predicted import predicted_roots
 from linmstmm.roots import brackets, certify, fast_path, floor, pencil, segments
 from linmstmm.roots import clusters as close_roots

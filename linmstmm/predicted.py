@@ -8,7 +8,9 @@ roots are predicted first and each evaluation goes where a root is:
    the same file (:mod:`linmstmm.coarse_prediction`): a dense eigenproblem of
    a few hundred unknowns, accurate to about 1e-3 for the lowest and 1e-2 by
    the hundredth;
-2. **polish** — every prediction by the secant method on det Ū_all
+2. **polish** — where the requested accuracy is loose (``rtol`` from
+   COUNTED_PREDICTION up), a prediction that counts at ±rtol across it certify
+   stands as it is (:func:`_counted_predictions`); every other prediction by the secant method on det Ū_all
    (:func:`secant_roots`: one evaluation per step, superlinear, all roots in
    one batch per step); a result that strays, shares its root with another,
    or (in a cluster) only creeps to the rounding floor goes to Newton on the
@@ -51,6 +53,13 @@ NEAR_KNOWN = 1e-5
 #: the others only place the certifying count's upper end in the gap above it
 #: (the coarse model is within about 1e-2 of every root it predicts).
 NEAR_COUNT = 2e-2
+#: From this rtol up, each prediction is first tried as it stands: where the
+#: Wittrick–Williams counts at ±rtol across it find as many natural frequencies as
+#: there are predictions within ±rtol of it, it is certified to rtol without an
+#: evaluation of det (:func:`_counted_predictions`). The coarse model predicts the
+#: launchers' ten lowest to within 2e-6, so from about that rtol most stand; below
+#: it the counts would be spent in vain.
+COUNTED_PREDICTION = 1e-6
 
 
 def _clusters(predictions: np.ndarray) -> list[list[int]]:
@@ -152,11 +161,13 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
 
 
 def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, stop: int):
-    """``roots`` (rad/s) and the roots of ``predictions[start:stop]``, ascending: by the
-    secant, then the pencil, then the segment search around those both left troubled.
-    None where a count of that search cannot be made (the full search decides)."""
-    found, unsettled = _secant_polished(finder, predictions, start, stop, roots)
-    found, troubled = _pencil_polished(finder, list(roots) + found, unsettled)
+    """``roots`` (rad/s) and the roots of ``predictions[start:stop]``, ascending: as they
+    stand where counts certify them to a loose rtol, else by the secant, then the
+    pencil, then the segment search around those both left troubled. None where a
+    count of that search cannot be made (the full search decides)."""
+    standing, indices = _counted_predictions(finder, predictions, start, stop)
+    found, unsettled = _secant_polished(finder, predictions, indices, list(roots) + standing)
+    found, troubled = _pencil_polished(finder, list(roots) + standing + found, unsettled)
     found, troubled = _deflated_polished(finder, found, troubled, predictions)
     for lo, hi in _intervals_around(troubled, predictions, found):
         counted = _completed_by_counts(finder, found, lo, hi)
@@ -170,9 +181,38 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
     return sorted(found)
 
 
-def _secant_polished(finder, predictions: np.ndarray, start: int, stop: int,
+def _counted_predictions(finder, predictions: np.ndarray, start: int, stop: int) -> tuple[list[float], np.ndarray]:
+    """(predictions certified as they stand, rad/s; indices of the others):
+    those of ``predictions[start:stop]`` across which the Wittrick–Williams counts
+    at ±rtol find as many natural frequencies as there are predictions within ±rtol
+    (so each root there lies within rtol of one of them), where the finder certifies
+    to COUNTED_PREDICTION or looser; none otherwise. A prediction taken so has the
+    finder's rtol as its last step (:attr:`RootFinder.last_step`). The counts are the
+    certifying count's first ones across these values: it makes them once.
+    """
+    indices = np.arange(start, stop)
+    counter = finder.counter
+    if counter is None or finder.rtol < COUNTED_PREDICTION or not indices.size:
+        return [], indices
+    width = finder.rtol
+    candidates = predictions[indices]
+    prefetch = getattr(counter, "prefetch", None)
+    if prefetch is not None:
+        prefetch([omega * (1 + sign * width) for omega in candidates for sign in (-1, 1)])
+    stands = np.zeros(indices.size, dtype=bool)
+    for j, omega in enumerate(candidates):
+        below, above = counter(omega * (1 - width)), counter(omega * (1 + width))
+        stands[j] = (below is not None and above is not None
+                     and above - below == np.count_nonzero(np.abs(predictions - omega) < width * omega))
+    counted = [float(omega) for omega in candidates[stands]]
+    for omega in counted:
+        finder.last_step[omega] = width
+    return counted, indices[~stands]
+
+
+def _secant_polished(finder, predictions: np.ndarray, indices: np.ndarray,
                      known: list[float]) -> tuple[list[float], list[float]]:
-    """(roots, unsettled predictions): ``predictions[start:stop]`` by the secant on det
+    """(roots, unsettled predictions): ``predictions[indices]`` by the secant on det
     (the others are their neighbours only); one that lands on a ``known`` root (rad/s)
     is unsettled.
 
@@ -184,21 +224,21 @@ def _secant_polished(finder, predictions: np.ndarray, start: int, stop: int,
     the finder's rtol for the others (a secant that stalled above it on a noisy det,
     1.3e-9 on a ring's 10th root with the default rtol, goes to the pencil).
     """
-    found, steps = secant_roots(finder.log_det, predictions[start:stop], finder.xtol, finder.UNCERTAIN)
+    found, steps = secant_roots(finder.log_det, predictions[indices], finder.xtol, finder.UNCERTAIN)
     in_cluster = np.zeros(predictions.size, dtype=bool)
     for group in _clusters(predictions):
         in_cluster[group] = len(group) > 1
     settled = np.array([not np.isnan(root) and abs(root - predictions[i]) <= 0.5 * _gap(predictions, i)
-                        and steps[i - start] <= (finder.xtol if in_cluster[i] else finder.rtol)
+                        and step <= (finder.xtol if in_cluster[i] else finder.rtol)
                         and not _known(root, known, finder.SAME_ROOT)
-                        for i, root in enumerate(found, start)], dtype=bool)
+                        for i, root, step in zip(indices, found, steps)], dtype=bool)
     for i in np.flatnonzero(settled):  # two that settled on one root: neither stands
         twins = settled & (np.abs(found - found[i]) <= finder.SAME_ROOT * found[i])
         if twins.sum() > 1:
             settled[twins] = False
     for root, step in zip(found[settled], steps[settled]):
         finder.last_step[root] = step
-    return list(found[settled]), [float(p) for p in predictions[start:stop][~settled]]
+    return list(found[settled]), [float(p) for p in predictions[indices][~settled]]
 
 
 def _completed_by_counts(finder, found: list[float], lo: float, hi: float):

@@ -22,6 +22,12 @@ from linmstmm.model import Model
 #: Radians of a bending wave per element of the predicting mesh: its frequencies are
 #: then high by about 1/720 relative, well inside the secant's reach.
 WAVE_PER_ELEMENT = 1.0
+#: The same where the predictions may stand unpolished (a request certified to
+#: rtol from :data:`linmstmm.predicted.COUNTED_PREDICTION` up): bending frequencies
+#: high by about 0.5⁴/720 ≈ 9e-5 at most, and far less for modes that live mostly in
+#: the springs and bodies (the launcher's 11th–20th: 5e-4 off on the mesh of
+#: WAVE_PER_ELEMENT, 3e-5 on one twice as fine).
+LOOSE_WAVE_PER_ELEMENT = 0.5
 #: Unknowns of the predicting FE model beyond which there is no prediction (and the
 #: scan-based search runs): its dense eigenproblem grows as their cube, and a chain
 #: of 1000 bodies took 3.5 s to predict what the search finds in 0.1 s.
@@ -58,8 +64,7 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
     Returns (m,) ascending, m <= count (fewer if the model has fewer); none for
     a model of more than MAX_UNKNOWNS unknowns.
     """
-    nodes = len(model.points) + len(model.rigids) + (elements_per_beam - 1) * len(model.beams)
-    if 6 * nodes > MAX_UNKNOWNS:  # a dense solve would cost more than the search it saves
+    if elements_per_beam > _finest_mesh(model):  # a dense solve would cost more than the search it saves
         return np.zeros(0)
     pencil = coarse_pencil(model, elements_per_beam)
     K, M, scale, fe = pencil.K, pencil.M, pencil.scale, pencil.fe
@@ -128,6 +133,15 @@ def coarse_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
     return CoarsePencil(fe, K, M, scale)
 
 
+def _finest_mesh(model: Model) -> int:
+    """The most elements per beam whose predicting FE model has at most MAX_UNKNOWNS
+    unknowns (6 per point, body and interior beam node); below 1 where even one is too many."""
+    nodes = len(model.points) + len(model.rigids)
+    if not model.beams:
+        return MAX_ELEMENTS if 6 * nodes <= MAX_UNKNOWNS else 0
+    return (MAX_UNKNOWNS // 6 - nodes) // len(model.beams) + 1
+
+
 def _regular_pencil(K: np.ndarray, M: np.ndarray):
     """(K, M) less one unknown per motion with neither stiffness nor mass (a massless
     point free to turn between two joints), which makes the pencil singular and QZ's
@@ -145,18 +159,26 @@ def _regular_pencil(K: np.ndarray, M: np.ndarray):
     return K[np.ix_(kept, kept)], M[np.ix_(kept, kept)]
 
 
-def predict_frequencies(model: Model, count: int) -> np.ndarray:
+def predict_frequencies(model: Model, count: int, rtol: float | None = None) -> np.ndarray:
     """:func:`coarse_predictions` on a mesh fine enough for the highest of them.
 
     Two elements per beam first; where the beams' bending waves at the highest
     prediction need more than twice as many elements for :data:`WAVE_PER_ELEMENT`
-    radians each, once more with that many (at most MAX_ELEMENTS per beam).
+    radians each (:data:`LOOSE_WAVE_PER_ELEMENT` where ``rtol``, the accuracy the
+    roots are certified to, lets predictions stand unpolished), once more with
+    that many: at most MAX_ELEMENTS per beam, and at most as many as keep the
+    model within MAX_UNKNOWNS (the finest that does, where more were needed:
+    the second launcher's 100 lowest wanted 1,800 unknowns and were left
+    without predictions to a search of 25,000 evaluations).
     """
+    from linmstmm.predicted import COUNTED_PREDICTION
+
+    wave = LOOSE_WAVE_PER_ELEMENT if rtol is not None and rtol >= COUNTED_PREDICTION else WAVE_PER_ELEMENT
     predictions = coarse_predictions(model, count, 2)
     if not model.beams or not predictions.size:
         return predictions
     beta_L = max(bending_wavenumber(beam, predictions[-1]) * beam.length for beam in model.beams)
-    needed = min(int(np.ceil(beta_L / WAVE_PER_ELEMENT)), MAX_ELEMENTS)
+    needed = min(int(np.ceil(beta_L / wave)), MAX_ELEMENTS, max(_finest_mesh(model), 2))
     if needed <= 2 * 2:
         return predictions
     return coarse_predictions(model, count, needed, shift=0.5 * predictions[0] ** 2)

@@ -5,7 +5,7 @@ only, each mirroring a numpy counterpart that stays the readable reference and
 the test oracle (tests/test_wittrick_williams.py compares them):
 
 * :func:`assembled` — :func:`linmstmm.dynamic_stiffness.clamped_counts` and
-  :meth:`linmstmm.wittrick_williams.ModeCounter.matrix`: J₀(ω) and the reduced
+  :meth:`linmstmm.wittrick_williams.ModeCounter.matrices` (at one ω): J₀(ω) and the reduced
   exact dynamic stiffness D(ω) with the scale of its terms;
 * :func:`block_inertia` — :func:`linmstmm.wittrick_williams._block_inertia`;
 * :func:`count` — :meth:`linmstmm.wittrick_williams.ModeCounter._numpy`: the

@@ -33,6 +33,7 @@ both ends move alike is applied.
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -94,14 +95,25 @@ class BeamTable:
 
 def dynamic_stiffness(beams: BeamTable, omega: float) -> np.ndarray:
     """(n_beams, 12, 12) exact dynamic stiffness of each beam at ``omega`` (rad/s),
-    in its local DOFs (N/m, N, N m/rad). Infinite or NaN entries only at a
-    clamped–clamped frequency (see :func:`clamped_counts`)."""
-    d = np.zeros((beams.L.size, 12, 12))
-    _rod(d, _AXIAL, beams.EA, beams.rhoA, beams.L, omega, beams.axial)
-    _rod(d, _TORSION, beams.GJ, beams.rhoIp, beams.L, omega, beams.torsion)
-    d[:, _X_Y[:, None], _X_Y] = _bending(beams.EIz, beams.rhoA, beams.L, omega)
-    d[:, _X_Z[:, None], _X_Z] = _bending(beams.EIy, beams.rhoA, beams.L, omega) * np.outer(_FLIP, _FLIP)
-    return d
+    in its local DOFs (N/m, N, N m/rad): :func:`dynamic_stiffnesses` at one frequency."""
+    return dynamic_stiffnesses(beams, np.array([omega], dtype=float))[0]
+
+
+def dynamic_stiffnesses(beams: BeamTable, omegas: np.ndarray) -> np.ndarray:
+    """(m, n_beams, 12, 12) exact dynamic stiffness of each beam at each of the m
+    ``omegas`` (rad/s), in its local DOFs (N/m, N, N m/rad), all formed at once.
+    Infinite or NaN entries only at a clamped–clamped frequency (see
+    :func:`clamped_counts`)."""
+    omegas = np.asarray(omegas, dtype=float).ravel()
+    n = beams.L.size
+    every = BeamTable(*(np.tile(column, omegas.size) for column in dataclasses.astuple(beams)))
+    omega = np.repeat(omegas, n)                  # frequency after frequency, each for every beam
+    d = np.zeros((omega.size, 12, 12))
+    _rod(d, _AXIAL, every.EA, every.rhoA, every.L, omega, every.axial)
+    _rod(d, _TORSION, every.GJ, every.rhoIp, every.L, omega, every.torsion)
+    d[:, _X_Y[:, None], _X_Y] = _bending(every.EIz, every.rhoA, every.L, omega)
+    d[:, _X_Z[:, None], _X_Z] = _bending(every.EIy, every.rhoA, every.L, omega) * np.outer(_FLIP, _FLIP)
+    return d.reshape(omegas.size, n, 12, 12)
 
 
 def clamped_counts(beams: BeamTable, omega: float, at_least: bool = False) -> int | None:
@@ -109,26 +121,33 @@ def clamped_counts(beams: BeamTable, omega: float, at_least: bool = False) -> in
     below ``omega`` (rad/s), exactly; None within POLE of one of them. at_least:
     never None — a family float64 cannot place ω in (ω within POLE of one of its
     frequencies, or so high that POLE spans one) counts one fewer, a lower bound."""
-    total = 0
+    count = clamped_counts_at(beams, np.array([omega], dtype=float), at_least)[0]
+    return None if count < 0 else int(count)
+
+
+def clamped_counts_at(beams: BeamTable, omegas: np.ndarray, at_least: bool = False) -> np.ndarray:
+    """(m,) int: :func:`clamped_counts` at each of the m ``omegas`` (rad/s), all formed
+    at once; −1 where it is None."""
+    omegas = np.asarray(omegas, dtype=float).reshape(-1, 1)
+    total = np.zeros(omegas.shape[0], dtype=np.int64)
+    unknown = np.zeros(omegas.shape[0], dtype=bool)
     for stiffness, inertia, deformable in ((beams.EA, beams.rhoA, beams.axial),
                                           (beams.GJ, beams.rhoIp, beams.torsion)):
-        phase = omega * beams.L[deformable] * np.sqrt(inertia / stiffness)[deformable] / math.pi
+        phase = omegas * beams.L[deformable] * np.sqrt(inertia / stiffness)[deformable] / math.pi
         nearest = np.round(phase)
         undecided = (nearest >= 1) & (np.abs(phase - nearest) < POLE * phase)
-        if np.any(undecided) and not at_least:
-            return None
-        total += int(np.maximum(np.floor(phase) - undecided, 0).sum())
+        unknown |= undecided.any(axis=1)
+        total += np.maximum(np.floor(phase) - undecided, 0).sum(axis=1).astype(np.int64)
     for stiffness in (beams.EIy, beams.EIz):
-        lam = beams.L * (beams.rhoA * omega ** 2 / stiffness) ** 0.25
-        lam = lam[lam >= SERIES_BELOW]            # none below 4.73
+        lam = beams.L * (beams.rhoA * omegas ** 2 / stiffness) ** 0.25
+        considered = lam >= SERIES_BELOW            # none below 4.73
         delta = _hyperbolic(lam)[0] - np.cos(lam)   # (1 − cos λ cosh λ) / cosh λ
-        undecided = np.abs(delta) < POLE
-        if np.any(undecided) and not at_least:
-            return None
+        undecided = considered & (np.abs(delta) < POLE)
+        unknown |= undecided.any(axis=1)
         i = np.floor(lam / math.pi)
         exact = i - (1 - (-1.0) ** i * np.sign(delta)) / 2
-        total += int(np.maximum(np.where(undecided, i - 1, exact), 0).sum())
-    return total
+        total += np.where(considered, np.maximum(np.where(undecided, i - 1, exact), 0), 0).sum(axis=1).astype(np.int64)
+    return np.where(unknown & (not at_least), -1, total)
 
 
 def _rod(d, dofs, stiffness, inertia, length, omega, deformable):

@@ -34,7 +34,7 @@ import numpy as np
 import scipy.linalg.lapack as lapack
 
 from linmstmm.determinant import resolved_engine
-from linmstmm.dynamic_stiffness import BeamTable, clamped_counts, dynamic_stiffness
+from linmstmm.dynamic_stiffness import BeamTable, clamped_counts_at, dynamic_stiffnesses
 from linmstmm.fe.assembly import beam_element_dofs, constrained_parts
 from linmstmm.model import Model
 from linmstmm.spread import spread
@@ -55,6 +55,10 @@ MAX_ORDER = 150
 #: counts 1e-9 to 1e-5 from them) 1e-11, 1e-12 and 1e-13 all gave no wrong count,
 #: leaving 2,333, 1,639 and 1,189 undecided.
 SINGULAR_PIVOT = 1e-12
+
+#: Frequencies whose D(ω) the numpy engine forms at once (:meth:`ModeCounter.prefetch`):
+#: one at a time, forming D(ω) took 176 of the 308 µs of a count on the launcher.
+NUMPY_BATCH = 64
 
 
 def mode_counter(model: Model, engine: str = "auto") -> ModeCounter | None:
@@ -124,20 +128,28 @@ class ModeCounter:
 
     def _numpy(self, omega: float) -> int | None:
         """:meth:`__call__` by the numpy reference."""
-        clamped = clamped_counts(self._beams, omega)
-        if clamped is None:
-            return None
-        matrix, magnitude = self.matrix(omega)
-        if not np.all(np.isfinite(matrix)):
-            return None
-        negatives = _negative_eigenvalues(matrix, magnitude)
-        return None if negatives is None else clamped + negatives
+        return self._numpy_at([omega])[0]
+
+    def _numpy_at(self, omegas) -> list[int | None]:
+        """:meth:`__call__` at each of ``omegas`` (rad/s) by the numpy reference, J₀ and
+        D(ω) formed for all of them at once (the same numbers as one at a time)."""
+        clamped = clamped_counts_at(self._beams, omegas)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # a clamped pole: undecided below
+            matrices, magnitudes = self.matrices(omegas)
+        answers = []
+        for known, matrix, magnitude in zip(clamped, matrices, magnitudes):
+            negatives = None
+            if known >= 0 and np.all(np.isfinite(matrix)):
+                negatives = _negative_eigenvalues(matrix, magnitude)
+            answers.append(None if negatives is None else int(known) + negatives)
+        return answers
 
     def prefetch(self, omegas) -> None:
         """Count now at each of ``omegas`` (rad/s) not counted yet, for :meth:`__call__`
         to answer from: with the compiled engine shared among the cores
-        (:func:`linmstmm.spread.spread`; each piece with buffers of its own), the same
-        answers as one by one.
+        (:func:`linmstmm.spread.spread`; each piece with buffers of its own), with
+        numpy D(ω) formed for NUMPY_BATCH of them at a time; the same answers as one
+        by one.
 
         Parameters
         ----------
@@ -146,8 +158,9 @@ class ModeCounter:
         """
         wanted = sorted({float(omega) for omega in omegas} - set(self._answers))
         if self.engine != "compiled":
-            for omega in wanted:
-                self(omega)
+            for start in range(0, len(wanted), NUMPY_BATCH):
+                batch = wanted[start:start + NUMPY_BATCH]
+                self._answers.update(zip(batch, self._numpy_at(batch)))
             return
         counts = np.empty(len(wanted), dtype=np.int64)
         self._beam_table()  # made here, not by two pieces at once
@@ -192,18 +205,21 @@ class ModeCounter:
         return kernels.count(omega, self._beam_table(), self._maps, self._columns, self._static, self._mass,
                              SINGULAR_PIVOT, matrix, magnitude, work)
 
-    def matrix(self, omega: float) -> tuple[np.ndarray, np.ndarray]:
-        """(D(ω), |D|(ω)): the reduced exact dynamic stiffness (n_dof, n_dof), and the
-        same assembled from the absolute values of every term (the scale each entry's
-        rounding is relative to)."""
-        local = dynamic_stiffness(self._beams, omega)
-        parts = np.swapaxes(self._maps, 1, 2) @ local @ self._maps       # (n_beams, k, k)
+    def matrices(self, omegas) -> tuple[np.ndarray, np.ndarray]:
+        """(D(ω), |D|(ω)) at each of the m ``omegas`` (rad/s): the reduced exact dynamic
+        stiffness (m, n_dof, n_dof), and the same assembled from the absolute values of
+        every term (the scale each entry's rounding is relative to)."""
+        omegas = np.asarray(omegas, dtype=float).ravel()
+        local = dynamic_stiffnesses(self._beams, omegas)                 # (m, n_beams, 12, 12)
+        parts = np.swapaxes(self._maps, 1, 2) @ local @ self._maps       # (m, n_beams, k, k)
         size = self.n_dof + 1                                            # + a row for padding
-        beams = np.bincount(self._scatter, parts.ravel(), minlength=size * size).reshape(size, size)
-        magnitude = np.bincount(self._scatter, np.abs(parts).ravel(), minlength=size * size).reshape(size, size)
-        n = self.n_dof
-        matrix = beams[:n, :n] + self._static - omega ** 2 * self._mass
-        return matrix, magnitude[:n, :n] + np.abs(self._static) + omega ** 2 * np.abs(self._mass)
+        scatter = (self._scatter + size * size * np.arange(omegas.size)[:, None]).ravel()
+        length = omegas.size * size * size
+        beams = np.bincount(scatter, parts.ravel(), minlength=length).reshape(-1, size, size)
+        magnitude = np.bincount(scatter, np.abs(parts).ravel(), minlength=length).reshape(-1, size, size)
+        n, squared = self.n_dof, (omegas ** 2)[:, None, None]
+        matrix = beams[:, :n, :n] + self._static - squared * self._mass
+        return matrix, magnitude[:, :n, :n] + np.abs(self._static) + squared * np.abs(self._mass)
 
 
 def _beam_maps(model: Model, layout, T) -> tuple[np.ndarray, np.ndarray]:

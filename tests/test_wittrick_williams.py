@@ -182,6 +182,9 @@ def test_clamped_pivots_leave_the_count_undecided():
         counter = ModeCounter(model, engine)
         assert counter(omega) is None
         assert counter(omega * (1 + 1e-6)) == 2           # both planes' first clamped-clamped mode
+        together = ModeCounter(model, engine)             # and so made among others at once
+        together.prefetch([omega * (1 - 1e-6), omega, omega * (1 + 1e-6)])
+        assert [together(w) for w in (omega * (1 - 1e-6), omega, omega * (1 + 1e-6))] == [0, None, 2]
 
 
 def test_a_model_too_long_for_a_dense_count_gets_no_counter():

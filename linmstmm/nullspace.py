@@ -116,12 +116,8 @@ def characteristic_frequencies(topology) -> list[float]:
     records = [element.record for element in topology.elements if element.record is not None]
     mass = sum(record.mass for record in records if record.kind in ("rigid", "beam"))
     beams = [record for record in records if record.kind == "beam" and record.rho > 0]
-    springs = []
-    for record in records:
-        if record.kind == "spring" and mass > 0:
-            finite = record.k[:3][np.isfinite(record.k[:3]) & (record.k[:3] > 0)]  # not released
-            if finite.size:
-                springs.append(np.sqrt(finite.min() / mass))
+    springs = [np.sqrt(k / mass) for k in _softest_finite([record.k[:3] for record in records
+                                                         if record.kind == "spring"]) if mass > 0]
     span = sum(beam.length for beam in beams)
     candidates = []
     for length in ([beam.length for beam in beams], [span] * len(beams)):
@@ -139,13 +135,21 @@ def _torsion_scales(topology, records, mass) -> list[float]:
     the scale of a model whose only compliance is rotational (rods on pins with
     torsion springs); empty where there is none."""
     size = extent(topology)
-    scales = []
-    for record in records:
-        if record.kind == "spring" and mass > 0 and size > 0:
-            finite = record.k[3:][np.isfinite(record.k[3:]) & (record.k[3:] > 0)]
-            if finite.size:
-                scales.append(np.sqrt(finite.min() / (mass * size ** 2)))
-    return scales
+    if not (mass > 0 and size > 0):
+        return []
+    return [np.sqrt(k / (mass * size ** 2))
+            for k in _softest_finite([record.k[3:] for record in records if record.kind == "spring"])]
+
+
+def _softest_finite(stiffnesses: list) -> list[float]:
+    """For each of the springs' (3,) stiffnesses that has a finite, unreleased one (k > 0),
+    the least of those, in the springs' order (all at once: a chain has thousands)."""
+    if not stiffnesses:
+        return []
+    k = np.array(stiffnesses, dtype=float)
+    usable = np.isfinite(k) & (k > 0)
+    softest = np.where(usable, k, np.inf).min(axis=1)
+    return softest[usable.any(axis=1)].tolist()
 
 
 #: A null space that moves with ω at INDETERMINATE_TOLERANCE is looked for again at

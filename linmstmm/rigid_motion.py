@@ -136,6 +136,7 @@ def rigid_body_motions(model: Model) -> dict[str, np.ndarray]:
     """
     columns = []
     names = list(model.points)
+    number = {name: i for i, name in enumerate(names)}
     parts, all_segments = connected_parts(model)
     segment_of = {p: s for s, segment in enumerate(all_segments) for p in segment}
     for part in parts:
@@ -160,8 +161,7 @@ def rigid_body_motions(model: Model) -> dict[str, np.ndarray]:
         if not moving.shape[1]:
             continue
         motion = np.zeros((len(names), 6, moving.shape[1]))
-        for i, p in enumerate(part):
-            motion[names.index(p)] = field[i] @ moving
+        motion[[number[p] for p in part]] = field @ moving
         columns.append(motion)
     stacked = np.concatenate(columns, axis=2) if columns else np.zeros((len(names), 6, 0))
     return {name: stacked[i] for i, name in enumerate(names)}
@@ -171,8 +171,8 @@ def _segment_field(field: np.ndarray, segment: list, count: int) -> np.ndarray:
     """(n, 6, 6 count): the unit motions ``field`` (n, 6, 6) of n points, each
     point's placed in the columns of its segment (``segment[i]`` of ``count``)."""
     placed = np.zeros(field.shape[:2] + (6 * count,))
-    for i, s in enumerate(segment):
-        placed[i, :, 6 * s:6 * s + 6] = field[i]
+    columns = 6 * np.asarray(segment, dtype=int).reshape(-1, 1, 1) + np.arange(6)    # (n, 1, 6)
+    placed[np.arange(len(field))[:, None, None], np.arange(6)[:, None], columns] = field
     return placed
 
 

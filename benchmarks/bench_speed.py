@@ -106,17 +106,51 @@ def one_core():
         spread.cores = original
 
 
-def first_solve(model, count: int, rounds: int) -> tuple[float, object]:
+def first_solve(model, count: int, rounds: int, engine: str = "compiled", **options) -> tuple[float, object]:
     """(best wall time s, result) of ``natural_frequencies`` solving ``model`` for the first
     time: the compiled models are forgotten before each round (untimed), so each
-    round compiles it again (:mod:`linmstmm.compiled_model`), as a new process does."""
+    round compiles it again (:mod:`linmstmm.compiled_model`), as a new process does.
+    options: more arguments of ``natural_frequencies`` (``rtol``)."""
     best, result = np.inf, None
     for _ in range(rounds):
         forget_compiled_models()
         start = time.perf_counter()
-        result = natural_frequencies(model, count, engine="compiled")
+        result = natural_frequencies(model, count, engine=engine, **options)
         best = min(best, time.perf_counter() - start)
     return best, result
+
+
+#: The accuracies of the speed–accuracy table (None: the default, certified to 1e-9).
+RTOLS = (None, 1e-6, 1e-4)
+
+
+def rtol_table(model, counts, rounds: int) -> list[str]:
+    """Markdown table: the first N at each of RTOLS, by both engines, first solve and
+    compiled model, with the speed-up over the default and the largest difference from
+    the default's frequencies."""
+    lines = ["What a looser `rtol` saves (`natural_frequencies(..., rtol=R)`): speed-up over the "
+             "default of the same engine and kind of solve. The numpy engine is what a new process "
+             "runs (`engine=\"auto\"` before the kernels are loaded).", "",
+             "| first N | rtol | compiled: first solve | speed-up | compiled: compiled model | speed-up | "
+             "evaluations | numpy: first solve | speed-up | numpy: compiled model | speed-up | "
+             "largest diff. from the default |", "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for count in counts:
+        base = {}
+        for rtol in RTOLS:
+            options = {} if rtol is None else {"rtol": rtol}
+            row = []
+            for engine in ("compiled", "numpy"):
+                first, result = first_solve(model, count, rounds, engine, **options)
+                again, _ = best_time(lambda: natural_frequencies(model, count, engine=engine, **options), rounds)
+                base.setdefault(engine, (first, again, result))
+                row.append((first, again, result))
+            (cf, ca, result), (nf, na, _) = row
+            (cf0, ca0, reference), (nf0, na0, _) = base["compiled"], base["numpy"]
+            lines.append(f"| {count} | {'default' if rtol is None else f'{rtol:g}'} | {cf * 1e3:.1f} ms | "
+                         f"{cf0 / cf:.2f}× | {ca * 1e3:.1f} ms | **{ca0 / ca:.2f}×** | {result.evaluations} | "
+                         f"{nf * 1e3:.1f} ms | {nf0 / nf:.2f}× | {na * 1e3:.1f} ms | {na0 / na:.2f}× | "
+                         f"{rel_diff(result.frequencies_hz, reference.frequencies_hz):.1e} |")
+    return lines
 
 
 def count_costs(model, rounds: int) -> dict:
@@ -266,7 +300,7 @@ def main() -> None:
                     f"{fe_time / first_time:.1f} |")
                 curves.setdefault(label, []).append((count, first_time, mstmm_time, solves.get("eigh", np.nan),
                                                      solves.get("eigsh", np.nan), fe_time))
-            lines += ["", *budget_table(model, counts), ""]
+            lines += ["", *budget_table(model, counts), "", *rtol_table(model, counts[:2], rounds), ""]
     lines += ["**Reading the FE columns.** The FE mesh is the coarsest of 1, 2, 4, … 128 elements per "
               "beam whose first N frequencies by eigsh are within 1e-9 of the transfer-matrix ones (1e-6 "
               "from N = 60), or, where none is, the mesh that came closest (column *its diff. from "

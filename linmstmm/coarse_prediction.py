@@ -22,12 +22,6 @@ from linmstmm.model import Model
 #: Radians of a bending wave per element of the predicting mesh: its frequencies are
 #: then high by about 1/720 relative, well inside the secant's reach.
 WAVE_PER_ELEMENT = 1.0
-#: The same where the predictions may stand unpolished (a request certified to
-#: rtol from :data:`linmstmm.predicted.COUNTED_PREDICTION` up): bending frequencies
-#: high by about 0.5⁴/720 ≈ 9e-5 at most, and far less for modes that live mostly in
-#: the springs and bodies (the launcher's 11th–20th: 5e-4 off on the mesh of
-#: WAVE_PER_ELEMENT, 3e-5 on one twice as fine).
-LOOSE_WAVE_PER_ELEMENT = 0.5
 #: Unknowns of the predicting FE model beyond which there is no prediction (and the
 #: scan-based search runs): its dense eigenproblem grows as their cube, and a chain
 #: of 1000 bodies took 3.5 s to predict what the search finds in 0.1 s.
@@ -159,26 +153,22 @@ def _regular_pencil(K: np.ndarray, M: np.ndarray):
     return K[np.ix_(kept, kept)], M[np.ix_(kept, kept)]
 
 
-def predict_frequencies(model: Model, count: int, rtol: float | None = None) -> np.ndarray:
+def predict_frequencies(model: Model, count: int) -> np.ndarray:
     """:func:`coarse_predictions` on a mesh fine enough for the highest of them.
 
     Two elements per beam first; where the beams' bending waves at the highest
     prediction need more than twice as many elements for :data:`WAVE_PER_ELEMENT`
-    radians each (:data:`LOOSE_WAVE_PER_ELEMENT` where ``rtol``, the accuracy the
-    roots are certified to, lets predictions stand unpolished), once more with
-    that many: at most MAX_ELEMENTS per beam, and at most as many as keep the
-    model within MAX_UNKNOWNS (the finest that does, where more were needed:
-    the second launcher's 100 lowest wanted 1,800 unknowns and were left
-    without predictions to a search of 25,000 evaluations).
+    radians each, once more with that many: at most MAX_ELEMENTS per beam, and
+    at most as many as keep the model within MAX_UNKNOWNS (the finest that does,
+    where more would be needed: without predictions the scan-based search took
+    24,708 evaluations for the second launcher's 100 lowest on a mesh of 1,800
+    unknowns, which a twice finer wave per element asked for).
     """
-    from linmstmm.predicted import COUNTED_PREDICTION
-
-    wave = LOOSE_WAVE_PER_ELEMENT if rtol is not None and rtol >= COUNTED_PREDICTION else WAVE_PER_ELEMENT
     predictions = coarse_predictions(model, count, 2)
     if not model.beams or not predictions.size:
         return predictions
     beta_L = max(bending_wavenumber(beam, predictions[-1]) * beam.length for beam in model.beams)
-    needed = min(int(np.ceil(beta_L / wave)), MAX_ELEMENTS, max(_finest_mesh(model), 2))
+    needed = min(int(np.ceil(beta_L / WAVE_PER_ELEMENT)), MAX_ELEMENTS, max(_finest_mesh(model), 2))
     if needed <= 2 * 2:
         return predictions
     return coarse_predictions(model, count, needed, shift=0.5 * predictions[0] ** 2)

@@ -140,6 +140,8 @@ def rigid_body_motions(model: Model) -> dict[str, np.ndarray]:
     parts, all_segments = connected_parts(model)
     segment_of = {p: s for s, segment in enumerate(all_segments) for p in segment}
     for part in parts:
+        if _clamped_whole(model, part, segment_of):
+            continue
         members = set(part)
         positions = np.array([model.points[p] for p in part])
         coms = [body.com for body in model.rigids if body.ports[0] in members]
@@ -165,6 +167,14 @@ def rigid_body_motions(model: Model) -> dict[str, np.ndarray]:
         columns.append(motion)
     stacked = np.concatenate(columns, axis=2) if columns else np.zeros((len(names), 6, 0))
     return {name: stacked[i] for i, name in enumerate(names)}
+
+
+def _clamped_whole(model: Model, part: list, segment_of: dict) -> bool:
+    """True where ``part`` is one segment (no joint inside it) with a point whose six
+    components are all fixed: it cannot move at all, so it has no zero-frequency
+    motion (most grounded models; nothing else need be formed for them)."""
+    clamped = [p for p in part if p in model.boundary and np.all(model.boundary[p])]
+    return bool(clamped) and len({segment_of[p] for p in part}) == 1
 
 
 def _segment_field(field: np.ndarray, segment: list, count: int) -> np.ndarray:

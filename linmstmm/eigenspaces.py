@@ -9,7 +9,7 @@ import numpy as np
 import scipy.linalg
 
 from linmstmm.deduction import Deduction
-from linmstmm.nullspace import NULL_TOLERANCE, equilibration, own_units_start
+from linmstmm.nullspace import NULL_TOLERANCE, characteristic_frequencies, equilibration, own_units_start
 
 #: Frequencies closer than this (relative) are one repeated frequency.
 SAME_FREQUENCY = 1e-9
@@ -46,7 +46,9 @@ def _null_basis(deduction: Deduction, omega: float, dimension: int) -> np.ndarra
     """(dimension, N) basis of the null space of Ū_all(omega), on all N unknowns.
 
     Works on the equilibrated matrix S = ``rows · Ū · cols`` (the basis is
-    mapped back by ``cols``), whose scales come from Ū at ω(1 ± SCALE_PROBE),
+    mapped back by ``cols``), whose scales come from Ū at ω(1 ± SCALE_PROBE) (at
+    ω = 0 from SCALE_PROBE times the model's own frequency scale, as each ω² term
+    vanishes there: a free ring's six rigid-body modes were hidden so),
     balanced from the model's own units (the same in any units):
     at the root itself an entry that vanishes there (cos kL of a rod at
     resonance) would be blown up to ~1 when alone in its row, hiding the
@@ -59,7 +61,8 @@ def _null_basis(deduction: Deduction, omega: float, dimension: int) -> np.ndarra
     unknowns are zero. Raises RuntimeError if any of the ``dimension``
     singular values is not below NULL_TOLERANCE × the largest.
     """
-    matrix, below, above = deduction.matrix(omega * np.array([1.0, 1 - SCALE_PROBE, 1 + SCALE_PROBE]))
+    near = omega if omega > 0 else SCALE_PROBE * min(characteristic_frequencies(deduction.topology))
+    matrix, below, above = deduction.matrix(np.array([omega, near * (1 - SCALE_PROBE), near * (1 + SCALE_PROBE)]))
     rows, cols = equilibration(np.maximum(np.abs(below), np.abs(above)), start=own_units_start(deduction))
     scaled = rows[:, None] * matrix * cols
     u, sigma, vh = np.linalg.svd(scaled)

@@ -118,3 +118,28 @@ def test_star_modes_have_no_fake_zero_frequency_shapes():
     modes = mode_shapes(pinned_star(8), count=3)
     assert modes.rigid_body_modes == 0
     assert modes.stiffness_orthogonality_error < 1e-6
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_a_free_ring_has_six_zero_frequency_shapes_that_are_the_rigid_motions(seed):
+    """A closed ring with no boundary end: its six shapes at ω = 0 (the null space of
+    Ū_all there, balanced at the model's own scale since every ω² term vanishes at 0)
+    are rigid motions of its points, u = a + θ × p, and span all six."""
+    from random_models import random_model
+
+    model = random_model("ring", seed)
+    modes = mode_shapes(model, count=2, rigid_body=True)
+    assert modes.rigid_body_modes == 6 == fe_frequencies(model, count=1).rigid_body_modes
+    names = list(model.points)
+    positions = np.array([model.points[p] for p in names])
+    motions = np.concatenate([modes.point_displacements[p][:6] for p in names], axis=1).T   # (6 n_points, 6)
+    arm = positions - positions.mean(axis=0)
+    rigid = np.zeros((len(names), 6, 6))                  # each point's (u, θ) under the six unit motions
+    rigid[:, :3, :3] = rigid[:, 3:, 3:] = np.eye(3)
+    rigid[:, 0, 4], rigid[:, 0, 5] = arm[:, 2], -arm[:, 1]
+    rigid[:, 1, 3], rigid[:, 1, 5] = -arm[:, 2], arm[:, 0]
+    rigid[:, 2, 3], rigid[:, 2, 4] = arm[:, 1], -arm[:, 0]
+    basis = rigid.reshape(-1, 6)
+    coefficients = np.linalg.lstsq(basis, motions, rcond=None)[0]
+    assert np.linalg.norm(basis @ coefficients - motions) <= 1e-8 * np.linalg.norm(motions)
+    assert np.linalg.matrix_rank(coefficients, tol=1e-8 * np.abs(coefficients).max()) == 6

@@ -138,21 +138,39 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
     a few more than ``count`` (those above place the count's upper end in a
     gap). Returns the roots, or None where a count cannot be made or does not
     come to zero (the caller then searches). Records each secant root's last
-    step in ``finder.last_step``.
+    step in ``finder.last_step``. Where a prediction stood unpolished
+    (:func:`_counted_predictions`), the roots must pass the Wittrick–Williams
+    counts alone, else they are found again with every prediction polished.
     """
     predictions = np.sort(np.asarray(predictions, dtype=float))
     predictions = predictions[predictions > 0]
     if predictions.size < count:
         return None
+    roots, upper = _certified(finder, predictions, count, stand=True)
+    # A value that stood (:func:`_counted_predictions`, which records its last step
+    # under the prediction's own value) is no zero of det: the argument principle's
+    # count, with it divided out, takes it for any root missing. Where one stood, the
+    # roots are kept only if the Wittrick–Williams counts alone certify them (those
+    # counts are made already); otherwise every prediction is polished.
+    stood = not finder.last_step.keys().isdisjoint(predictions.tolist())
+    if stood and (roots is None or finder.stiffness_other_zeros(roots, None, upper) != 0):
+        roots, _ = _certified(finder, predictions, count, stand=False)
+    return roots
+
+
+def _certified(finder, predictions: np.ndarray, count: int, stand: bool) -> tuple[list[float] | None, float]:
+    """(the roots :func:`predicted_roots` returns, rad/s, or None; the upper end of
+    their certifying count, rad/s): from ``predictions`` (ascending, positive),
+    with those that counts certify as they stand taken so if ``stand``."""
     wanted = int(np.searchsorted(predictions, predictions[count - 1] * (1 + NEAR_COUNT), side="right"))
-    roots = _polished(finder, predictions, [], 0, wanted)
+    roots = _polished(finder, predictions, [], 0, wanted, stand)
     if roots is not None and len(roots) < count < predictions.size:  # some predicted twice: as many more
         more = min(wanted + count - len(roots), predictions.size)
         more = int(np.searchsorted(predictions, predictions[more - 1] * (1 + NEAR_COUNT), side="right"))
-        roots = _polished(finder, predictions, roots, wanted, more)
+        roots = _polished(finder, predictions, roots, wanted, more, stand)
         wanted = more
     if roots is None or len(roots) < count:
-        return None
+        return None, np.nan
     # The predictions not polished lie above the count's contour: divided out too,
     # they change no count but smooth its phase near the contour's upper end.
     beyond = list(predictions[wanted:])
@@ -162,19 +180,20 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
         # halve by counts to the stretch that holds it and search only there.
         roots = _repaired(finder, roots, None, upper, REPAIR_DEPTH)
         if roots is None or len(roots) < count:
-            return None
+            return None, np.nan
         upper = _gap_above(roots, count, finder.SAME_ROOT, beyond)
         if not finder.confirm_no_other_zeros(roots + beyond, upper):
-            return None
-    return [r for r in roots if r <= upper]
+            return None, np.nan
+    return [r for r in roots if r <= upper], upper
 
 
-def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, stop: int):
+def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, stop: int, stand: bool):
     """``roots`` (rad/s) and the roots of ``predictions[start:stop]``, ascending: as they
-    stand where counts certify them to a loose rtol, else by the secant, then the
+    stand where counts certify them to a loose rtol (if ``stand``), else by the secant, then the
     pencil, then the segment search around those both left troubled. None where a
     count of that search cannot be made (the full search decides)."""
-    standing, indices = _counted_predictions(finder, predictions, start, stop)
+    standing, indices = (_counted_predictions(finder, predictions, start, stop) if stand
+                         else ([], np.arange(start, stop)))
     found, unsettled = _secant_polished(finder, predictions, indices, list(roots) + standing)
     found, troubled = _pencil_polished(finder, list(roots) + standing + found, unsettled)
     found, troubled = _deflated_polished(finder, found, troubled, predictions)

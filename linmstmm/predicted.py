@@ -9,8 +9,9 @@ roots are predicted first and each evaluation goes where a root is:
    a few hundred unknowns, accurate to about 1e-3 for the lowest and 1e-2 by
    the hundredth;
 2. **polish** — where the requested accuracy is loose (``rtol`` from
-   COUNTED_PREDICTION up), a prediction that counts at ±rtol across it certify
-   stands as it is (:func:`_counted_predictions`); every other prediction by the secant method on det Ū_all
+   COUNTED_PREDICTION up), a prediction with no other within CLUSTER that counts
+   at ±rtol across it certify stands as it is (:func:`_counted_predictions`);
+   every other prediction by the secant method on det Ū_all
    (:func:`secant_roots`: one evaluation per step, superlinear, all roots in
    one batch per step); a result that strays, shares its root with another,
    or (in a cluster) only creeps to the rounding floor goes to Newton on the
@@ -53,10 +54,10 @@ NEAR_KNOWN = 1e-5
 #: the others only place the certifying count's upper end in the gap above it
 #: (the coarse model is within about 1e-2 of every root it predicts).
 NEAR_COUNT = 2e-2
-#: From this rtol up, each prediction is first tried as it stands: where the
-#: Wittrick–Williams counts at ±rtol across it find as many natural frequencies as
-#: there are predictions within ±rtol of it, it is certified to rtol without an
-#: evaluation of det (:func:`_counted_predictions`). The coarse model predicts the
+#: From this rtol up, each prediction with no other within CLUSTER is first tried as
+#: it stands: where the Wittrick–Williams counts at ±rtol across it find one natural
+#: frequency, it is certified to rtol without an evaluation of det
+#: (:func:`_counted_predictions`). The coarse model predicts the
 #: launchers' ten lowest to within 2e-6, so from about that rtol most stand; below
 #: it the counts would be spent in vain.
 COUNTED_PREDICTION = 1e-6
@@ -71,6 +72,14 @@ def _clusters(predictions: np.ndarray) -> list[list[int]]:
         else:
             groups.append([i])
     return groups
+
+
+def _in_cluster(predictions: np.ndarray) -> np.ndarray:
+    """(m,) bool: which of ``predictions`` (ascending) share a cluster (:func:`_clusters`) with another."""
+    in_cluster = np.zeros(predictions.size, dtype=bool)
+    for group in _clusters(predictions):
+        in_cluster[group] = len(group) > 1
+    return in_cluster
 
 
 def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
@@ -129,21 +138,39 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
     a few more than ``count`` (those above place the count's upper end in a
     gap). Returns the roots, or None where a count cannot be made or does not
     come to zero (the caller then searches). Records each secant root's last
-    step in ``finder.last_step``.
+    step in ``finder.last_step``. Where a prediction stood unpolished
+    (:func:`_counted_predictions`), the roots must pass the Wittrick–Williams
+    counts alone, else they are found again with every prediction polished.
     """
     predictions = np.sort(np.asarray(predictions, dtype=float))
     predictions = predictions[predictions > 0]
     if predictions.size < count:
         return None
+    roots, upper = _certified(finder, predictions, count, stand=True)
+    # A value that stood (:func:`_counted_predictions`, which records its last step
+    # under the prediction's own value) is no zero of det: the argument principle's
+    # count, with it divided out, takes it for any root missing. Where one stood, the
+    # roots are kept only if the Wittrick–Williams counts alone certify them (those
+    # counts are made already); otherwise every prediction is polished.
+    stood = not finder.last_step.keys().isdisjoint(predictions.tolist())
+    if stood and (roots is None or finder.stiffness_other_zeros(roots, None, upper) != 0):
+        roots, _ = _certified(finder, predictions, count, stand=False)
+    return roots
+
+
+def _certified(finder, predictions: np.ndarray, count: int, stand: bool) -> tuple[list[float] | None, float]:
+    """(the roots :func:`predicted_roots` returns, rad/s, or None; the upper end of
+    their certifying count, rad/s): from ``predictions`` (ascending, positive),
+    with those that counts certify as they stand taken so if ``stand``."""
     wanted = int(np.searchsorted(predictions, predictions[count - 1] * (1 + NEAR_COUNT), side="right"))
-    roots = _polished(finder, predictions, [], 0, wanted)
+    roots = _polished(finder, predictions, [], 0, wanted, stand)
     if roots is not None and len(roots) < count < predictions.size:  # some predicted twice: as many more
         more = min(wanted + count - len(roots), predictions.size)
         more = int(np.searchsorted(predictions, predictions[more - 1] * (1 + NEAR_COUNT), side="right"))
-        roots = _polished(finder, predictions, roots, wanted, more)
+        roots = _polished(finder, predictions, roots, wanted, more, stand)
         wanted = more
     if roots is None or len(roots) < count:
-        return None
+        return None, np.nan
     # The predictions not polished lie above the count's contour: divided out too,
     # they change no count but smooth its phase near the contour's upper end.
     beyond = list(predictions[wanted:])
@@ -153,19 +180,20 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
         # halve by counts to the stretch that holds it and search only there.
         roots = _repaired(finder, roots, None, upper, REPAIR_DEPTH)
         if roots is None or len(roots) < count:
-            return None
+            return None, np.nan
         upper = _gap_above(roots, count, finder.SAME_ROOT, beyond)
         if not finder.confirm_no_other_zeros(roots + beyond, upper):
-            return None
-    return [r for r in roots if r <= upper]
+            return None, np.nan
+    return [r for r in roots if r <= upper], upper
 
 
-def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, stop: int):
+def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, stop: int, stand: bool):
     """``roots`` (rad/s) and the roots of ``predictions[start:stop]``, ascending: as they
-    stand where counts certify them to a loose rtol, else by the secant, then the
+    stand where counts certify them to a loose rtol (if ``stand``), else by the secant, then the
     pencil, then the segment search around those both left troubled. None where a
     count of that search cannot be made (the full search decides)."""
-    standing, indices = _counted_predictions(finder, predictions, start, stop)
+    standing, indices = (_counted_predictions(finder, predictions, start, stop) if stand
+                         else ([], np.arange(start, stop)))
     found, unsettled = _secant_polished(finder, predictions, indices, list(roots) + standing)
     found, troubled = _pencil_polished(finder, list(roots) + standing + found, unsettled)
     found, troubled = _deflated_polished(finder, found, troubled, predictions)
@@ -182,32 +210,39 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
 
 
 def _counted_predictions(finder, predictions: np.ndarray, start: int, stop: int) -> tuple[list[float], np.ndarray]:
-    """(predictions certified as they stand, rad/s; indices of the others):
-    those of ``predictions[start:stop]`` across which the Wittrick–Williams counts
-    at ±rtol find as many natural frequencies as there are predictions within ±rtol
-    (so each root there lies within rtol of one of them), where the finder certifies
-    to COUNTED_PREDICTION or looser; none otherwise. A prediction taken so has the
-    finder's rtol as its last step (:attr:`RootFinder.last_step`). The counts are the
-    certifying count's first ones across these values: it makes them once.
+    """(predictions certified as they stand, rad/s; indices of the others, ascending):
+    those of ``predictions[start:stop]`` alone (no other prediction within CLUSTER)
+    across which the Wittrick–Williams counts at ±rtol find one natural frequency (so
+    a root lies within rtol of it), where the finder certifies to COUNTED_PREDICTION
+    or looser; none otherwise. A prediction taken so has the finder's rtol as its
+    last step (:attr:`RootFinder.last_step`). The counts are the certifying count's
+    first ones across these values: it makes them once.
+
+    A value that stands is known to rtol only, where the rest of the search tells
+    roots apart far more finely, so a cluster's members are not tried: a double
+    root's two predictions standing for it missed the count that tells a multiple
+    root from a cluster (1e-6 around it), and a close pair's lower member, predicted
+    within rtol of the upper root, stood for that root, which the secant then found
+    again as a new one (thousands of evaluations and a refinement in mpmath where
+    the default rtol took a few hundred).
     """
     indices = np.arange(start, stop)
     counter = finder.counter
     if counter is None or finder.rtol < COUNTED_PREDICTION or not indices.size:
         return [], indices
+    tried = indices[~_in_cluster(predictions)[indices]]
     width = finder.rtol
-    candidates = predictions[indices]
     prefetch = getattr(counter, "prefetch", None)
     if prefetch is not None:
-        prefetch([omega * (1 + sign * width) for omega in candidates for sign in (-1, 1)])
-    stands = np.zeros(indices.size, dtype=bool)
-    for j, omega in enumerate(candidates):
+        prefetch([omega * (1 + sign * width) for omega in predictions[tried] for sign in (-1, 1)])
+    stands = np.zeros(tried.size, dtype=bool)
+    for j, omega in enumerate(predictions[tried]):
         below, above = counter(omega * (1 - width)), counter(omega * (1 + width))
-        stands[j] = (below is not None and above is not None
-                     and above - below == np.count_nonzero(np.abs(predictions - omega) < width * omega))
-    counted = [float(omega) for omega in candidates[stands]]
+        stands[j] = below is not None and above is not None and above - below == 1
+    counted = [float(omega) for omega in predictions[tried[stands]]]
     for omega in counted:
         finder.last_step[omega] = width
-    return counted, indices[~stands]
+    return counted, np.setdiff1d(indices, tried[stands])
 
 
 def _secant_polished(finder, predictions: np.ndarray, indices: np.ndarray,
@@ -225,9 +260,7 @@ def _secant_polished(finder, predictions: np.ndarray, indices: np.ndarray,
     1.3e-9 on a ring's 10th root with the default rtol, goes to the pencil).
     """
     found, steps = secant_roots(finder.log_det, predictions[indices], finder.xtol, finder.UNCERTAIN)
-    in_cluster = np.zeros(predictions.size, dtype=bool)
-    for group in _clusters(predictions):
-        in_cluster[group] = len(group) > 1
+    in_cluster = _in_cluster(predictions)
     settled = np.array([not np.isnan(root) and abs(root - predictions[i]) <= 0.5 * _gap(predictions, i)
                         and step <= (finder.xtol if in_cluster[i] else finder.rtol)
                         and not _known(root, known, finder.SAME_ROOT)

@@ -316,6 +316,11 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         How det Ū_all is evaluated: "numpy", "compiled" (numba), or "auto"
         (compiled where the kernels are already loaded in this process; see
         :mod:`linmstmm.determinant`). The roots agree to rounding either way.
+    rtol : float or None
+        Relative accuracy every frequency is certified to, MIN_RTOL to MAX_RTOL
+        (1e-12 to 1e-4; None: 1e-9). From 1e-6 up, a lone coarse prediction that
+        the count across it certifies is listed unpolished, within rtol of its
+        root (:func:`~linmstmm.predicted.predicted_roots`).
 
     Returns
     -------
@@ -327,6 +332,8 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         For ``fmax`` alone that is not finite, or below which the beams have
         more modes than a range is searched for
         (:func:`~linmstmm.mode_bound.check_range_request`).
+    ValueError
+        For ``rtol`` outside its range, or given with ``digits``.
     """
     if rtol is not None and digits is not None:
         raise ValueError("give rtol or digits, not both: digits asks for mpmath's precision, rtol for float64's")

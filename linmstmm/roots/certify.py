@@ -33,6 +33,19 @@ def confirmed(finder, found: list[float], count: int | None, omega_max: float | 
     return below[:count] if finder.confirm_no_other_zeros(found, upper) else None
 
 
+def cut_at(finder, found: list[float], omega_max: float | None) -> list[float]:
+    """The roots of ``found`` (rad/s, ascending, complete up to omega_max or beyond)
+    that lie below ``omega_max`` (None: all): as many of the lowest as the
+    Wittrick–Williams count finds natural frequencies below it, where it decides,
+    else those whose values are. A prediction that stood unpolished
+    (:func:`~linmstmm.predicted._counted_predictions`) is known to rtol only: its
+    value can lie across omega_max from its root."""
+    if omega_max is None:
+        return found
+    below = stiffness_count(finder, [], None, omega_max)
+    return found[:below] if below is not None else [w for w in found if w <= omega_max]
+
+
 def settled(finder, found: list[float], count: int | None, omega_max: float | None,
              cap: float = np.inf) -> list[float]:
     """``found`` with every multiplicity above one below the closing count's top (and

@@ -243,7 +243,7 @@ class RootFinder:
                      if wanted is not None and self._usable(predictions) else None)
             if found is not None:  # certified up to above the wanted-th: complete below omega_max too
                 found = self._separated_above_floor(found)
-                return [w for w in found[:count] if omega_max is None or w <= omega_max]
+                return self._cut_at(found[:count], omega_max)
         found = self._scan_ahead(count, omega_max) if count is not None or omega_max is not None else None
         if found is None:
             found = self._search(count, omega_max)
@@ -308,6 +308,7 @@ class RootFinder:
     _count_top = certify.count_top
     _recovered = certify.recovered
     _below_count = staticmethod(certify.below_count)
+    _cut_at = certify.cut_at
     confirm_no_other_zeros = certify.confirm_no_other_zeros
     other_zeros = certify.other_zeros
     stiffness_count = certify.stiffness_count

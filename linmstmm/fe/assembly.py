@@ -8,7 +8,7 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from linmstmm.fe.constraints import _drop_debris, _eliminate
+from linmstmm.fe.constraints import _eliminate, reduced_constraints
 from linmstmm.fe.elements import frame_elements
 from linmstmm.fe.layout import (
     DofIndex,
@@ -22,13 +22,6 @@ from linmstmm.fe.masses import _negligible_mass_removed
 from linmstmm.fe.rigid_motions import _rigid_basis, _rigid_motions
 from linmstmm.fe.sparse import csr_of_distinct, symmetric_part
 from linmstmm.model import Model
-
-
-def beam_element_dofs(layout, beam, n):
-    """(n, 12) full DOFs of the elements of ``beam`` and (n, 12, 12) their maps from
-    those DOFs to the element's local ones (end nodes are inertial, interior ones local)."""
-    dofs, to_local = element_maps(layout.index.beam_nodes[beam.name][None], np.asarray(beam.axes, float)[None])
-    return dofs[0], to_local[0]
 
 
 class _BeamElements(NamedTuple):
@@ -193,8 +186,7 @@ def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
     _add_rigid_masses(model, layout, mass)
     _add_boundaries(model, layout, constraints)
     t0, q0_dofs = _port_map(model, layout, constraints)
-    reduced_constraints = _drop_debris(constraints.matrix(n_full) @ t0)
-    t1, masters = _eliminate(reduced_constraints)
+    t1, masters = _eliminate(reduced_constraints(constraints.matrix(n_full), t0))
     return ConstrainedParts(layout, (t0 @ t1).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass, beams)
 
 

@@ -19,7 +19,8 @@ from linmstmm.fe.layout import (
     spring_rows,
 )
 from linmstmm.fe.masses import _negligible_mass_removed
-from linmstmm.fe.rigid_motions import _rigid_basis, _rigid_motions
+from linmstmm.fe.products import compressed_rows, congruence, dense_product, scipy_csr, small, transposed
+from linmstmm.fe.rigid_motions import rigid_modes
 from linmstmm.fe.sparse import csr_of_distinct, symmetric_part
 from linmstmm.model import Model
 
@@ -244,6 +245,58 @@ class FEModel:
         return (to_inertial @ values[..., None])[..., 0].reshape(-1, 6)
 
 
+@dataclass(frozen=True, eq=False)
+class Assembly:
+    """A meshed model's reduced matrices before its rigid-body modes are sought: what
+    :func:`assemble` and the coarse predictions (:mod:`linmstmm.coarse_prediction`) share.
+
+    Attributes
+    ----------
+    model : the model assembled, masses negligible against its own scale removed
+        (:mod:`linmstmm.fe.masses`).
+    parts : its :class:`ConstrainedParts` (layout, T, masters, n_full).
+    M, K : (n_dof, n_dof) scipy CSR, symmetric bit for bit: mass (kg, kg m²) and
+        stiffness (N/m, N m/rad).
+    G, D : natural factor ``K = G.T @ diag(D) @ G``: G (n_strain, n_dof) scipy CSR,
+        D (n_strain,).
+    """
+
+    model: Model
+    parts: ConstrainedParts
+    M: sp.csr_matrix
+    K: sp.csr_matrix
+    G: sp.csr_matrix
+    D: np.ndarray
+
+
+def assembled(model: Model, elements_per_beam: int) -> Assembly:
+    """The :class:`Assembly` of ``model`` with ``elements_per_beam`` (int >= 1) equal
+    elements per beam.
+
+    M = Tᵀ M_full T and K = (Gᵀ D) G are formed densely where their dense
+    intermediate (n_dof × n_full) is small (:func:`linmstmm.fe.products.small`), by
+    scipy.sparse otherwise: the same matrices bit for bit either way.
+    """
+    model = _negligible_mass_removed(model)
+    parts = constrained_parts(model, elements_per_beam)
+    T, n_full = parts.T, parts.n_full
+    strains, mass, stiffness = _Triplets(), parts.rigid_mass, []
+    _add_beams(parts.beams, strains, stiffness, mass)
+    strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
+    stiffness += parts.spring_stiffness
+
+    G = (strains.matrix(n_full) @ T).tocsr()
+    D = np.concatenate(stiffness) if stiffness else np.zeros(0)
+    mass = mass.matrix(n_full, n_full)
+    if small(T.shape[1], n_full):
+        M, K = (_symmetric_of_dense(product) for product in (congruence(T, mass), dense_product(transposed(G, D), G)))
+    else:
+        weighted = transposed(G, D)
+        M = symmetric_part(T.T @ mass @ T)
+        K = symmetric_part(sp.csc_matrix((weighted.data, weighted.indices, weighted.indptr), shape=weighted.shape) @ G)
+    return Assembly(model, parts, M, K, G, D)
+
+
 def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
     """Global mass and stiffness of ``model`` with all constraints eliminated.
 
@@ -255,31 +308,17 @@ def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
     n = int(elements_per_beam)
     if n < 1:
         raise ValueError(f"elements_per_beam must be >= 1, got {elements_per_beam}")
-    model = _negligible_mass_removed(model)
-    parts = constrained_parts(model, n)
-    layout, T, masters, n_full = parts.layout, parts.T, parts.masters, parts.n_full
-    strains, mass, stiffness = _Triplets(), parts.rigid_mass, []
-    _add_beams(parts.beams, strains, stiffness, mass)
-    strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
-    stiffness += parts.spring_stiffness
-
-    G = (strains.matrix(n_full) @ T).tocsr()
-    D = np.concatenate(stiffness) if stiffness else np.zeros(0)
-    M = _symmetric(T.T @ mass.matrix(n_full, n_full) @ T)
-    K = _symmetric(_scaled_transpose(G, D) @ G)
-    motions, weight = _rigid_motions(model, layout)
-    rigid_modes, supports = _rigid_basis(motions[masters], M, weight[masters])
-    return FEModel(M=M, K=K, T=T, G=G, D=D, dof_index=layout.index,
-                   n_dof=T.shape[1], n_full=n_full, elements_per_beam=n,
-                   rigid_modes=rigid_modes, supports=supports, frames=layout.frames,
+    assembly = assembled(model, n)
+    layout, T, masters = assembly.parts.layout, assembly.parts.T, assembly.parts.masters
+    M = assembly.M
+    modes, supports = rigid_modes(assembly.model, layout, masters, M)
+    return FEModel(M=M, K=assembly.K, T=T, G=assembly.G, D=assembly.D, dof_index=layout.index,
+                   n_dof=T.shape[1], n_full=assembly.parts.n_full, elements_per_beam=n,
+                   rigid_modes=modes, supports=supports, frames=layout.frames,
                    massive=np.flatnonzero(M.diagonal()))
 
 
-def _scaled_transpose(G: sp.csr_matrix, D: np.ndarray) -> sp.csc_matrix:
-    """``G.T @ diag(D)`` without a product: G's entries times their row's D, transposed."""
-    return sp.csc_matrix((G.data * np.repeat(D, np.diff(G.indptr)), G.indices, G.indptr), shape=G.shape[::-1])
-
-
-def _symmetric(matrix) -> sp.csr_matrix:
-    """(A + Aᵀ) / 2 of a sparse product A (:func:`~linmstmm.fe.sparse.symmetric_part`)."""
-    return symmetric_part(matrix)
+def _symmetric_of_dense(product: np.ndarray) -> sp.csr_matrix:
+    """(A + Aᵀ) / 2 of a dense square product A, as canonical CSR: the matrix
+    :func:`~linmstmm.fe.sparse.symmetric_part` makes of A's sparse form."""
+    return scipy_csr(compressed_rows((product + product.T) * 0.5))

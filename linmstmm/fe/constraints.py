@@ -102,7 +102,7 @@ def reduced_constraints(constraints: sp.csr_matrix, t0: sp.csr_matrix) -> Compre
     shape = (constraints.shape[0], t0.shape[1])
     if small(*shape):
         dense = dense_product(constraints, t0)
-        rows, cols = np.nonzero(dense)
+        rows, cols = np.nonzero(dense != 0)       # (a mask: float nonzero scans several times slower)
         return _debris_dropped(rows, cols, dense[rows, cols], shape)
     product = sp.csr_matrix(constraints @ t0)
     product.sum_duplicates()                           # indices ascending

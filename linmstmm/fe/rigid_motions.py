@@ -161,15 +161,68 @@ def _rigid_basis(motions, M, weight):
     modes : (n_dof, r_massive) with ``modes.T @ M @ modes = I``.
     supports : (r,) DOFs on which the motions are independent (pivoted QR).
     """
-    n = M.shape[0]
     if motions.shape[1] == 0:
-        return np.zeros((n, 0)), np.zeros(0, dtype=int)
+        return np.zeros((M.shape[0], 0)), np.zeros(0, dtype=int)
+    weighted, basis, kinetic, directions, massive = _kinetic_directions(motions, M, weight)
+    modes = basis @ (directions[:, massive] / np.sqrt(kinetic[massive]))
+    pivots = la.qr(weighted.T, pivoting=True, mode="r")[1]
+    return modes, np.sort(pivots[:basis.shape[1]])
+
+
+def rigid_modes(model, layout, masters: np.ndarray, M) -> tuple[np.ndarray, np.ndarray]:
+    """The rigid-body modes and supports (:func:`_rigid_basis`) of ``model`` meshed on
+    ``layout``, in its reduced DOFs ``masters`` ((n_dof,) full DOFs) with (n_dof, n_dof)
+    sparse mass M; none at once where every segment is clamped (:func:`_held_everywhere`)."""
+    if _held_everywhere(model, layout):
+        return np.zeros((M.shape[0], 0)), np.zeros(0, dtype=int)
+    motions, weight = _rigid_motions(model, layout)
+    return _rigid_basis(motions[masters], M, weight[masters])
+
+
+def rigid_mode_count(model, layout, masters: np.ndarray, M) -> int:
+    """The number of rigid-body modes :func:`rigid_modes` finds, without forming them
+    or the supports.
+
+    Parameters
+    ----------
+    model, layout : the model and its meshed nodes (:func:`linmstmm.fe.layout._layout`).
+    masters : (n_dof,) the full DOFs kept as the reduced ones.
+    M : (n_dof, n_dof) scipy sparse mass, kg and kg m².
+
+    Returns
+    -------
+    int
+    """
+    if _held_everywhere(model, layout):
+        return 0
+    motions, weight = _rigid_motions(model, layout)
+    if motions.shape[1] == 0:
+        return 0
+    return int(np.count_nonzero(_kinetic_directions(motions[masters], M, weight[masters])[4]))
+
+
+def _held_everywhere(model, layout) -> bool:
+    """Whether every segment (:func:`_rigid_motions`) has a point fixed in all six
+    components. Then there is no rigid motion: weighted, each such point's six held
+    rows are unit upper triangular on its segment's motions (their least singular
+    value above 1/3, far above REDUNDANT_CONSTRAINT of the largest), and further
+    rows only add rank."""
+    clamped = [layout.index.points[point] for point, fixed in model.boundary.items() if np.all(fixed)]
+    if not clamped:
+        return False
+    edges, joints = _edges(model, layout)
+    segments = _components(edges[~joints], layout.n_nodes)
+    return np.unique(segments[clamped]).size == segments.max() + 1
+
+
+def _kinetic_directions(motions, M, weight):
+    """The rigid motions' basis and kinetic energies (of :func:`_rigid_basis`): weighted
+    (n_dof, r) orthonormal, basis (the same unweighted), kinetic (r,) and directions
+    (r, r) the eigenpairs of its kinetic-energy matrix, massive (r,) bool which move mass."""
     weighted = la.orth(weight[:, None] * motions)
     basis = weighted / weight[:, None]
     kinetic, directions = la.eigh(basis.T @ (M @ basis))
     # against the model's own mass scale too: a joint can leave a motion of massless
     # points alone, whose kinetic energy is the rounding of the others' DOFs
     massive = kinetic > MASSLESS * max(np.abs(kinetic).max(), (M.diagonal() / weight ** 2).max())
-    modes = basis @ (directions[:, massive] / np.sqrt(kinetic[massive]))
-    pivots = la.qr(weighted.T, pivoting=True, mode="r")[1]
-    return modes, np.sort(pivots[:basis.shape[1]])
+    return weighted, basis, kinetic, directions, massive

@@ -70,8 +70,10 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
             eigsh,  # imported where used: the command line starts without it
         )
 
-        scaling, fe = diags(scale), pencil.assembly
-        lam = eigsh((scaling @ fe.K @ scaling).tocsc(), k=wanted + 1, M=(scaling @ fe.M @ scaling).tocsc(),
+        from linmstmm.fe.products import scipy_csr
+
+        scaling, K, M = diags(scale), scipy_csr(pencil.assembly.K), scipy_csr(pencil.assembly.M)
+        lam = eigsh((scaling @ K @ scaling).tocsc(), k=wanted + 1, M=(scaling @ M @ scaling).tocsc(),
                     sigma=-shift, which="LM", return_eigenvectors=False,
                     v0=np.random.default_rng(0).standard_normal(n))  # the same start every run
         lam = np.sort(lam)[rigid:]
@@ -124,11 +126,11 @@ def coarse_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
     from linmstmm.fe.rigid_motions import rigid_mode_count
 
     fe = assembled(model, elements_per_beam)
-    K, M = fe.K.toarray(), fe.M.toarray()
+    K, M = (matrix if isinstance(matrix, np.ndarray) else matrix.toarray() for matrix in (fe.K, fe.M))
     size = np.where(np.diag(M) > 0, np.diag(M), np.abs(np.diag(K)))
     scale = 1 / np.sqrt(np.where(size > 0, size, 1.0))
+    K, M = K * np.outer(scale, scale), M * np.outer(scale, scale)
     for matrix in (K, M):
-        matrix *= np.outer(scale, scale)
         matrix.setflags(write=False)  # shared by every prediction of this model
     rigid = rigid_mode_count(fe.model, fe.parts.layout, fe.parts.masters, fe.M)
     return CoarsePencil(fe, rigid, K, M, scale)

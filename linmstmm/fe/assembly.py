@@ -19,7 +19,7 @@ from linmstmm.fe.layout import (
     spring_rows,
 )
 from linmstmm.fe.masses import _negligible_mass_removed
-from linmstmm.fe.products import compressed_rows, congruence, dense_product, scipy_csr, small, transposed
+from linmstmm.fe.products import congruence, dense_product, scipy_csr, small, transposed
 from linmstmm.fe.rigid_motions import rigid_modes
 from linmstmm.fe.sparse import csr_of_distinct, symmetric_part
 from linmstmm.model import Model
@@ -255,16 +255,17 @@ class Assembly:
     model : the model assembled, masses negligible against its own scale removed
         (:mod:`linmstmm.fe.masses`).
     parts : its :class:`ConstrainedParts` (layout, T, masters, n_full).
-    M, K : (n_dof, n_dof) scipy CSR, symmetric bit for bit: mass (kg, kg m²) and
-        stiffness (N/m, N m/rad).
+    M, K : (n_dof, n_dof) symmetric bit for bit: mass (kg, kg m²) and stiffness
+        (N/m, N m/rad); dense numpy arrays where formed densely, scipy CSR otherwise
+        (:func:`~linmstmm.fe.products.scipy_csr` makes either CSR).
     G, D : natural factor ``K = G.T @ diag(D) @ G``: G (n_strain, n_dof) scipy CSR,
         D (n_strain,).
     """
 
     model: Model
     parts: ConstrainedParts
-    M: sp.csr_matrix
-    K: sp.csr_matrix
+    M: np.ndarray | sp.csr_matrix
+    K: np.ndarray | sp.csr_matrix
     G: sp.csr_matrix
     D: np.ndarray
 
@@ -310,15 +311,15 @@ def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
         raise ValueError(f"elements_per_beam must be >= 1, got {elements_per_beam}")
     assembly = assembled(model, n)
     layout, T, masters = assembly.parts.layout, assembly.parts.T, assembly.parts.masters
-    M = assembly.M
+    M, K = scipy_csr(assembly.M), scipy_csr(assembly.K)
     modes, supports = rigid_modes(assembly.model, layout, masters, M)
-    return FEModel(M=M, K=assembly.K, T=T, G=assembly.G, D=assembly.D, dof_index=layout.index,
+    return FEModel(M=M, K=K, T=T, G=assembly.G, D=assembly.D, dof_index=layout.index,
                    n_dof=T.shape[1], n_full=assembly.parts.n_full, elements_per_beam=n,
                    rigid_modes=modes, supports=supports, frames=layout.frames,
                    massive=np.flatnonzero(M.diagonal()))
 
 
-def _symmetric_of_dense(product: np.ndarray) -> sp.csr_matrix:
-    """(A + Aᵀ) / 2 of a dense square product A, as canonical CSR: the matrix
-    :func:`~linmstmm.fe.sparse.symmetric_part` makes of A's sparse form."""
-    return scipy_csr(compressed_rows((product + product.T) * 0.5))
+def _symmetric_of_dense(product: np.ndarray) -> np.ndarray:
+    """(A + Aᵀ) / 2 of a dense square product A: the entries
+    :func:`~linmstmm.fe.sparse.symmetric_part` makes of A's sparse form, (a + b) * 0.5."""
+    return (product + product.T) * 0.5

@@ -69,13 +69,20 @@ def compressed_rows(dense: np.ndarray) -> Compressed:
     """The nonzero entries of ``dense`` (n, p) as a canonical CSR :class:`Compressed`
     (column indices ascending), as scipy stores the sparse matrix it equals."""
     rows, cols = np.nonzero(dense != 0)       # (a mask: float nonzero scans several times slower)
-    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=dense.shape[0]))])
+    indptr = np.zeros(dense.shape[0] + 1, cols.dtype)
+    np.cumsum(np.bincount(rows, minlength=dense.shape[0]), out=indptr[1:])
     return Compressed("csr", indptr, cols, dense[rows, cols], dense.shape)
 
 
-def scipy_csr(matrix: Compressed) -> sp.csr_matrix:
-    """The scipy CSR matrix of a CSR :class:`Compressed` whose indices ascend in each row."""
-    csr = sp.csr_matrix((matrix.data, matrix.indices, matrix.indptr), shape=matrix.shape)
+def scipy_csr(matrix) -> sp.csr_matrix:
+    """The scipy CSR matrix of a dense array, of a CSR :class:`Compressed` whose indices
+    ascend in each row, or of a scipy sparse matrix (itself if CSR)."""
+    if isinstance(matrix, np.ndarray):
+        matrix = compressed_rows(matrix)
+    if not isinstance(matrix, Compressed):
+        return matrix.tocsr()
+    index = np.int32 if max(matrix.shape[1], len(matrix.data)) < 2 ** 31 else np.int64  # scipy's choice, made once
+    csr = sp.csr_matrix((matrix.data, matrix.indices.astype(index), matrix.indptr.astype(index)), shape=matrix.shape)
     csr.has_sorted_indices = True
     return csr
 

@@ -9,6 +9,7 @@ import scipy.linalg as la
 from linmstmm.fe.constraints import NEGLIGIBLE_ENTRY, REDUNDANT_CONSTRAINT
 from linmstmm.fe.layout import spring_rows
 from linmstmm.fe.masses import MASSLESS
+from linmstmm.fe.products import scipy_csr
 
 
 def _edges(model, layout) -> tuple[np.ndarray, np.ndarray]:
@@ -187,7 +188,8 @@ def rigid_mode_count(model, layout, masters: np.ndarray, M) -> int:
     ----------
     model, layout : the model and its meshed nodes (:func:`linmstmm.fe.layout._layout`).
     masters : (n_dof,) the full DOFs kept as the reduced ones.
-    M : (n_dof, n_dof) scipy sparse mass, kg and kg m².
+    M : (n_dof, n_dof) mass, kg and kg m², scipy CSR or dense (taken as the CSR of
+        its nonzero entries: the same kinetic energies).
 
     Returns
     -------
@@ -198,7 +200,7 @@ def rigid_mode_count(model, layout, masters: np.ndarray, M) -> int:
     motions, weight = _rigid_motions(model, layout)
     if motions.shape[1] == 0:
         return 0
-    return int(np.count_nonzero(_kinetic_directions(motions[masters], M, weight[masters])[4]))
+    return int(np.count_nonzero(_kinetic_directions(motions[masters], scipy_csr(M), weight[masters])[4]))
 
 
 def _held_everywhere(model, layout) -> bool:

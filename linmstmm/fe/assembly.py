@@ -21,7 +21,7 @@ from linmstmm.fe.layout import (
 from linmstmm.fe.masses import _negligible_mass_removed
 from linmstmm.fe.products import congruence, dense_product, scipy_csr, small, transposed
 from linmstmm.fe.rigid_motions import rigid_modes
-from linmstmm.fe.sparse import csr_of_distinct, symmetric_part
+from linmstmm.fe.sparse import csr_of_rows, symmetric_part
 from linmstmm.model import Model
 
 
@@ -129,18 +129,24 @@ def _port_map(model, layout, constraints):
     centre_nodes = np.array([layout.index.rigids[body.name] for body, _ in bodies], int)
     ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
     kinematics = _port_kinematics(layout.positions[port_nodes], layout.positions[centre_nodes])
-    joined = constraints.new_rows(6 * np.count_nonzero(~first)).reshape(-1, 6, 1)
-    constraints.add(joined, ports[~first][:, None, :], np.eye(6))
-    constraints.add(joined, centres[~first][:, None, :], -kinematics[~first])
+    if not first.all():
+        joined = constraints.new_rows(6 * np.count_nonzero(~first)).reshape(-1, 6, 1)
+        constraints.add(joined, ports[~first][:, None, :], np.eye(6))
+        constraints.add(joined, centres[~first][:, None, :], -kinematics[~first])
     slaved = np.zeros(n_full, bool)
     slaved[ports[first]] = True
     kept = np.flatnonzero(~slaved)
     column_of = np.full(n_full, -1)
     column_of[kept] = np.arange(len(kept))
-    rows = np.concatenate([np.repeat(ports[first], 6, axis=1).ravel(), kept])
-    cols = np.concatenate([np.tile(centres[first], 6).ravel(), kept])
-    values = np.concatenate([kinematics[first].ravel(), np.ones(len(kept))])
-    return csr_of_distinct(rows, column_of[cols], values, (n_full, len(kept))), kept
+    # rows in order: a slaved port DOF holds its body's six centre DOFs (columns
+    # ascending, zeros kept), every other DOF itself
+    indptr = np.zeros(n_full + 1, int)
+    np.cumsum(np.where(slaved, 6, 1), out=indptr[1:])
+    indices, data = np.empty(indptr[-1], int), np.empty(indptr[-1])
+    indices[indptr[kept]], data[indptr[kept]] = np.arange(len(kept)), 1.0
+    held = indptr[ports[first]][..., None] + np.arange(6)                   # (p, 6, 6)
+    indices[held], data[held] = column_of[centres[first]][:, None, :], kinematics[first]
+    return csr_of_rows(indptr, indices, data, (n_full, len(kept))), kept
 
 
 @dataclass(frozen=True, eq=False)

@@ -16,6 +16,8 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
+from linmstmm.fe.sparse import csr_of_rows
+
 #: Largest result (rows × columns) formed densely by :func:`dense_product` for the
 #: callers that choose between it and scipy.sparse: clearing and scanning a dense
 #: result costs about a nanosecond an entry, scipy's product tens of microseconds.
@@ -81,10 +83,7 @@ def scipy_csr(matrix) -> sp.csr_matrix:
         matrix = compressed_rows(matrix)
     if not isinstance(matrix, Compressed):
         return matrix.tocsr()
-    index = np.int32 if max(matrix.shape[1], len(matrix.data)) < 2 ** 31 else np.int64  # scipy's choice, made once
-    csr = sp.csr_matrix((matrix.data, matrix.indices.astype(index), matrix.indptr.astype(index)), shape=matrix.shape)
-    csr.has_sorted_indices = True
-    return csr
+    return csr_of_rows(matrix.indptr, matrix.indices, matrix.data, matrix.shape)
 
 
 def rows_scaled(matrix, factors: np.ndarray) -> Compressed:

@@ -23,8 +23,17 @@ def _edges(model, layout) -> tuple[np.ndarray, np.ndarray]:
     edges = np.concatenate([np.array(ports, int).reshape(-1, 2), np.array(springs, int).reshape(-1, 2),
                             np.stack([table[:, :-1].ravel(), table[:, 1:].ravel()], axis=1)])
     joints = np.zeros(len(edges), bool)
-    joints[len(ports):len(ports) + len(springs)] = [spring.released.size > 0 for spring in model.springs]
+    joints[len(ports):len(ports) + len(springs)] = _released_any(model.springs)
     return edges, joints
+
+
+def _released_any(springs) -> np.ndarray:
+    """(s,) bool: which of ``springs`` release a direction (are joints)."""
+    given = [i for i, spring in enumerate(springs) if spring.release is not None]
+    joints = np.zeros(len(springs), bool)
+    if given:
+        joints[given] = np.array([springs[i].release for i in given], bool).reshape(len(given), 6).any(axis=1)
+    return joints
 
 
 def _components(edges: np.ndarray, n_nodes: int) -> np.ndarray:

@@ -70,9 +70,24 @@ def csr_of_summed(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shape)
 
 def _csr_of_sorted(position: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> sp.csr_matrix:
     """CSR of entries at ascending distinct ``position`` = row × n_cols + col."""
-    starts = np.searchsorted(position, np.arange(shape[0] + 1) * shape[1])
-    index = np.int32 if max(shape[1], len(position)) < 2 ** 31 else np.int64  # scipy's own choice, not made again
-    matrix = sp.csr_matrix((values, cols.astype(index), starts.astype(index)), shape=shape)
+    return csr_of_rows(np.searchsorted(position, np.arange(shape[0] + 1) * shape[1]), cols, values, shape)
+
+
+def csr_of_rows(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, shape) -> sp.csr_matrix:
+    """The scipy CSR matrix of compressed rows whose column ``indices`` ascend in each
+    row, its index arrays made of the type scipy would choose (once, here).
+
+    Parameters
+    ----------
+    indptr : (n_rows + 1,) int. indices : (nnz,) int. data : (nnz,) float.
+    shape : (n_rows, n_cols).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, flagged as having sorted indices.
+    """
+    index = np.int32 if max(shape[1], len(data)) < 2 ** 31 else np.int64
+    matrix = sp.csr_matrix((data, indices.astype(index, copy=False), indptr.astype(index, copy=False)), shape=shape)
     matrix.has_sorted_indices = True
     return matrix
 

@@ -61,19 +61,21 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
     if elements_per_beam > _finest_mesh(model):  # a dense solve would cost more than the search it saves
         return np.zeros(0)
     pencil = coarse_pencil(model, elements_per_beam)
-    K, M, scale, fe = pencil.K, pencil.M, pencil.scale, pencil.fe
-    wanted = min(count + fe.rigid_modes.shape[1], K.shape[0]) - 1
-    if shift is not None and fe.massive.size == fe.n_dof and wanted + 2 < fe.n_dof > DENSE_PREDICTION:
+    K, M, scale, rigid, n = pencil.K, pencil.M, pencil.scale, pencil.rigid_body_modes, pencil.K.shape[0]
+    wanted = min(count + rigid, n) - 1
+    if shift is not None and np.all(pencil.assembly.M.diagonal() != 0) and wanted + 2 < n > DENSE_PREDICTION:
         from scipy.sparse import diags
         from scipy.sparse.linalg import (
             eigsh,  # imported where used: the command line starts without it
         )
 
-        scaling = diags(scale)
-        lam = eigsh((scaling @ fe.K @ scaling).tocsc(), k=wanted + 1, M=(scaling @ fe.M @ scaling).tocsc(),
+        from linmstmm.fe.products import scipy_csr
+
+        scaling, K, M = diags(scale), scipy_csr(pencil.assembly.K), scipy_csr(pencil.assembly.M)
+        lam = eigsh((scaling @ K @ scaling).tocsc(), k=wanted + 1, M=(scaling @ M @ scaling).tocsc(),
                     sigma=-shift, which="LM", return_eigenvectors=False,
-                    v0=np.random.default_rng(0).standard_normal(fe.n_dof))  # the same start every run
-        lam = np.sort(lam)[fe.rigid_modes.shape[1]:]
+                    v0=np.random.default_rng(0).standard_normal(n))  # the same start every run
+        lam = np.sort(lam)[rigid:]
         return np.sqrt(np.maximum(lam[:count], 0.0))
     try:  # Cholesky of M: every unknown carries mass
         lam = scipy.linalg.eigh(K, M, eigvals_only=True, subset_by_index=[0, wanted])
@@ -81,7 +83,7 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
         K, M = _regular_pencil(K, M)
         lam = scipy.linalg.eigvals(K, M)
         lam = np.sort(lam[np.isfinite(lam)].real)
-    lam = np.sort(lam)[fe.rigid_modes.shape[1]:]  # the rigid-body modes' zeros first
+    lam = np.sort(lam)[rigid:]  # the rigid-body modes' zeros first
     return np.sqrt(np.maximum(lam[:count], 0.0))
 
 
@@ -91,8 +93,11 @@ class CoarsePencil:
 
     Attributes
     ----------
-    fe : linmstmm.fe.assembly.FEModel
-        The assembled model (sparse K, M; its rigid-body modes and massive unknowns).
+    assembly : linmstmm.fe.assembly.Assembly
+        The assembled model (sparse K, M).
+    rigid_body_modes : int
+        Its rigid-body modes, counted as the FE route counts them
+        (:func:`linmstmm.fe.rigid_motions.rigid_mode_count`), not formed.
     K, M : numpy.ndarray, shape (n, n)
         Dense, each unknown scaled to unit mass (or stiffness, where it has
         none): the same eigenvalues, and a pencil that no longer depends on
@@ -103,7 +108,8 @@ class CoarsePencil:
         The scaling of each unknown.
     """
 
-    fe: object
+    assembly: object
+    rigid_body_modes: int
     K: np.ndarray
     M: np.ndarray
     scale: np.ndarray
@@ -115,16 +121,18 @@ def coarse_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
     on the first call for this model object (about 2 ms of a launcher's 3 ms
     prediction), the same after (a Model cannot change; see
     :mod:`linmstmm.compiled_model`)."""
-    from linmstmm.fe.assembly import assemble
+    from linmstmm.fe.assembly import assembled
+    from linmstmm.fe.rigid_motions import rigid_mode_count
 
-    fe = assemble(model, elements_per_beam)
-    K, M = fe.K.toarray(), fe.M.toarray()
+    fe = assembled(model, elements_per_beam)
+    K, M = (matrix if isinstance(matrix, np.ndarray) else matrix.toarray() for matrix in (fe.K, fe.M))
     size = np.where(np.diag(M) > 0, np.diag(M), np.abs(np.diag(K)))
     scale = 1 / np.sqrt(np.where(size > 0, size, 1.0))
+    K, M = K * np.outer(scale, scale), M * np.outer(scale, scale)
     for matrix in (K, M):
-        matrix *= np.outer(scale, scale)
         matrix.setflags(write=False)  # shared by every prediction of this model
-    return CoarsePencil(fe, K, M, scale)
+    rigid = rigid_mode_count(fe.model, fe.parts.layout, fe.parts.masters, fe.M)
+    return CoarsePencil(fe, rigid, K, M, scale)
 
 
 def _finest_mesh(model: Model) -> int:

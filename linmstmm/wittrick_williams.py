@@ -35,7 +35,8 @@ import scipy.linalg.lapack as lapack
 
 from linmstmm.determinant import resolved_engine
 from linmstmm.dynamic_stiffness import BeamTable, clamped_counts_at, dynamic_stiffnesses
-from linmstmm.fe.assembly import beam_element_dofs, constrained_parts
+from linmstmm.fe.assembly import constrained_parts
+from linmstmm.fe.products import compressed_rows, congruence, dense_product, dense_rows, rows_scaled, transposed
 from linmstmm.model import Model
 from linmstmm.spread import spread
 
@@ -94,13 +95,14 @@ class ModeCounter:
         self.engine = resolved_engine(engine)
         parts = constrained_parts(model, 1)
         T, n = parts.T, parts.T.shape[1]
-        springs = parts.spring_strains.matrix(parts.n_full) @ T
+        # dense, each entry summed as scipy.sparse sums it (linmstmm.fe.products)
+        springs = compressed_rows(dense_product(parts.spring_strains.matrix(parts.n_full), T))
         stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
         self.n_dof = n
-        self._static = (springs.T @ (springs.multiply(stiffness[:, None]))).toarray()
-        self._mass = (T.T @ parts.rigid_mass.matrix(parts.n_full, parts.n_full) @ T).toarray()
+        self._static = dense_product(transposed(springs), rows_scaled(springs, stiffness))
+        self._mass = congruence(T, parts.rigid_mass.matrix(parts.n_full, parts.n_full))
         self._beams = BeamTable.of(model.beams)
-        self._maps, self._columns = _beam_maps(model, parts.layout, T)
+        self._maps, self._columns = _beam_maps(parts)
         self._scatter = (self._columns[:, :, None] * (n + 1) + self._columns[:, None, :]).ravel()
         self._answers: dict[float, int | None] = {}
         self._table = None  # the beams as the compiled kernels take them, on their first call
@@ -222,25 +224,23 @@ class ModeCounter:
         return matrix, magnitude[:, :n, :n] + np.abs(self._static) + squared * np.abs(self._mass)
 
 
-def _beam_maps(model: Model, layout, T) -> tuple[np.ndarray, np.ndarray]:
+def _beam_maps(parts) -> tuple[np.ndarray, np.ndarray]:
     """((n_beams, 12, k) maps from the reduced DOFs each beam touches to its local
-    ones, (n_beams, k) those DOFs). k: the most reduced DOFs one beam touches;
-    shorter lists are padded with the extra DOF n_dof and zero columns."""
-    n = T.shape[1]
-    columns, maps = [], []
-    for beam in model.beams:
-        dofs, to_local = beam_element_dofs(layout, beam, 1)
-        rows = T[dofs[0]].toarray()                                      # (12, n_dof)
-        touched = np.flatnonzero(np.any(rows != 0.0, axis=0))
-        columns.append(touched)
-        maps.append(to_local[0] @ rows[:, touched])
-    width = max((c.size for c in columns), default=0)
-    padded = np.full((len(columns), width), n)
-    stacked = np.zeros((len(columns), 12, width))
-    for i, (touched, block) in enumerate(zip(columns, maps)):
-        padded[i, :touched.size] = touched
-        stacked[i, :, :touched.size] = block
-    return stacked, padded
+    ones, (n_beams, k) those DOFs), beams in ``model.beams`` order, of the
+    :class:`~linmstmm.fe.assembly.ConstrainedParts` of one element per beam. k: the
+    most reduced DOFs one beam touches; shorter lists are padded with the extra DOF
+    n_dof and zero columns."""
+    T, n = parts.T, parts.T.shape[1]
+    to_local = parts.beams.to_local[:, 0]                                # (n_beams, 12, 12)
+    rows = dense_rows(T, parts.beams.dofs[:, 0])                         # (n_beams, 12, n_dof)
+    touched = np.any(rows != 0.0, axis=1)                                # (n_beams, n_dof)
+    width = int(touched.sum(axis=1).max(initial=0))
+    # each beam's touched DOFs ascending, then the padding DOF n (a stable sort of "untouched")
+    columns = np.argsort(~touched, axis=1, kind="stable")[:, :width]
+    present = np.take_along_axis(touched, columns, axis=1)
+    picked = np.take_along_axis(rows, np.broadcast_to(columns[:, None, :], rows.shape[:2] + (width,)), axis=2)
+    maps = np.where(present[:, None, :], to_local @ picked, 0.0)
+    return maps, np.where(present, columns, n)
 
 
 def _negative_eigenvalues(matrix: np.ndarray, magnitude: np.ndarray) -> int | None:

@@ -8,7 +8,7 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from linmstmm.fe.constraints import _drop_debris, _eliminate
+from linmstmm.fe.constraints import _eliminate, reduced_constraints
 from linmstmm.fe.elements import frame_elements
 from linmstmm.fe.layout import (
     DofIndex,
@@ -19,16 +19,10 @@ from linmstmm.fe.layout import (
     spring_rows,
 )
 from linmstmm.fe.masses import _negligible_mass_removed
-from linmstmm.fe.rigid_motions import _rigid_basis, _rigid_motions
-from linmstmm.fe.sparse import csr_of_distinct, symmetric_part
+from linmstmm.fe.products import congruence, dense_product, scipy_csr, small, transposed
+from linmstmm.fe.rigid_motions import rigid_modes
+from linmstmm.fe.sparse import csr_of_rows, symmetric_part
 from linmstmm.model import Model
-
-
-def beam_element_dofs(layout, beam, n):
-    """(n, 12) full DOFs of the elements of ``beam`` and (n, 12, 12) their maps from
-    those DOFs to the element's local ones (end nodes are inertial, interior ones local)."""
-    dofs, to_local = element_maps(layout.index.beam_nodes[beam.name][None], np.asarray(beam.axes, float)[None])
-    return dofs[0], to_local[0]
 
 
 class _BeamElements(NamedTuple):
@@ -135,18 +129,24 @@ def _port_map(model, layout, constraints):
     centre_nodes = np.array([layout.index.rigids[body.name] for body, _ in bodies], int)
     ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
     kinematics = _port_kinematics(layout.positions[port_nodes], layout.positions[centre_nodes])
-    joined = constraints.new_rows(6 * np.count_nonzero(~first)).reshape(-1, 6, 1)
-    constraints.add(joined, ports[~first][:, None, :], np.eye(6))
-    constraints.add(joined, centres[~first][:, None, :], -kinematics[~first])
+    if not first.all():
+        joined = constraints.new_rows(6 * np.count_nonzero(~first)).reshape(-1, 6, 1)
+        constraints.add(joined, ports[~first][:, None, :], np.eye(6))
+        constraints.add(joined, centres[~first][:, None, :], -kinematics[~first])
     slaved = np.zeros(n_full, bool)
     slaved[ports[first]] = True
     kept = np.flatnonzero(~slaved)
     column_of = np.full(n_full, -1)
     column_of[kept] = np.arange(len(kept))
-    rows = np.concatenate([np.repeat(ports[first], 6, axis=1).ravel(), kept])
-    cols = np.concatenate([np.tile(centres[first], 6).ravel(), kept])
-    values = np.concatenate([kinematics[first].ravel(), np.ones(len(kept))])
-    return csr_of_distinct(rows, column_of[cols], values, (n_full, len(kept))), kept
+    # rows in order: a slaved port DOF holds its body's six centre DOFs (columns
+    # ascending, zeros kept), every other DOF itself
+    indptr = np.zeros(n_full + 1, int)
+    np.cumsum(np.where(slaved, 6, 1), out=indptr[1:])
+    indices, data = np.empty(indptr[-1], int), np.empty(indptr[-1])
+    indices[indptr[kept]], data[indptr[kept]] = np.arange(len(kept)), 1.0
+    held = indptr[ports[first]][..., None] + np.arange(6)                   # (p, 6, 6)
+    indices[held], data[held] = column_of[centres[first]][:, None, :], kinematics[first]
+    return csr_of_rows(indptr, indices, data, (n_full, len(kept))), kept
 
 
 @dataclass(frozen=True, eq=False)
@@ -193,8 +193,7 @@ def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
     _add_rigid_masses(model, layout, mass)
     _add_boundaries(model, layout, constraints)
     t0, q0_dofs = _port_map(model, layout, constraints)
-    reduced_constraints = _drop_debris(constraints.matrix(n_full) @ t0)
-    t1, masters = _eliminate(reduced_constraints)
+    t1, masters = _eliminate(reduced_constraints(constraints.matrix(n_full), t0))
     return ConstrainedParts(layout, (t0 @ t1).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass, beams)
 
 
@@ -252,6 +251,59 @@ class FEModel:
         return (to_inertial @ values[..., None])[..., 0].reshape(-1, 6)
 
 
+@dataclass(frozen=True, eq=False)
+class Assembly:
+    """A meshed model's reduced matrices before its rigid-body modes are sought: what
+    :func:`assemble` and the coarse predictions (:mod:`linmstmm.coarse_prediction`) share.
+
+    Attributes
+    ----------
+    model : the model assembled, masses negligible against its own scale removed
+        (:mod:`linmstmm.fe.masses`).
+    parts : its :class:`ConstrainedParts` (layout, T, masters, n_full).
+    M, K : (n_dof, n_dof) symmetric bit for bit: mass (kg, kg m²) and stiffness
+        (N/m, N m/rad); dense numpy arrays where formed densely, scipy CSR otherwise
+        (:func:`~linmstmm.fe.products.scipy_csr` makes either CSR).
+    G, D : natural factor ``K = G.T @ diag(D) @ G``: G (n_strain, n_dof) scipy CSR,
+        D (n_strain,).
+    """
+
+    model: Model
+    parts: ConstrainedParts
+    M: np.ndarray | sp.csr_matrix
+    K: np.ndarray | sp.csr_matrix
+    G: sp.csr_matrix
+    D: np.ndarray
+
+
+def assembled(model: Model, elements_per_beam: int) -> Assembly:
+    """The :class:`Assembly` of ``model`` with ``elements_per_beam`` (int >= 1) equal
+    elements per beam.
+
+    M = Tᵀ M_full T and K = (Gᵀ D) G are formed densely where their dense
+    intermediate (n_dof × n_full) is small (:func:`linmstmm.fe.products.small`), by
+    scipy.sparse otherwise: the same matrices bit for bit either way.
+    """
+    model = _negligible_mass_removed(model)
+    parts = constrained_parts(model, elements_per_beam)
+    T, n_full = parts.T, parts.n_full
+    strains, mass, stiffness = _Triplets(), parts.rigid_mass, []
+    _add_beams(parts.beams, strains, stiffness, mass)
+    strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
+    stiffness += parts.spring_stiffness
+
+    G = (strains.matrix(n_full) @ T).tocsr()
+    D = np.concatenate(stiffness) if stiffness else np.zeros(0)
+    mass = mass.matrix(n_full, n_full)
+    if small(T.shape[1], n_full):
+        M, K = (_symmetric_of_dense(product) for product in (congruence(T, mass), dense_product(transposed(G, D), G)))
+    else:
+        weighted = transposed(G, D)
+        M = symmetric_part(T.T @ mass @ T)
+        K = symmetric_part(sp.csc_matrix((weighted.data, weighted.indices, weighted.indptr), shape=weighted.shape) @ G)
+    return Assembly(model, parts, M, K, G, D)
+
+
 def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
     """Global mass and stiffness of ``model`` with all constraints eliminated.
 
@@ -263,31 +315,17 @@ def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:
     n = int(elements_per_beam)
     if n < 1:
         raise ValueError(f"elements_per_beam must be >= 1, got {elements_per_beam}")
-    model = _negligible_mass_removed(model)
-    parts = constrained_parts(model, n)
-    layout, T, masters, n_full = parts.layout, parts.T, parts.masters, parts.n_full
-    strains, mass, stiffness = _Triplets(), parts.rigid_mass, []
-    _add_beams(parts.beams, strains, stiffness, mass)
-    strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
-    stiffness += parts.spring_stiffness
-
-    G = (strains.matrix(n_full) @ T).tocsr()
-    D = np.concatenate(stiffness) if stiffness else np.zeros(0)
-    M = _symmetric(T.T @ mass.matrix(n_full, n_full) @ T)
-    K = _symmetric(_scaled_transpose(G, D) @ G)
-    motions, weight = _rigid_motions(model, layout)
-    rigid_modes, supports = _rigid_basis(motions[masters], M, weight[masters])
-    return FEModel(M=M, K=K, T=T, G=G, D=D, dof_index=layout.index,
-                   n_dof=T.shape[1], n_full=n_full, elements_per_beam=n,
-                   rigid_modes=rigid_modes, supports=supports, frames=layout.frames,
+    assembly = assembled(model, n)
+    layout, T, masters = assembly.parts.layout, assembly.parts.T, assembly.parts.masters
+    M, K = scipy_csr(assembly.M), scipy_csr(assembly.K)
+    modes, supports = rigid_modes(assembly.model, layout, masters, M)
+    return FEModel(M=M, K=K, T=T, G=assembly.G, D=assembly.D, dof_index=layout.index,
+                   n_dof=T.shape[1], n_full=assembly.parts.n_full, elements_per_beam=n,
+                   rigid_modes=modes, supports=supports, frames=layout.frames,
                    massive=np.flatnonzero(M.diagonal()))
 
 
-def _scaled_transpose(G: sp.csr_matrix, D: np.ndarray) -> sp.csc_matrix:
-    """``G.T @ diag(D)`` without a product: G's entries times their row's D, transposed."""
-    return sp.csc_matrix((G.data * np.repeat(D, np.diff(G.indptr)), G.indices, G.indptr), shape=G.shape[::-1])
-
-
-def _symmetric(matrix) -> sp.csr_matrix:
-    """(A + Aᵀ) / 2 of a sparse product A (:func:`~linmstmm.fe.sparse.symmetric_part`)."""
-    return symmetric_part(matrix)
+def _symmetric_of_dense(product: np.ndarray) -> np.ndarray:
+    """(A + Aᵀ) / 2 of a dense square product A: the entries
+    :func:`~linmstmm.fe.sparse.symmetric_part` makes of A's sparse form, (a + b) * 0.5."""
+    return (product + product.T) * 0.5

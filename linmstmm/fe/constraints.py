@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from linmstmm.fe.products import Compressed, dense_product, small
 from linmstmm.fe.sparse import csr_of_distinct
 
 #: A substituted constraint row whose entries all fall below this fraction of
@@ -14,7 +15,7 @@ REDUNDANT_CONSTRAINT = 1e-10
 NEGLIGIBLE_ENTRY = 1e-14
 
 
-def _eliminate(constraints: sp.csr_matrix) -> sp.csr_matrix:
+def _eliminate(constraints: Compressed) -> tuple[sp.csr_matrix, np.ndarray]:
     """Master–slave null-space basis of the rows of ``constraints``.
 
     Rows are taken one at a time, written in the current masters, and one
@@ -32,6 +33,10 @@ def _eliminate(constraints: sp.csr_matrix) -> sp.csr_matrix:
     users = {}                          # master -> slaves that use it
     indptr, indices, data = constraints.indptr, constraints.indices, constraints.data
     for r in range(constraints.shape[0]):
+        if indptr[r + 1] - indptr[r] == 1 and indices[indptr[r]] not in expression \
+                and not users.get(indices[indptr[r]]):
+            expression[int(indices[indptr[r]])] = {}
+            continue
         row, scale = _in_masters(indices[indptr[r]:indptr[r + 1]].tolist(),
                                  data[indptr[r]:indptr[r + 1]].tolist(), expression)
         largest = max(map(abs, row.values()), default=0.0)
@@ -90,14 +95,27 @@ def _substitute(terms, owner, slave, solved, users):
         users.setdefault(master, set()).add(owner)
 
 
-def _drop_debris(matrix) -> sp.csr_matrix:
-    """``matrix`` without entries below NEGLIGIBLE_ENTRY of their row's largest."""
-    matrix = sp.csr_matrix(matrix)
-    matrix.sum_duplicates()
-    magnitude = np.abs(matrix.data)
-    row_of = np.repeat(np.arange(matrix.shape[0]), np.diff(matrix.indptr))
-    row_max = np.zeros(matrix.shape[0])
-    np.maximum.at(row_max, row_of, magnitude)
-    matrix.data[magnitude <= NEGLIGIBLE_ENTRY * row_max[row_of]] = 0.0
-    matrix.eliminate_zeros()
-    return matrix
+def reduced_constraints(constraints: sp.csr_matrix, t0: sp.csr_matrix) -> Compressed:
+    """``constraints @ t0`` (canonical CSR rows), less the entries below NEGLIGIBLE_ENTRY of
+    their row's largest: densely where small (:mod:`linmstmm.fe.products`), the same
+    entries as scipy.sparse's product."""
+    shape = (constraints.shape[0], t0.shape[1])
+    if small(*shape):
+        dense = dense_product(constraints, t0)
+        rows, cols = np.nonzero(dense != 0)       # (a mask: float nonzero scans several times slower)
+        return _debris_dropped(rows, cols, dense[rows, cols], shape)
+    product = sp.csr_matrix(constraints @ t0)
+    product.sum_duplicates()                           # indices ascending
+    rows = np.repeat(np.arange(shape[0]), np.diff(product.indptr))
+    return _debris_dropped(rows, product.indices, product.data, shape)
+
+
+def _debris_dropped(rows, cols, values, shape) -> Compressed:
+    """The CSR rows of the entries (rows, cols, values), in row order and columns
+    ascending within a row, without those at most NEGLIGIBLE_ENTRY of their row's largest."""
+    magnitude = np.abs(values)
+    row_max = np.zeros(shape[0])
+    np.maximum.at(row_max, rows, magnitude)
+    kept = magnitude > NEGLIGIBLE_ENTRY * row_max[rows]
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows[kept], minlength=shape[0]))])
+    return Compressed("csr", indptr, cols[kept], values[kept], shape)

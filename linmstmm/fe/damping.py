@@ -8,8 +8,9 @@ import scipy.linalg as la
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from linmstmm.fe.assembly import FEModel, _symmetric, assemble
+from linmstmm.fe.assembly import FEModel, assemble
 from linmstmm.fe.layout import _spring_directions, _Triplets
+from linmstmm.fe.sparse import symmetric_part
 from linmstmm.model import Model
 
 _TWO_PI = 2.0 * np.pi
@@ -29,7 +30,7 @@ def dashpot_matrix(model: Model, fe: FEModel) -> sp.csr_matrix:
                 rows.add(rows.new_rows(1), cols, values)
                 damping.append(float(spring.c[component]))
     H = rows.matrix(fe.n_full) @ fe.T
-    return _symmetric(H.T @ sp.diags(np.asarray(damping)) @ H)
+    return symmetric_part(H.T @ sp.diags(np.asarray(damping)) @ H)
 
 
 def harmonic_receptance(model: Model, point: str, vector, frequencies_hz, points,

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from linmstmm.fe.sparse import csr_of_distinct
+from linmstmm.fe.sparse import csr_of_distinct, csr_of_summed
 from linmstmm.model import Model
 
 
@@ -152,9 +152,7 @@ class _Triplets:
             return sp.csr_matrix((n_rows, n_cols))
         rows, cols, values = (np.concatenate(part) for part in (self.rows, self.cols, self.values))
         if self.repeats:
-            matrix = sp.coo_matrix((values, (rows, cols)), shape=(n_rows, n_cols)).tocsr()
-            matrix.eliminate_zeros()
-            return matrix
+            return csr_of_summed(rows, cols, values, (n_rows, n_cols))
         nonzero = values != 0
         return csr_of_distinct(rows[nonzero], cols[nonzero], values[nonzero], (n_rows, n_cols))
 

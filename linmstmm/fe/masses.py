@@ -28,13 +28,26 @@ def _negligible_mass_removed(model: Model) -> Model:
     """
     places = np.array([*model.points.values(), *(body.com for body in model.rigids)], float)
     extent = np.linalg.norm(places - places.mean(axis=0), axis=1).max()
-    total = sum(body.mass for body in model.rigids) + sum(beam.mass for beam in model.beams)
-    inertia = total * extent ** 2 + sum(np.trace(body.inertia) for body in model.rigids)
-    rigids = tuple(_body_mass_kept(body, MASSLESS * total, MASSLESS * inertia) for body in model.rigids)
+    masses = np.array([body.mass for body in model.rigids], float)
+    tensors = np.array([body.inertia for body in model.rigids], float).reshape(-1, 3, 3)
+    total = sum(masses.tolist()) + sum(beam.mass for beam in model.beams)
+    inertia = total * extent ** 2 + sum(np.trace(tensors, axis1=1, axis2=2).tolist())
+    looked_at = _maybe_negligible(masses, tensors, MASSLESS * total, MASSLESS * inertia).tolist()
+    rigids = tuple(_body_mass_kept(body, MASSLESS * total, MASSLESS * inertia) if look else body
+                   for body, look in zip(model.rigids, looked_at))
     beams = tuple(beam if beam.mass > MASSLESS * total else replace(beam, rho=0.0) for beam in model.beams)
     if all(a is b for a, b in zip(rigids + beams, model.rigids + model.beams)):
         return model  # nothing negligible: no copy (a copy validates the whole model again)
     return replace(model, rigids=rigids, beams=beams)
+
+
+def _maybe_negligible(masses: np.ndarray, tensors: np.ndarray, least_mass: float, least_inertia: float) -> np.ndarray:
+    """(b,) bool: the bodies (masses (b,) kg, inertia tensors (b, 3, 3) kg m²) that
+    :func:`_body_mass_kept` may change; the others it returns as they are."""
+    diagonal = tensors.diagonal(axis1=1, axis2=2)
+    gershgorin = diagonal - (np.abs(tensors).sum(axis=2) - np.abs(diagonal))
+    light = (masses != 0) & (masses <= least_mass)
+    return light | (diagonal.any(axis=1) & (gershgorin.min(axis=1, initial=np.inf) <= least_inertia))
 
 
 def _body_mass_kept(body: Rigid, least_mass: float, least_inertia: float) -> Rigid:

@@ -9,6 +9,7 @@ import scipy.linalg as la
 from linmstmm.fe.constraints import NEGLIGIBLE_ENTRY, REDUNDANT_CONSTRAINT
 from linmstmm.fe.layout import spring_rows
 from linmstmm.fe.masses import MASSLESS
+from linmstmm.fe.products import scipy_csr
 
 
 def _edges(model, layout) -> tuple[np.ndarray, np.ndarray]:
@@ -22,8 +23,17 @@ def _edges(model, layout) -> tuple[np.ndarray, np.ndarray]:
     edges = np.concatenate([np.array(ports, int).reshape(-1, 2), np.array(springs, int).reshape(-1, 2),
                             np.stack([table[:, :-1].ravel(), table[:, 1:].ravel()], axis=1)])
     joints = np.zeros(len(edges), bool)
-    joints[len(ports):len(ports) + len(springs)] = [spring.released.size > 0 for spring in model.springs]
+    joints[len(ports):len(ports) + len(springs)] = _released_any(model.springs)
     return edges, joints
+
+
+def _released_any(springs) -> np.ndarray:
+    """(s,) bool: which of ``springs`` release a direction (are joints)."""
+    given = [i for i, spring in enumerate(springs) if spring.release is not None]
+    joints = np.zeros(len(springs), bool)
+    if given:
+        joints[given] = np.array([springs[i].release for i in given], bool).reshape(len(given), 6).any(axis=1)
+    return joints
 
 
 def _components(edges: np.ndarray, n_nodes: int) -> np.ndarray:
@@ -161,15 +171,69 @@ def _rigid_basis(motions, M, weight):
     modes : (n_dof, r_massive) with ``modes.T @ M @ modes = I``.
     supports : (r,) DOFs on which the motions are independent (pivoted QR).
     """
-    n = M.shape[0]
     if motions.shape[1] == 0:
-        return np.zeros((n, 0)), np.zeros(0, dtype=int)
+        return np.zeros((M.shape[0], 0)), np.zeros(0, dtype=int)
+    weighted, basis, kinetic, directions, massive = _kinetic_directions(motions, M, weight)
+    modes = basis @ (directions[:, massive] / np.sqrt(kinetic[massive]))
+    pivots = la.qr(weighted.T, pivoting=True, mode="r")[1]
+    return modes, np.sort(pivots[:basis.shape[1]])
+
+
+def rigid_modes(model, layout, masters: np.ndarray, M) -> tuple[np.ndarray, np.ndarray]:
+    """The rigid-body modes and supports (:func:`_rigid_basis`) of ``model`` meshed on
+    ``layout``, in its reduced DOFs ``masters`` ((n_dof,) full DOFs) with (n_dof, n_dof)
+    sparse mass M; none at once where every segment is clamped (:func:`_held_everywhere`)."""
+    if _held_everywhere(model, layout):
+        return np.zeros((M.shape[0], 0)), np.zeros(0, dtype=int)
+    motions, weight = _rigid_motions(model, layout)
+    return _rigid_basis(motions[masters], M, weight[masters])
+
+
+def rigid_mode_count(model, layout, masters: np.ndarray, M) -> int:
+    """The number of rigid-body modes :func:`rigid_modes` finds, without forming them
+    or the supports.
+
+    Parameters
+    ----------
+    model, layout : the model and its meshed nodes (:func:`linmstmm.fe.layout._layout`).
+    masters : (n_dof,) the full DOFs kept as the reduced ones.
+    M : (n_dof, n_dof) mass, kg and kg m², scipy CSR or dense (taken as the CSR of
+        its nonzero entries: the same kinetic energies).
+
+    Returns
+    -------
+    int
+    """
+    if _held_everywhere(model, layout):
+        return 0
+    motions, weight = _rigid_motions(model, layout)
+    if motions.shape[1] == 0:
+        return 0
+    return int(np.count_nonzero(_kinetic_directions(motions[masters], scipy_csr(M), weight[masters])[4]))
+
+
+def _held_everywhere(model, layout) -> bool:
+    """Whether every segment (:func:`_rigid_motions`) has a point fixed in all six
+    components. Then there is no rigid motion: weighted, each such point's six held
+    rows are unit upper triangular on its segment's motions (their least singular
+    value above 1/3, far above REDUNDANT_CONSTRAINT of the largest), and further
+    rows only add rank."""
+    clamped = [layout.index.points[point] for point, fixed in model.boundary.items() if np.all(fixed)]
+    if not clamped:
+        return False
+    edges, joints = _edges(model, layout)
+    segments = _components(edges[~joints], layout.n_nodes)
+    return np.unique(segments[clamped]).size == segments.max() + 1
+
+
+def _kinetic_directions(motions, M, weight):
+    """The rigid motions' basis and kinetic energies (of :func:`_rigid_basis`): weighted
+    (n_dof, r) orthonormal, basis (the same unweighted), kinetic (r,) and directions
+    (r, r) the eigenpairs of its kinetic-energy matrix, massive (r,) bool which move mass."""
     weighted = la.orth(weight[:, None] * motions)
     basis = weighted / weight[:, None]
     kinetic, directions = la.eigh(basis.T @ (M @ basis))
     # against the model's own mass scale too: a joint can leave a motion of massless
     # points alone, whose kinetic energy is the rounding of the others' DOFs
     massive = kinetic > MASSLESS * max(np.abs(kinetic).max(), (M.diagonal() / weight ** 2).max())
-    modes = basis @ (directions[:, massive] / np.sqrt(kinetic[massive]))
-    pivots = la.qr(weighted.T, pivoting=True, mode="r")[1]
-    return modes, np.sort(pivots[:basis.shape[1]])
+    return weighted, basis, kinetic, directions, massive

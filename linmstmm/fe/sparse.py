@@ -34,10 +34,60 @@ def csr_of_distinct(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shap
     return _csr_of_sorted(position, cols[order], np.asarray(values, float)[order], shape)
 
 
+def csr_of_summed(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> sp.csr_matrix:
+    """The CSR matrix scipy makes of entries that may share a position:
+    ``scipy.sparse.coo_matrix((values, (rows, cols))).tocsr()``, zeros dropped.
+
+    Where no position is given more than twice it is summed here (a sum of two is
+    the same in either order); three or more are left to scipy, which sums them in
+    the order its sort leaves them.
+
+    Parameters
+    ----------
+    rows, cols : (nnz,) int positions. values : (nnz,) float entries.
+    shape : (n_rows, n_cols).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix of ``shape``, canonical.
+    """
+    position = rows.astype(np.int64) * shape[1] + cols
+    order = np.argsort(position)
+    position = position[order]
+    if np.any(position[2:] == position[:-2]):
+        matrix = sp.coo_matrix((values, (rows, cols)), shape=shape).tocsr()
+        matrix.eliminate_zeros()
+        return matrix
+    values = np.asarray(values, float)[order]
+    repeated = np.flatnonzero(position[1:] == position[:-1])
+    sums = values.copy()
+    sums[repeated] += values[repeated + 1]
+    kept = np.ones(len(position), bool)
+    kept[repeated + 1] = False
+    kept &= sums != 0
+    return _csr_of_sorted(position[kept], cols[order][kept], sums[kept], shape)
+
+
 def _csr_of_sorted(position: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> sp.csr_matrix:
     """CSR of entries at ascending distinct ``position`` = row × n_cols + col."""
-    starts = np.searchsorted(position, np.arange(shape[0] + 1) * shape[1])
-    matrix = sp.csr_matrix((values, cols, starts), shape=shape)
+    return csr_of_rows(np.searchsorted(position, np.arange(shape[0] + 1) * shape[1]), cols, values, shape)
+
+
+def csr_of_rows(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, shape) -> sp.csr_matrix:
+    """The scipy CSR matrix of compressed rows whose column ``indices`` ascend in each
+    row, its index arrays made of the type scipy would choose (once, here).
+
+    Parameters
+    ----------
+    indptr : (n_rows + 1,) int. indices : (nnz,) int. data : (nnz,) float.
+    shape : (n_rows, n_cols).
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, flagged as having sorted indices.
+    """
+    index = np.int32 if max(shape[1], len(data)) < 2 ** 31 else np.int64
+    matrix = sp.csr_matrix((data, indices.astype(index, copy=False), indptr.astype(index, copy=False)), shape=shape)
     matrix.has_sorted_indices = True
     return matrix
 

@@ -36,7 +36,14 @@ import scipy.linalg.lapack as lapack
 from linmstmm.determinant import resolved_engine
 from linmstmm.dynamic_stiffness import BeamTable, clamped_counts_at, dynamic_stiffnesses
 from linmstmm.fe.assembly import constrained_parts
-from linmstmm.fe.products import compressed_rows, congruence, dense_product, dense_rows, rows_scaled, transposed
+from linmstmm.fe.products import (
+    compressed_rows,
+    congruence,
+    dense_product,
+    dense_rows,
+    rows_scaled,
+    transposed,
+)
 from linmstmm.model import Model
 from linmstmm.spread import spread
 

@@ -126,10 +126,11 @@ def clamped_counts(beams: BeamTable, omega: float, at_least: bool = False) -> in
 
 
 def clamped_counts_at(beams: BeamTable, omegas: np.ndarray, at_least: bool = False) -> np.ndarray:
-    """(m,) int: :func:`clamped_counts` at each of the m ``omegas`` (rad/s), all formed
-    at once; −1 where it is None."""
+    """(m,) float: :func:`clamped_counts` at each of the m ``omegas`` (rad/s), all formed
+    at once, whole numbers (summed in float64, as one at a time: far above any frequency
+    asked for they pass int64); −1 where it is None."""
     omegas = np.asarray(omegas, dtype=float).reshape(-1, 1)
-    total = np.zeros(omegas.shape[0], dtype=np.int64)
+    total = np.zeros(omegas.shape[0])
     unknown = np.zeros(omegas.shape[0], dtype=bool)
     for stiffness, inertia, deformable in ((beams.EA, beams.rhoA, beams.axial),
                                           (beams.GJ, beams.rhoIp, beams.torsion)):
@@ -137,7 +138,7 @@ def clamped_counts_at(beams: BeamTable, omegas: np.ndarray, at_least: bool = Fal
         nearest = np.round(phase)
         undecided = (nearest >= 1) & (np.abs(phase - nearest) < POLE * phase)
         unknown |= undecided.any(axis=1)
-        total += np.maximum(np.floor(phase) - undecided, 0).sum(axis=1).astype(np.int64)
+        total += np.maximum(np.floor(phase) - undecided, 0).sum(axis=1)
     for stiffness in (beams.EIy, beams.EIz):
         lam = beams.L * (beams.rhoA * omegas ** 2 / stiffness) ** 0.25
         considered = lam >= SERIES_BELOW            # none below 4.73
@@ -146,8 +147,8 @@ def clamped_counts_at(beams: BeamTable, omegas: np.ndarray, at_least: bool = Fal
         unknown |= undecided.any(axis=1)
         i = np.floor(lam / math.pi)
         exact = i - (1 - (-1.0) ** i * np.sign(delta)) / 2
-        total += np.where(considered, np.maximum(np.where(undecided, i - 1, exact), 0), 0).sum(axis=1).astype(np.int64)
-    return np.where(unknown & (not at_least), -1, total)
+        total += np.where(considered, np.maximum(np.where(undecided, i - 1, exact), 0), 0).sum(axis=1)
+    return np.where(unknown & (not at_least), -1.0, total)
 
 
 def _rod(d, dofs, stiffness, inertia, length, omega, deformable):

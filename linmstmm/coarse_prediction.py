@@ -70,7 +70,7 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
             eigsh,  # imported where used: the command line starts without it
         )
 
-        from linmstmm.fe.products import scipy_csr
+        from linmstmm.fe.sparse import scipy_csr
 
         scaling, K, M = diags(scale), scipy_csr(pencil.assembly.K), scipy_csr(pencil.assembly.M)
         lam = eigsh((scaling @ K @ scaling).tocsc(), k=wanted + 1, M=(scaling @ M @ scaling).tocsc(),

@@ -36,7 +36,14 @@ import scipy.linalg.lapack as lapack
 from linmstmm.determinant import resolved_engine
 from linmstmm.dynamic_stiffness import BeamTable, clamped_counts, dynamic_stiffness
 from linmstmm.fe.assembly import constrained_parts
-from linmstmm.fe.products import compressed_rows, congruence, dense_product, dense_rows, rows_scaled, transposed
+from linmstmm.fe.products import (
+    congruence,
+    dense_product,
+    dense_rows,
+    rows_scaled,
+    transposed,
+)
+from linmstmm.fe.sparse import compressed_rows
 from linmstmm.model import Model
 from linmstmm.spread import spread
 
@@ -92,11 +99,11 @@ class ModeCounter:
         parts = constrained_parts(model, 1)
         T, n = parts.T, parts.T.shape[1]
         # dense, each entry summed as scipy.sparse sums it (linmstmm.fe.products)
-        springs = compressed_rows(dense_product(parts.spring_strains.matrix(parts.n_full), T))
+        springs = compressed_rows(dense_product(parts.spring_strains.compressed(parts.n_full), T))
         stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
         self.n_dof = n
         self._static = dense_product(transposed(springs), rows_scaled(springs, stiffness))
-        self._mass = congruence(T, parts.rigid_mass.matrix(parts.n_full, parts.n_full))
+        self._mass = congruence(T, parts.rigid_mass.compressed(parts.n_full, parts.n_full))
         self._beams = BeamTable.of(model.beams)
         self._maps, self._columns = _beam_maps(parts)
         self._scatter = (self._columns[:, :, None] * (n + 1) + self._columns[:, None, :]).ravel()

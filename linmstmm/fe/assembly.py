@@ -19,9 +19,9 @@ from linmstmm.fe.layout import (
     spring_rows,
 )
 from linmstmm.fe.masses import _negligible_mass_removed
-from linmstmm.fe.products import congruence, dense_product, scipy_csr, small, transposed
+from linmstmm.fe.products import congruence, dense_product, small, transposed
 from linmstmm.fe.rigid_motions import rigid_modes
-from linmstmm.fe.sparse import csr_of_rows, symmetric_part
+from linmstmm.fe.sparse import Compressed, scipy_csr, symmetric_part
 from linmstmm.model import Model
 
 
@@ -146,7 +146,7 @@ def _port_map(model, layout, constraints):
     indices[indptr[kept]], data[indptr[kept]] = np.arange(len(kept)), 1.0
     held = indptr[ports[first]][..., None] + np.arange(6)                   # (p, 6, 6)
     indices[held], data[held] = column_of[centres[first]][:, None, :], kinematics[first]
-    return csr_of_rows(indptr, indices, data, (n_full, len(kept))), kept
+    return scipy_csr(Compressed("csr", indptr, indices, data, (n_full, len(kept)))), kept
 
 
 @dataclass(frozen=True, eq=False)
@@ -193,7 +193,7 @@ def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
     _add_rigid_masses(model, layout, mass)
     _add_boundaries(model, layout, constraints)
     t0, q0_dofs = _port_map(model, layout, constraints)
-    t1, masters = _eliminate(reduced_constraints(constraints.matrix(n_full), t0))
+    t1, masters = _eliminate(reduced_constraints(constraints.compressed(n_full), t0))
     return ConstrainedParts(layout, (t0 @ t1).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass, beams)
 
 
@@ -294,12 +294,12 @@ def assembled(model: Model, elements_per_beam: int) -> Assembly:
 
     G = (strains.matrix(n_full) @ T).tocsr()
     D = np.concatenate(stiffness) if stiffness else np.zeros(0)
-    mass = mass.matrix(n_full, n_full)
+    mass = mass.compressed(n_full, n_full)
     if small(T.shape[1], n_full):
         M, K = (_symmetric_of_dense(product) for product in (congruence(T, mass), dense_product(transposed(G, D), G)))
     else:
         weighted = transposed(G, D)
-        M = symmetric_part(T.T @ mass @ T)
+        M = symmetric_part(T.T @ scipy_csr(mass) @ T)
         K = symmetric_part(sp.csc_matrix((weighted.data, weighted.indices, weighted.indptr), shape=weighted.shape) @ G)
     return Assembly(model, parts, M, K, G, D)
 

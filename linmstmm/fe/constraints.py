@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from linmstmm.fe.products import Compressed, dense_product, small
-from linmstmm.fe.sparse import csr_of_distinct
+from linmstmm.fe.products import dense_product, small
+from linmstmm.fe.sparse import Compressed, csr_of_distinct, scipy_csr
 
 #: A substituted constraint row whose entries all fall below this fraction of
 #: the largest term that entered it is redundant (implied by earlier rows).
@@ -95,7 +95,7 @@ def _substitute(terms, owner, slave, solved, users):
         users.setdefault(master, set()).add(owner)
 
 
-def reduced_constraints(constraints: sp.csr_matrix, t0: sp.csr_matrix) -> Compressed:
+def reduced_constraints(constraints: Compressed, t0: sp.csr_matrix) -> Compressed:
     """``constraints @ t0`` (canonical CSR rows), less the entries below NEGLIGIBLE_ENTRY of
     their row's largest: densely where small (:mod:`linmstmm.fe.products`), the same
     entries as scipy.sparse's product."""
@@ -104,7 +104,7 @@ def reduced_constraints(constraints: sp.csr_matrix, t0: sp.csr_matrix) -> Compre
         dense = dense_product(constraints, t0)
         rows, cols = np.nonzero(dense != 0)       # (a mask: float nonzero scans several times slower)
         return _debris_dropped(rows, cols, dense[rows, cols], shape)
-    product = sp.csr_matrix(constraints @ t0)
+    product = sp.csr_matrix(scipy_csr(constraints) @ t0)
     product.sum_duplicates()                           # indices ascending
     rows = np.repeat(np.arange(shape[0]), np.diff(product.indptr))
     return _debris_dropped(rows, product.indices, product.data, shape)

@@ -11,33 +11,14 @@ adds them with :func:`numpy.bincount`, which adds in the order given.
 """
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import numpy as np
-import scipy.sparse as sp
 
-from linmstmm.fe.sparse import csr_of_rows
+from linmstmm.fe.sparse import Compressed, compressed_rows
 
 #: Largest result (rows × columns) formed densely by :func:`dense_product` for the
 #: callers that choose between it and scipy.sparse: clearing and scanning a dense
 #: result costs about a nanosecond an entry, scipy's product tens of microseconds.
 DENSE_ENTRIES = 1 << 17
-
-
-class Compressed(NamedTuple):
-    """A sparse matrix's stored entries in scipy's compressed layout, without a scipy
-    object (the attributes a scipy CSR or CSC matrix has too).
-
-    format : "csr" (``indptr`` runs over rows, ``indices`` are columns) or "csc".
-    indptr : (n_major + 1,) int. indices : (nnz,) int. data : (nnz,) float.
-    shape : (n_rows, n_cols).
-    """
-
-    format: str
-    indptr: np.ndarray
-    indices: np.ndarray
-    data: np.ndarray
-    shape: tuple
 
 
 def small(n_rows: int, n_cols: int) -> bool:
@@ -65,25 +46,6 @@ def dense_product(a, b) -> np.ndarray:
     position = rows[entry] * n_cols + b.indices[taken]
     summed = np.bincount(position, a.data[entry] * b.data[taken], minlength=n_rows * n_cols)
     return summed.reshape(n_rows, n_cols)
-
-
-def compressed_rows(dense: np.ndarray) -> Compressed:
-    """The nonzero entries of ``dense`` (n, p) as a canonical CSR :class:`Compressed`
-    (column indices ascending), as scipy stores the sparse matrix it equals."""
-    rows, cols = np.nonzero(dense != 0)       # (a mask: float nonzero scans several times slower)
-    indptr = np.zeros(dense.shape[0] + 1, cols.dtype)
-    np.cumsum(np.bincount(rows, minlength=dense.shape[0]), out=indptr[1:])
-    return Compressed("csr", indptr, cols, dense[rows, cols], dense.shape)
-
-
-def scipy_csr(matrix) -> sp.csr_matrix:
-    """The scipy CSR matrix of a dense array, of a CSR :class:`Compressed` whose indices
-    ascend in each row, or of a scipy sparse matrix (itself if CSR)."""
-    if isinstance(matrix, np.ndarray):
-        matrix = compressed_rows(matrix)
-    if not isinstance(matrix, Compressed):
-        return matrix.tocsr()
-    return csr_of_rows(matrix.indptr, matrix.indices, matrix.data, matrix.shape)
 
 
 def rows_scaled(matrix, factors: np.ndarray) -> Compressed:

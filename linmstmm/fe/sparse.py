@@ -1,14 +1,33 @@
 """Sparse matrices built straight from their entries, without scipy's general
-conversion (most of the cost of small models' assembly)."""
+conversion (most of the cost of small models' assembly): as :class:`Compressed`
+arrays where only numpy reads them, as scipy CSR where scipy does."""
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import numpy as np
 import scipy.sparse as sp
 
 
-def csr_of_distinct(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> sp.csr_matrix:
-    """The CSR matrix of entries at distinct positions (no (row, col) twice), indices
-    sorted: the same matrix as ``scipy.sparse.csr_matrix((values, (rows, cols)))``,
+class Compressed(NamedTuple):
+    """A sparse matrix's stored entries in scipy's compressed layout, without a scipy
+    object (the attributes a scipy CSR or CSC matrix has too).
+
+    format : "csr" (``indptr`` runs over rows, ``indices`` are columns) or "csc".
+    indptr : (n_major + 1,) int. indices : (nnz,) int. data : (nnz,) float.
+    shape : (n_rows, n_cols).
+    """
+
+    format: str
+    indptr: np.ndarray
+    indices: np.ndarray
+    data: np.ndarray
+    shape: tuple
+
+
+def compressed_of_distinct(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> Compressed:
+    """The CSR rows of entries at distinct positions (no (row, col) twice), indices
+    sorted: the matrix ``scipy.sparse.csr_matrix((values, (rows, cols)))`` stores,
     explicit zeros kept.
 
     Parameters
@@ -19,7 +38,7 @@ def csr_of_distinct(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shap
 
     Returns
     -------
-    scipy.sparse.csr_matrix of ``shape``, canonical.
+    Compressed, CSR of ``shape``, canonical.
 
     Raises
     ------
@@ -31,11 +50,16 @@ def csr_of_distinct(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shap
     position = position[order]
     if np.any(position[1:] == position[:-1]):
         raise ValueError("csr_of_distinct: a (row, col) position is given twice")
-    return _csr_of_sorted(position, cols[order], np.asarray(values, float)[order], shape)
+    return _sorted_rows(position, cols[order], np.asarray(values, float)[order], shape)
 
 
-def csr_of_summed(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> sp.csr_matrix:
-    """The CSR matrix scipy makes of entries that may share a position:
+def csr_of_distinct(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> sp.csr_matrix:
+    """:func:`compressed_of_distinct` as a scipy CSR matrix (the same parameters)."""
+    return scipy_csr(compressed_of_distinct(rows, cols, values, shape))
+
+
+def compressed_of_summed(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> Compressed:
+    """The CSR rows scipy makes of entries that may share a position:
     ``scipy.sparse.coo_matrix((values, (rows, cols))).tocsr()``, zeros dropped.
 
     Where no position is given more than twice it is summed here (a sum of two is
@@ -49,7 +73,7 @@ def csr_of_summed(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shape)
 
     Returns
     -------
-    scipy.sparse.csr_matrix of ``shape``, canonical.
+    Compressed, CSR of ``shape``, canonical.
     """
     position = rows.astype(np.int64) * shape[1] + cols
     order = np.argsort(position)
@@ -57,7 +81,7 @@ def csr_of_summed(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shape)
     if np.any(position[2:] == position[:-2]):
         matrix = sp.coo_matrix((values, (rows, cols)), shape=shape).tocsr()
         matrix.eliminate_zeros()
-        return matrix
+        return Compressed("csr", matrix.indptr, matrix.indices, matrix.data, shape)
     values = np.asarray(values, float)[order]
     repeated = np.flatnonzero(position[1:] == position[:-1])
     sums = values.copy()
@@ -65,31 +89,45 @@ def csr_of_summed(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, shape)
     kept = np.ones(len(position), bool)
     kept[repeated + 1] = False
     kept &= sums != 0
-    return _csr_of_sorted(position[kept], cols[order][kept], sums[kept], shape)
+    return _sorted_rows(position[kept], cols[order][kept], sums[kept], shape)
 
 
-def _csr_of_sorted(position: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> sp.csr_matrix:
-    """CSR of entries at ascending distinct ``position`` = row × n_cols + col."""
-    return csr_of_rows(np.searchsorted(position, np.arange(shape[0] + 1) * shape[1]), cols, values, shape)
+def _sorted_rows(position: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> Compressed:
+    """CSR rows of entries at ascending distinct ``position`` = row × n_cols + col."""
+    return Compressed("csr", np.searchsorted(position, np.arange(shape[0] + 1) * shape[1]), cols, values, shape)
 
 
-def csr_of_rows(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, shape) -> sp.csr_matrix:
-    """The scipy CSR matrix of compressed rows whose column ``indices`` ascend in each
-    row, its index arrays made of the type scipy would choose (once, here).
+def compressed_rows(dense: np.ndarray) -> Compressed:
+    """The nonzero entries of ``dense`` (n, p) as canonical CSR rows (column indices
+    ascending), as scipy stores the sparse matrix it equals."""
+    rows, cols = np.nonzero(dense != 0)       # (a mask: float nonzero scans several times slower)
+    indptr = np.zeros(dense.shape[0] + 1, cols.dtype)
+    np.cumsum(np.bincount(rows, minlength=dense.shape[0]), out=indptr[1:])
+    return Compressed("csr", indptr, cols, dense[rows, cols], dense.shape)
+
+
+def scipy_csr(matrix) -> sp.csr_matrix:
+    """The scipy CSR matrix of a dense array, of a CSR :class:`Compressed` whose indices
+    ascend in each row, or of a scipy sparse matrix (itself if CSR). The index arrays
+    are made of the type scipy would choose, once, here.
 
     Parameters
     ----------
-    indptr : (n_rows + 1,) int. indices : (nnz,) int. data : (nnz,) float.
-    shape : (n_rows, n_cols).
+    matrix : numpy.ndarray (n, p), Compressed or scipy sparse.
 
     Returns
     -------
-    scipy.sparse.csr_matrix, flagged as having sorted indices.
+    scipy.sparse.csr_matrix, flagged as having sorted indices where made here.
     """
-    index = np.int32 if max(shape[1], len(data)) < 2 ** 31 else np.int64
-    matrix = sp.csr_matrix((data, indices.astype(index, copy=False), indptr.astype(index, copy=False)), shape=shape)
-    matrix.has_sorted_indices = True
-    return matrix
+    if isinstance(matrix, np.ndarray):
+        matrix = compressed_rows(matrix)
+    if not isinstance(matrix, Compressed):
+        return matrix.tocsr()
+    index = np.int32 if max(matrix.shape[1], len(matrix.data)) < 2 ** 31 else np.int64
+    csr = sp.csr_matrix((matrix.data, matrix.indices.astype(index, copy=False),
+                         matrix.indptr.astype(index, copy=False)), shape=matrix.shape)
+    csr.has_sorted_indices = True
+    return csr
 
 
 def symmetric_part(matrix) -> sp.csr_matrix:
@@ -116,4 +154,4 @@ def symmetric_part(matrix) -> sp.csr_matrix:
     sums = np.add.reduceat(np.concatenate([matrix.data, matrix.data])[order], first)
     kept = sums != 0
     position = position[first][kept]
-    return _csr_of_sorted(position, position % n, sums[kept] * 0.5, (n, n))
+    return scipy_csr(_sorted_rows(position, position % n, sums[kept] * 0.5, (n, n)))

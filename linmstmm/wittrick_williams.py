@@ -222,8 +222,8 @@ def _beam_maps(parts) -> tuple[np.ndarray, np.ndarray]:
     most reduced DOFs one beam touches; shorter lists are padded with the extra DOF
     n_dof and zero columns."""
     T, n = parts.T, parts.T.shape[1]
-    to_local = parts.beams.to_local[:, 0]                                # (n_beams, 12, 12)
-    rows = dense_rows(T, parts.beams.dofs[:, 0])                         # (n_beams, 12, n_dof)
+    dofs, to_local = (part[:, 0] for part in parts.beam_maps)           # (n_beams, 12), (n_beams, 12, 12)
+    rows = dense_rows(T, dofs)                                           # (n_beams, 12, n_dof)
     touched = np.any(rows != 0.0, axis=1)                                # (n_beams, n_dof)
     width = int(touched.sum(axis=1).max(initial=0))
     # each beam's touched DOFs ascending, then the padding DOF n (a stable sort of "untouched")

@@ -43,11 +43,13 @@ class _BeamElements(NamedTuple):
     m: np.ndarray
 
 
-def _beam_elements(model, layout, n) -> _BeamElements:
-    """The :class:`_BeamElements` of ``model`` on ``layout`` (``n`` elements per beam)."""
-    h = np.array([beam.length for beam in model.beams], float) / n
-    rows, d, m, strain = frame_elements(model.beams, h)
-    dofs, to_local = element_maps(layout.beam_table, _beam_axes(model.beams))
+def _beam_elements(beams, maps, n) -> _BeamElements:
+    """The :class:`_BeamElements` of ``beams`` (b :class:`~linmstmm.model.Beam`, ``n``
+    elements each) whose elements' DOFs and maps to local ones are ``maps``
+    ((b, n, 12), (b, n, 12, 12); :func:`~linmstmm.fe.layout.element_maps`)."""
+    h = np.array([beam.length for beam in beams], float) / n
+    rows, d, m, strain = frame_elements(beams, h)
+    dofs, to_local = maps
     return _BeamElements(dofs, to_local, rows[:, None] @ to_local, d, strain, m)
 
 
@@ -64,13 +66,17 @@ def _add_beams(elements: _BeamElements, strains, stiffness, mass):
     mass.add(dofs[..., :, None], dofs[..., None, :], np.swapaxes(to_local, 2, 3) @ m[:, None] @ to_local)
 
 
-def _add_beam_constraints(elements: _BeamElements, constraints):
-    """Directions a beam declares rigid (``axial`` or ``torsion`` False) become constraints."""
+def _add_beam_constraints(beams, maps, n, constraints):
+    """Directions a beam declares rigid (``axial`` or ``torsion`` False) become constraints
+    (beams and ``maps`` as for :func:`_beam_elements`; only those beams' elements are formed)."""
+    held = [i for i, beam in enumerate(beams) if not (beam.axial and beam.torsion)]
+    if not held:
+        return
+    elements = _beam_elements([beams[i] for i in held], (maps[0][held], maps[1][held]), n)
     rigid = np.broadcast_to(~elements.strain[:, None], elements.rows.shape[:3])
-    if rigid.any():
-        constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None],
-                        np.broadcast_to(elements.dofs[:, :, None], rigid.shape + (12,))[rigid],
-                        elements.rows[rigid])
+    constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None],
+                    np.broadcast_to(elements.dofs[:, :, None], rigid.shape + (12,))[rigid],
+                    elements.rows[rigid])
 
 
 def _add_springs(model, layout, strains, stiffness, constraints):
@@ -166,7 +172,8 @@ class ConstrainedParts:
         the strain operator on the full DOFs (growing :class:`_Triplets`) and
         their stiffnesses (list of arrays, N/m or N m/rad).
     rigid_mass : the bodies' 6 × 6 mass blocks on the full DOFs (triplets).
-    beams : the beams' elements on ``layout`` (:class:`_BeamElements`).
+    beam_maps : the beams' elements' full DOFs (b, n, 12) and maps to their local
+        DOFs (b, n, 12, 12) on ``layout`` (:func:`~linmstmm.fe.layout.element_maps`).
     """
 
     layout: object
@@ -176,7 +183,7 @@ class ConstrainedParts:
     spring_strains: _Triplets
     spring_stiffness: list
     rigid_mass: _Triplets
-    beams: _BeamElements
+    beam_maps: tuple
 
 
 def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
@@ -187,14 +194,14 @@ def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
     n_full = 6 * layout.n_nodes
     strains, mass, constraints = _Triplets(), _Triplets(repeats=True), _Triplets()
     stiffness = []
-    beams = _beam_elements(model, layout, elements_per_beam)
-    _add_beam_constraints(beams, constraints)
+    maps = element_maps(layout.beam_table, _beam_axes(model.beams))
+    _add_beam_constraints(model.beams, maps, elements_per_beam, constraints)
     _add_springs(model, layout, strains, stiffness, constraints)
     _add_rigid_masses(model, layout, mass)
     _add_boundaries(model, layout, constraints)
     t0, q0_dofs = _port_map(model, layout, constraints)
     t1, masters = _eliminate(reduced_constraints(constraints.compressed(n_full), t0))
-    return ConstrainedParts(layout, (t0 @ t1).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass, beams)
+    return ConstrainedParts(layout, (t0 @ t1).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass, maps)
 
 
 @dataclass(frozen=True, eq=False)
@@ -288,7 +295,7 @@ def assembled(model: Model, elements_per_beam: int) -> Assembly:
     parts = constrained_parts(model, elements_per_beam)
     T, n_full = parts.T, parts.n_full
     strains, mass, stiffness = _Triplets(), parts.rigid_mass, []
-    _add_beams(parts.beams, strains, stiffness, mass)
+    _add_beams(_beam_elements(model.beams, parts.beam_maps, elements_per_beam), strains, stiffness, mass)
     strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
     stiffness += parts.spring_stiffness
 

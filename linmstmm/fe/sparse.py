@@ -9,6 +9,12 @@ import numpy as np
 import scipy.sparse as sp
 
 
+#: Entries up to which :func:`compressed_of_summed` sums in numpy: 61 against 77 µs
+#: for scipy's conversion at 1,300 entries, 190 against 130 µs at 6,600 (a 1,000-beam
+#: chain's 1.2 million mass entries: 73 against 45 ms).
+FEW_ENTRIES = 4000
+
+
 class Compressed(NamedTuple):
     """A sparse matrix's stored entries in scipy's compressed layout, without a scipy
     object (the attributes a scipy CSR or CSC matrix has too).
@@ -62,9 +68,10 @@ def compressed_of_summed(rows: np.ndarray, cols: np.ndarray, values: np.ndarray,
     """The CSR rows scipy makes of entries that may share a position:
     ``scipy.sparse.coo_matrix((values, (rows, cols))).tocsr()``, zeros dropped.
 
-    Where no position is given more than twice it is summed here (a sum of two is
-    the same in either order); three or more are left to scipy, which sums them in
-    the order its sort leaves them.
+    Where there are few entries (FEW_ENTRIES) and no position is given more than
+    twice they are summed here (a sum of two is the same in either order); three or
+    more are left to scipy, which sums them in the order its sort leaves them, and
+    so are many entries (its conversion is linear, a sort is not).
 
     Parameters
     ----------
@@ -75,21 +82,27 @@ def compressed_of_summed(rows: np.ndarray, cols: np.ndarray, values: np.ndarray,
     -------
     Compressed, CSR of ``shape``, canonical.
     """
-    position = rows.astype(np.int64) * shape[1] + cols
-    order = np.argsort(position)
-    position = position[order]
-    if np.any(position[2:] == position[:-2]):
-        matrix = sp.coo_matrix((values, (rows, cols)), shape=shape).tocsr()
-        matrix.eliminate_zeros()
-        return Compressed("csr", matrix.indptr, matrix.indices, matrix.data, shape)
-    values = np.asarray(values, float)[order]
+    if len(rows) <= FEW_ENTRIES:
+        position = rows.astype(np.int64) * shape[1] + cols
+        order = np.argsort(position)
+        position = position[order]
+        if not np.any(position[2:] == position[:-2]):
+            return _pairs_summed(position, cols[order], np.asarray(values, float)[order], shape)
+    matrix = sp.coo_matrix((values, (rows, cols)), shape=shape).tocsr()
+    matrix.eliminate_zeros()
+    return Compressed("csr", matrix.indptr, matrix.indices, matrix.data, shape)
+
+
+def _pairs_summed(position: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> Compressed:
+    """CSR rows of entries at ascending ``position`` = row × n_cols + col, each position
+    at most twice (summed), zeros dropped."""
     repeated = np.flatnonzero(position[1:] == position[:-1])
     sums = values.copy()
     sums[repeated] += values[repeated + 1]
     kept = np.ones(len(position), bool)
     kept[repeated + 1] = False
     kept &= sums != 0
-    return _sorted_rows(position[kept], cols[order][kept], sums[kept], shape)
+    return _sorted_rows(position[kept], cols[kept], sums[kept], shape)
 
 
 def _sorted_rows(position: np.ndarray, cols: np.ndarray, values: np.ndarray, shape) -> Compressed:

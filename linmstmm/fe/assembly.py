@@ -270,7 +270,7 @@ class Assembly:
     parts : its :class:`ConstrainedParts` (layout, T, masters, n_full).
     M, K : (n_dof, n_dof) symmetric bit for bit: mass (kg, kg m²) and stiffness
         (N/m, N m/rad); dense numpy arrays where formed densely, scipy CSR otherwise
-        (:func:`~linmstmm.fe.products.scipy_csr` makes either CSR).
+        (:func:`~linmstmm.fe.sparse.scipy_csr` makes either CSR).
     G, D : natural factor ``K = G.T @ diag(D) @ G``: G (n_strain, n_dof) scipy CSR,
         D (n_strain,).
     """
@@ -302,10 +302,10 @@ def assembled(model: Model, elements_per_beam: int) -> Assembly:
     G = (strains.matrix(n_full) @ T).tocsr()
     D = np.concatenate(stiffness) if stiffness else np.zeros(0)
     mass = mass.compressed(n_full, n_full)
+    weighted = transposed(G, D)                 # Gᵀ diag(D), G's own arrays
     if small(T.shape[1], n_full):
-        M, K = (_symmetric_of_dense(product) for product in (congruence(T, mass), dense_product(transposed(G, D), G)))
+        M, K = (_symmetric_of_dense(product) for product in (congruence(T, mass), dense_product(weighted, G)))
     else:
-        weighted = transposed(G, D)
         M = symmetric_part(T.T @ scipy_csr(mass) @ T)
         K = symmetric_part(sp.csc_matrix((weighted.data, weighted.indices, weighted.indptr), shape=weighted.shape) @ G)
     return Assembly(model, parts, M, K, G, D)

@@ -55,7 +55,7 @@ def compressed_of_distinct(rows: np.ndarray, cols: np.ndarray, values: np.ndarra
     order = np.argsort(position)
     position = position[order]
     if np.any(position[1:] == position[:-1]):
-        raise ValueError("csr_of_distinct: a (row, col) position is given twice")
+        raise ValueError("compressed_of_distinct: a (row, col) position is given twice")
     return _sorted_rows(position, cols[order], np.asarray(values, float)[order], shape)
 
 

@@ -28,7 +28,13 @@ from test_fe_assembly import mixed_model
 import linmstmm.fe.products as products
 from linmstmm.fe.assembly import assemble, assembled, constrained_parts
 from linmstmm.fe.layout import _layout
-from linmstmm.fe.products import congruence, dense_product, dense_rows, rows_scaled, transposed
+from linmstmm.fe.products import (
+    congruence,
+    dense_product,
+    dense_rows,
+    rows_scaled,
+    transposed,
+)
 from linmstmm.fe.rigid_motions import _held_everywhere, _rigid_motions, rigid_mode_count
 from linmstmm.fe.sparse import compressed_of_summed, scipy_csr
 from linmstmm.model import load_model

@@ -201,7 +201,8 @@ def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
     _add_boundaries(model, layout, constraints)
     t0, q0_dofs = _port_map(model, layout, constraints)
     t1, masters = _eliminate(reduced_constraints(constraints.compressed(n_full), t0))
-    return ConstrainedParts(layout, (t0 @ t1).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass, maps)
+    return ConstrainedParts(layout, (t0 @ scipy_csr(t1)).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass,
+                            maps)
 
 
 @dataclass(frozen=True, eq=False)

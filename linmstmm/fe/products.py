@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.fe.sparse import Compressed, compressed_rows
+from linmstmm.fe.sparse import Compressed, compressed_rows, stored_entries
 
 #: Largest dense intermediate (rows × columns) for the callers that choose between
 #: :func:`dense_product` and scipy.sparse: clearing and scanning a dense result costs
@@ -45,7 +45,7 @@ def dense_product(a, b) -> np.ndarray:
     n_rows, n_cols = a.shape[0], b.shape[1]
     major = np.repeat(np.arange(len(a.indptr) - 1), np.diff(a.indptr))
     rows, inner = (major, a.indices) if a.format == "csr" else (a.indices, major)
-    entry, taken = _stored(b.indptr, inner)          # each entry of a times b's row of its k
+    entry, taken = stored_entries(b.indptr, inner)          # each entry of a times b's row of its k
     position = rows[entry] * n_cols + b.indices[taken]
     summed = np.bincount(position, a.data[entry] * b.data[taken], minlength=n_rows * n_cols)
     return summed.reshape(n_rows, n_cols)
@@ -74,25 +74,25 @@ def congruence(T, matrix) -> np.ndarray:
 
     Returns
     -------
-    numpy.ndarray, (m, m); formed through a dense (m, n) intermediate.
+    numpy.ndarray, (m, m); formed through a dense intermediate (m, the columns of
+    ``matrix`` that hold entries: the others add no term).
     """
-    return dense_product(compressed_rows(dense_product(transposed(T), matrix)), T)
+    used = np.flatnonzero(np.bincount(matrix.indices, minlength=matrix.shape[1]))
+    narrowed = Compressed("csr", matrix.indptr, np.searchsorted(used, matrix.indices), matrix.data,
+                          (matrix.shape[0], len(used)))
+    line, taken = stored_entries(T.indptr, used)                # the rows of T those columns meet
+    indptr = np.zeros(len(used) + 1, int)
+    np.cumsum(np.bincount(line, minlength=len(used)), out=indptr[1:])
+    rows = Compressed("csr", indptr, T.indices[taken], T.data[taken], (len(used), T.shape[1]))
+    return dense_product(compressed_rows(dense_product(transposed(T), narrowed)), rows)
 
 
 def dense_rows(matrix, rows: np.ndarray) -> np.ndarray:
     """``matrix[rows].toarray()`` of a CSR ``matrix``, for an int array ``rows`` of any
     shape: the result has that shape plus the column axis."""
     flat = np.ravel(rows)
-    line, taken = _stored(matrix.indptr, flat)
+    line, taken = stored_entries(matrix.indptr, flat)
     dense = np.zeros((len(flat), matrix.shape[1]))
     dense[line, matrix.indices[taken]] = matrix.data[taken]
     return dense.reshape(np.shape(rows) + (matrix.shape[1],))
 
-
-def _stored(indptr: np.ndarray, which: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The stored entries of the rows ``which`` (k,) of a compressed matrix, row after
-    row in stored order: (e,) the place in ``which`` each belongs to, and (e,) its
-    place in the matrix's ``indices`` and ``data``."""
-    lengths = np.diff(indptr)[which]
-    owner = np.repeat(np.arange(len(which)), lengths)
-    return owner, indptr[which][owner] + np.arange(len(owner)) - (np.cumsum(lengths) - lengths)[owner]

@@ -69,7 +69,7 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
             eigsh,  # imported where used: the command line starts without it
         )
 
-        from linmstmm.fe.products import scipy_csr
+        from linmstmm.fe.sparse import scipy_csr
 
         scaling, K, M = diags(scale), scipy_csr(pencil.assembly.K), scipy_csr(pencil.assembly.M)
         lam = eigsh((scaling @ K @ scaling).tocsc(), k=wanted + 1, M=(scaling @ M @ scaling).tocsc(),
@@ -118,9 +118,9 @@ class CoarsePencil:
 @functools.lru_cache(maxsize=PENCILS_KEPT)
 def coarse_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
     """The :class:`CoarsePencil` of ``model`` meshed with ``elements_per_beam``: assembled
-    on the first call for this model object (about 2 ms of a launcher's 3 ms
-    prediction), the same after (a Model cannot change; see
-    :mod:`linmstmm.compiled_model`)."""
+    on the first call for this model object (about 1.2 ms on the launcher, its
+    rigid-body modes counted, not formed), the same after (a Model cannot change;
+    see :mod:`linmstmm.compiled_model`)."""
     from linmstmm.fe.assembly import assembled
     from linmstmm.fe.rigid_motions import rigid_mode_count
 

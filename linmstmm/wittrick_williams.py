@@ -37,13 +37,13 @@ from linmstmm.determinant import resolved_engine
 from linmstmm.dynamic_stiffness import BeamTable, clamped_counts_at, dynamic_stiffnesses
 from linmstmm.fe.assembly import constrained_parts
 from linmstmm.fe.products import (
-    compressed_rows,
     congruence,
     dense_product,
     dense_rows,
     rows_scaled,
     transposed,
 )
+from linmstmm.fe.sparse import compressed_rows
 from linmstmm.model import Model
 from linmstmm.spread import spread
 
@@ -103,11 +103,11 @@ class ModeCounter:
         parts = constrained_parts(model, 1)
         T, n = parts.T, parts.T.shape[1]
         # dense, each entry summed as scipy.sparse sums it (linmstmm.fe.products)
-        springs = compressed_rows(dense_product(parts.spring_strains.matrix(parts.n_full), T))
+        springs = compressed_rows(dense_product(parts.spring_strains.compressed(parts.n_full), T))
         stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
         self.n_dof = n
         self._static = dense_product(transposed(springs), rows_scaled(springs, stiffness))
-        self._mass = congruence(T, parts.rigid_mass.matrix(parts.n_full, parts.n_full))
+        self._mass = congruence(T, parts.rigid_mass.compressed(parts.n_full, parts.n_full))
         self._beams = BeamTable.of(model.beams)
         self._maps, self._columns = _beam_maps(parts)
         self._scatter = (self._columns[:, :, None] * (n + 1) + self._columns[:, None, :]).ravel()
@@ -238,8 +238,8 @@ def _beam_maps(parts) -> tuple[np.ndarray, np.ndarray]:
     most reduced DOFs one beam touches; shorter lists are padded with the extra DOF
     n_dof and zero columns."""
     T, n = parts.T, parts.T.shape[1]
-    to_local = parts.beams.to_local[:, 0]                                # (n_beams, 12, 12)
-    rows = dense_rows(T, parts.beams.dofs[:, 0])                         # (n_beams, 12, n_dof)
+    dofs, to_local = (part[:, 0] for part in parts.beam_maps)           # (n_beams, 12), (n_beams, 12, 12)
+    rows = dense_rows(T, dofs)                                           # (n_beams, 12, n_dof)
     touched = np.any(rows != 0.0, axis=1)                                # (n_beams, n_dof)
     width = int(touched.sum(axis=1).max(initial=0))
     # each beam's touched DOFs ascending, then the padding DOF n (a stable sort of "untouched")

@@ -97,7 +97,9 @@ bounds such a mode's own error.
 Modules
 -------
 * :mod:`~linmstmm.fe.layout` — node numbering, DOF layout, sparse triplets;
-* :mod:`~linmstmm.fe.sparse` — sparse matrices built straight from distinct entries;
+* :mod:`~linmstmm.fe.sparse` — sparse matrices built straight from their entries;
+* :mod:`~linmstmm.fe.products` — small models' products formed densely, summed as
+  scipy.sparse sums them (the same matrices bit for bit, without its per-call cost);
 * :mod:`~linmstmm.fe.elements` — the frame element and its dispersion error;
 * :mod:`~linmstmm.fe.masses` — negligible masses removed;
 * :mod:`~linmstmm.fe.constraints` — master–slave constraint elimination;

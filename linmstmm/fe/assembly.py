@@ -19,9 +19,9 @@ from linmstmm.fe.layout import (
     spring_rows,
 )
 from linmstmm.fe.masses import _negligible_mass_removed
-from linmstmm.fe.products import congruence, dense_product, scipy_csr, small, transposed
+from linmstmm.fe.products import congruence, dense_product, small, transposed
 from linmstmm.fe.rigid_motions import rigid_modes
-from linmstmm.fe.sparse import csr_of_rows, symmetric_part
+from linmstmm.fe.sparse import Compressed, scipy_csr, symmetric_part
 from linmstmm.model import Model
 
 
@@ -43,11 +43,13 @@ class _BeamElements(NamedTuple):
     m: np.ndarray
 
 
-def _beam_elements(model, layout, n) -> _BeamElements:
-    """The :class:`_BeamElements` of ``model`` on ``layout`` (``n`` elements per beam)."""
-    h = np.array([beam.length for beam in model.beams], float) / n
-    rows, d, m, strain = frame_elements(model.beams, h)
-    dofs, to_local = element_maps(layout.beam_table, _beam_axes(model.beams))
+def _beam_elements(beams, maps, n) -> _BeamElements:
+    """The :class:`_BeamElements` of ``beams`` (b :class:`~linmstmm.model.Beam`, ``n``
+    elements each) whose elements' DOFs and maps to local ones are ``maps``
+    ((b, n, 12), (b, n, 12, 12); :func:`~linmstmm.fe.layout.element_maps`)."""
+    h = np.array([beam.length for beam in beams], float) / n
+    rows, d, m, strain = frame_elements(beams, h)
+    dofs, to_local = maps
     return _BeamElements(dofs, to_local, rows[:, None] @ to_local, d, strain, m)
 
 
@@ -64,13 +66,17 @@ def _add_beams(elements: _BeamElements, strains, stiffness, mass):
     mass.add(dofs[..., :, None], dofs[..., None, :], np.swapaxes(to_local, 2, 3) @ m[:, None] @ to_local)
 
 
-def _add_beam_constraints(elements: _BeamElements, constraints):
-    """Directions a beam declares rigid (``axial`` or ``torsion`` False) become constraints."""
+def _add_beam_constraints(beams, maps, n, constraints):
+    """Directions a beam declares rigid (``axial`` or ``torsion`` False) become constraints
+    (beams and ``maps`` as for :func:`_beam_elements`; only those beams' elements are formed)."""
+    held = [i for i, beam in enumerate(beams) if not (beam.axial and beam.torsion)]
+    if not held:
+        return
+    elements = _beam_elements([beams[i] for i in held], (maps[0][held], maps[1][held]), n)
     rigid = np.broadcast_to(~elements.strain[:, None], elements.rows.shape[:3])
-    if rigid.any():
-        constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None],
-                        np.broadcast_to(elements.dofs[:, :, None], rigid.shape + (12,))[rigid],
-                        elements.rows[rigid])
+    constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None],
+                    np.broadcast_to(elements.dofs[:, :, None], rigid.shape + (12,))[rigid],
+                    elements.rows[rigid])
 
 
 def _add_springs(model, layout, strains, stiffness, constraints):
@@ -146,7 +152,7 @@ def _port_map(model, layout, constraints):
     indices[indptr[kept]], data[indptr[kept]] = np.arange(len(kept)), 1.0
     held = indptr[ports[first]][..., None] + np.arange(6)                   # (p, 6, 6)
     indices[held], data[held] = column_of[centres[first]][:, None, :], kinematics[first]
-    return csr_of_rows(indptr, indices, data, (n_full, len(kept))), kept
+    return scipy_csr(Compressed("csr", indptr, indices, data, (n_full, len(kept)))), kept
 
 
 @dataclass(frozen=True, eq=False)
@@ -166,7 +172,8 @@ class ConstrainedParts:
         the strain operator on the full DOFs (growing :class:`_Triplets`) and
         their stiffnesses (list of arrays, N/m or N m/rad).
     rigid_mass : the bodies' 6 × 6 mass blocks on the full DOFs (triplets).
-    beams : the beams' elements on ``layout`` (:class:`_BeamElements`).
+    beam_maps : the beams' elements' full DOFs (b, n, 12) and maps to their local
+        DOFs (b, n, 12, 12) on ``layout`` (:func:`~linmstmm.fe.layout.element_maps`).
     """
 
     layout: object
@@ -176,7 +183,7 @@ class ConstrainedParts:
     spring_strains: _Triplets
     spring_stiffness: list
     rigid_mass: _Triplets
-    beams: _BeamElements
+    beam_maps: tuple
 
 
 def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
@@ -187,14 +194,15 @@ def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
     n_full = 6 * layout.n_nodes
     strains, mass, constraints = _Triplets(), _Triplets(repeats=True), _Triplets()
     stiffness = []
-    beams = _beam_elements(model, layout, elements_per_beam)
-    _add_beam_constraints(beams, constraints)
+    maps = element_maps(layout.beam_table, _beam_axes(model.beams))
+    _add_beam_constraints(model.beams, maps, elements_per_beam, constraints)
     _add_springs(model, layout, strains, stiffness, constraints)
     _add_rigid_masses(model, layout, mass)
     _add_boundaries(model, layout, constraints)
     t0, q0_dofs = _port_map(model, layout, constraints)
-    t1, masters = _eliminate(reduced_constraints(constraints.matrix(n_full), t0))
-    return ConstrainedParts(layout, (t0 @ t1).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass, beams)
+    t1, masters = _eliminate(reduced_constraints(constraints.compressed(n_full), t0))
+    return ConstrainedParts(layout, (t0 @ scipy_csr(t1)).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass,
+                            maps)
 
 
 @dataclass(frozen=True, eq=False)
@@ -263,7 +271,7 @@ class Assembly:
     parts : its :class:`ConstrainedParts` (layout, T, masters, n_full).
     M, K : (n_dof, n_dof) symmetric bit for bit: mass (kg, kg m²) and stiffness
         (N/m, N m/rad); dense numpy arrays where formed densely, scipy CSR otherwise
-        (:func:`~linmstmm.fe.products.scipy_csr` makes either CSR).
+        (:func:`~linmstmm.fe.sparse.scipy_csr` makes either CSR).
     G, D : natural factor ``K = G.T @ diag(D) @ G``: G (n_strain, n_dof) scipy CSR,
         D (n_strain,).
     """
@@ -288,18 +296,18 @@ def assembled(model: Model, elements_per_beam: int) -> Assembly:
     parts = constrained_parts(model, elements_per_beam)
     T, n_full = parts.T, parts.n_full
     strains, mass, stiffness = _Triplets(), parts.rigid_mass, []
-    _add_beams(parts.beams, strains, stiffness, mass)
+    _add_beams(_beam_elements(model.beams, parts.beam_maps, elements_per_beam), strains, stiffness, mass)
     strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
     stiffness += parts.spring_stiffness
 
     G = (strains.matrix(n_full) @ T).tocsr()
     D = np.concatenate(stiffness) if stiffness else np.zeros(0)
-    mass = mass.matrix(n_full, n_full)
+    mass = mass.compressed(n_full, n_full)
+    weighted = transposed(G, D)                 # Gᵀ diag(D), G's own arrays
     if small(T.shape[1], n_full):
-        M, K = (_symmetric_of_dense(product) for product in (congruence(T, mass), dense_product(transposed(G, D), G)))
+        M, K = (_symmetric_of_dense(product) for product in (congruence(T, mass), dense_product(weighted, G)))
     else:
-        weighted = transposed(G, D)
-        M = symmetric_part(T.T @ mass @ T)
+        M = symmetric_part(T.T @ scipy_csr(mass) @ T)
         K = symmetric_part(sp.csc_matrix((weighted.data, weighted.indices, weighted.indptr), shape=weighted.shape) @ G)
     return Assembly(model, parts, M, K, G, D)
 

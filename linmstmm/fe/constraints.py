@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from linmstmm.fe.products import Compressed, dense_product, small
-from linmstmm.fe.sparse import csr_of_distinct
+from linmstmm.fe.products import dense_product, small
+from linmstmm.fe.sparse import Compressed, scipy_csr, stored_entries
 
 #: A substituted constraint row whose entries all fall below this fraction of
 #: the largest term that entered it is redundant (implied by earlier rows).
@@ -15,7 +15,7 @@ REDUNDANT_CONSTRAINT = 1e-10
 NEGLIGIBLE_ENTRY = 1e-14
 
 
-def _eliminate(constraints: Compressed) -> tuple[sp.csr_matrix, np.ndarray]:
+def _eliminate(constraints: Compressed) -> tuple[Compressed, np.ndarray]:
     """Master–slave null-space basis of the rows of ``constraints``.
 
     Rows are taken one at a time, written in the current masters, and one
@@ -26,7 +26,8 @@ def _eliminate(constraints: Compressed) -> tuple[sp.csr_matrix, np.ndarray]:
 
     Returns
     -------
-    T1 : (n, n_masters) sparse; the masters' rows are identity rows.
+    T1 : (n, n_masters) CSR rows (:class:`~linmstmm.fe.sparse.Compressed`); the
+        masters' rows are identity rows.
     masters : (n_masters,) their indices, ascending.
     """
     expression = {}                     # slave -> {master: coefficient}
@@ -68,18 +69,26 @@ def _in_masters(cols: list, values: list, expression: dict) -> tuple[dict, float
     return row, scale
 
 
-def _basis(expression: dict, n: int) -> tuple[sp.csr_matrix, np.ndarray]:
-    """(n, n_masters) sparse T1 and (n_masters,) masters, ascending, from each slave's
-    ``expression`` {master: coefficient}; every other DOF is a master."""
+def _basis(expression: dict, n: int) -> tuple[Compressed, np.ndarray]:
+    """(n, n_masters) CSR rows of T1 (indices ascending) and (n_masters,) masters,
+    ascending, from each slave's ``expression`` {master: coefficient}; every other
+    DOF is a master."""
     slaves = np.array(list(expression), int)
     is_master = np.ones(n, bool)
     is_master[slaves] = False
     masters = np.flatnonzero(is_master)
     column = np.cumsum(is_master) - 1
-    uses = np.array([m for terms in expression.values() for m in terms], int)
-    rows = np.concatenate([masters, np.repeat(slaves, [len(terms) for terms in expression.values()])])
-    values = np.concatenate([np.ones(len(masters)), [v for terms in expression.values() for v in terms.values()]])
-    return csr_of_distinct(rows, np.concatenate([column[masters], column[uses]]), values, (n, len(masters))), masters
+    ordered = [sorted(terms.items()) for terms in expression.values()]     # masters ascending
+    lengths = is_master.astype(int)
+    lengths[slaves] = [len(terms) for terms in ordered]
+    indptr = np.zeros(n + 1, int)
+    np.cumsum(lengths, out=indptr[1:])
+    indices, data = np.empty(indptr[-1], int), np.empty(indptr[-1])
+    indices[indptr[masters]], data[indptr[masters]] = column[masters], 1.0
+    place = stored_entries(indptr, slaves)[1]
+    indices[place] = column[np.array([m for terms in ordered for m, _ in terms], int)]
+    data[place] = [v for terms in ordered for _, v in terms]
+    return Compressed("csr", indptr, indices, data, (n, len(masters))), masters
 
 
 def _substitute(terms, owner, slave, solved, users):
@@ -95,7 +104,7 @@ def _substitute(terms, owner, slave, solved, users):
         users.setdefault(master, set()).add(owner)
 
 
-def reduced_constraints(constraints: sp.csr_matrix, t0: sp.csr_matrix) -> Compressed:
+def reduced_constraints(constraints: Compressed, t0: sp.csr_matrix) -> Compressed:
     """``constraints @ t0`` (canonical CSR rows), less the entries below NEGLIGIBLE_ENTRY of
     their row's largest: densely where small (:mod:`linmstmm.fe.products`), the same
     entries as scipy.sparse's product."""
@@ -104,7 +113,7 @@ def reduced_constraints(constraints: sp.csr_matrix, t0: sp.csr_matrix) -> Compre
         dense = dense_product(constraints, t0)
         rows, cols = np.nonzero(dense != 0)       # (a mask: float nonzero scans several times slower)
         return _debris_dropped(rows, cols, dense[rows, cols], shape)
-    product = sp.csr_matrix(constraints @ t0)
+    product = sp.csr_matrix(scipy_csr(constraints) @ t0)
     product.sum_duplicates()                           # indices ascending
     rows = np.repeat(np.arange(shape[0]), np.diff(product.indptr))
     return _debris_dropped(rows, product.indices, product.data, shape)

@@ -8,7 +8,12 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from linmstmm.fe.sparse import csr_of_distinct, csr_of_summed
+from linmstmm.fe.sparse import (
+    Compressed,
+    compressed_of_distinct,
+    compressed_of_summed,
+    scipy_csr,
+)
 from linmstmm.model import Model
 
 
@@ -147,14 +152,18 @@ class _Triplets:
     def matrix(self, n_cols, n_rows=None) -> sp.csr_matrix:
         """(n_rows, n_cols) canonical CSR of the entries, zeros dropped (summed first
         where they repeat, in scipy's order); ``n_rows`` defaults to the rows numbered."""
+        return scipy_csr(self.compressed(n_cols, n_rows))
+
+    def compressed(self, n_cols, n_rows=None) -> Compressed:
+        """:meth:`matrix` as :class:`~linmstmm.fe.sparse.Compressed` rows (no scipy object)."""
         n_rows = self.n_rows if n_rows is None else n_rows
         if not self.rows:
-            return sp.csr_matrix((n_rows, n_cols))
+            return Compressed("csr", np.zeros(n_rows + 1, int), np.zeros(0, int), np.zeros(0), (n_rows, n_cols))
         rows, cols, values = (np.concatenate(part) for part in (self.rows, self.cols, self.values))
         if self.repeats:
-            return csr_of_summed(rows, cols, values, (n_rows, n_cols))
+            return compressed_of_summed(rows, cols, values, (n_rows, n_cols))
         nonzero = values != 0
-        return csr_of_distinct(rows[nonzero], cols[nonzero], values[nonzero], (n_rows, n_cols))
+        return compressed_of_distinct(rows[nonzero], cols[nonzero], values[nonzero], (n_rows, n_cols))
 
 
 def _spring_directions(spring, index: DofIndex, kept_only: bool):

@@ -9,7 +9,7 @@ import scipy.linalg as la
 from linmstmm.fe.constraints import NEGLIGIBLE_ENTRY, REDUNDANT_CONSTRAINT
 from linmstmm.fe.layout import spring_rows
 from linmstmm.fe.masses import MASSLESS
-from linmstmm.fe.products import scipy_csr
+from linmstmm.fe.sparse import scipy_csr
 
 
 def _edges(model, layout) -> tuple[np.ndarray, np.ndarray]:

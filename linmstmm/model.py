@@ -310,6 +310,8 @@ def _plain(value):
     """``value`` with arrays, tuples and numpy scalars turned into lists and Python scalars."""
     if isinstance(value, dict):
         return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, np.ndarray) and value.dtype != object:
+        return value.tolist()  # the same nested lists of Python scalars, formed at once
     if isinstance(value, (list, tuple, np.ndarray)):
         return [_plain(v) for v in value]
     if isinstance(value, np.generic):

@@ -151,9 +151,10 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
     # under the prediction's own value) is no zero of det: the argument principle's
     # count, with it divided out, takes it for any root missing. Where one stood, the
     # roots are kept only if the Wittrick–Williams counts alone certify them (those
-    # counts are made already); otherwise every prediction is polished.
+    # counts are made already); otherwise every prediction is polished. (None goes
+    # to the caller's search, which takes no prediction as it stands.)
     stood = not finder.last_step.keys().isdisjoint(predictions.tolist())
-    if stood and (roots is None or finder.stiffness_other_zeros(roots, None, upper) != 0):
+    if stood and roots is not None and finder.stiffness_other_zeros(roots, None, upper) != 0:
         roots, _ = _certified(finder, predictions, count, stand=False)
     return roots
 

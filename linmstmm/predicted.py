@@ -151,9 +151,10 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
     # under the prediction's own value) is no zero of det: the argument principle's
     # count, with it divided out, takes it for any root missing. Where one stood, the
     # roots are kept only if the Wittrick–Williams counts alone certify them (those
-    # counts are made already); otherwise every prediction is polished.
+    # counts are made already); otherwise every prediction is polished. (None goes
+    # to the caller's search, which takes no prediction as it stands.)
     stood = not finder.last_step.keys().isdisjoint(predictions.tolist())
-    if stood and (roots is None or finder.stiffness_other_zeros(roots, None, upper) != 0):
+    if stood and roots is not None and finder.stiffness_other_zeros(roots, None, upper) != 0:
         roots, _ = _certified(finder, predictions, count, stand=False)
     return roots
 
@@ -174,14 +175,14 @@ def _certified(finder, predictions: np.ndarray, count: int, stand: bool) -> tupl
     # The predictions not polished lie above the count's contour: divided out too,
     # they change no count but smooth its phase near the contour's upper end.
     beyond = list(predictions[wanted:])
-    upper = _gap_above(roots, count, finder.SAME_ROOT, beyond)
+    upper = _gap_above(roots, count, _same_root(finder), beyond)
     if not finder.confirm_no_other_zeros(roots + beyond, upper):
         # A root the coarse model did not predict in range (or one polished twice):
         # halve by counts to the stretch that holds it and search only there.
         roots = _repaired(finder, roots, None, upper, REPAIR_DEPTH)
         if roots is None or len(roots) < count:
             return None, np.nan
-        upper = _gap_above(roots, count, finder.SAME_ROOT, beyond)
+        upper = _gap_above(roots, count, _same_root(finder), beyond)
         if not finder.confirm_no_other_zeros(roots + beyond, upper):
             return None, np.nan
     return [r for r in roots if r <= upper], upper
@@ -263,10 +264,10 @@ def _secant_polished(finder, predictions: np.ndarray, indices: np.ndarray,
     in_cluster = _in_cluster(predictions)
     settled = np.array([not np.isnan(root) and abs(root - predictions[i]) <= 0.5 * _gap(predictions, i)
                         and step <= (finder.xtol if in_cluster[i] else finder.rtol)
-                        and not _known(root, known, finder.SAME_ROOT)
+                        and not _known(root, known, _same_root(finder))
                         for i, root, step in zip(indices, found, steps)], dtype=bool)
     for i in np.flatnonzero(settled):  # two that settled on one root: neither stands
-        twins = settled & (np.abs(found - found[i]) <= finder.SAME_ROOT * found[i])
+        twins = settled & (np.abs(found - found[i]) <= _same_root(finder) * found[i])
         if twins.sum() > 1:
             settled[twins] = False
     for root, step in zip(found[settled], steps[settled]):
@@ -295,16 +296,16 @@ def _pencil_polished(finder, roots: list[float], starts: list[float]) -> tuple[l
     root): the segment search takes the stretch around them."""
     roots, troubled, partners = list(roots), [], []
     for start, (root, offsets) in zip(starts, finder.polish(starts)):
-        if root is not None and not _known(root, roots, finder.SAME_ROOT):
+        if root is not None and not _known(root, roots, _same_root(finder)):
             roots.append(root)
             continue
-        partner = None if root is None else _partner(root, offsets, finder.SAME_ROOT)
+        partner = None if root is None else _partner(root, offsets, _same_root(finder))
         if partner is None:
             troubled.append(start)
         else:
             partners.append((start, partner))
     for (start, _), (root, _) in zip(partners, finder.polish([p for _, p in partners])):
-        if root is not None and not _known(root, roots, finder.SAME_ROOT):
+        if root is not None and not _known(root, roots, _same_root(finder)):
             roots.append(root)
         else:
             troubled.append(start)
@@ -336,7 +337,7 @@ def _deflated_polished(finder, roots: list[float], starts: list[float],
         left, this_round = [], []
         for start, root, step in zip(starts, found, steps):
             if (np.isnan(root) or step > finder.xtol or abs(root - start) > _cluster_reach(predictions, start)
-                    or _known(root, roots, NEAR_KNOWN) or _known(root, this_round, finder.SAME_ROOT)):
+                    or _known(root, roots, NEAR_KNOWN) or _known(root, this_round, _same_root(finder))):
                 left.append(start)
             else:
                 this_round.append(float(root))
@@ -378,6 +379,14 @@ def _repaired(finder, roots: list[float], lo: float, hi: float, depth: int):
     middle = float(np.sqrt(inside[len(inside) // 2 - 1] * inside[len(inside) // 2]))
     roots = _repaired(finder, roots, lo, middle, depth - 1)
     return None if roots is None else _repaired(finder, roots, middle, hi, depth - 1)
+
+
+def _same_root(finder) -> float:
+    """Relative distance within which two polished values are one root: the finder's
+    SAME_ROOT, or its xtol where that is coarser (a loose rtol polishes to rtol/100
+    only: the secant and Newton on the pencil placed one root of a random tree
+    2e-9 apart at rtol 1e-4, and it was taken twice)."""
+    return max(finder.SAME_ROOT, finder.xtol)
 
 
 def _known(root: float, roots: list[float], same: float) -> bool:

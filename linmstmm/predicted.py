@@ -299,7 +299,7 @@ def _pencil_polished(finder, roots: list[float], starts: list[float]) -> tuple[l
         if root is not None and not _known(root, roots, _same_root(finder)):
             roots.append(root)
             continue
-        partner = None if root is None else _partner(root, offsets, _same_root(finder))
+        partner = None if root is None else _partner(root, offsets, _same_root(finder), finder.NEWTON_REACH)
         if partner is None:
             troubled.append(start)
         else:
@@ -394,10 +394,11 @@ def _known(root: float, roots: list[float], same: float) -> bool:
     return any(abs(r - root) <= same * root for r in roots)
 
 
-def _partner(root: float, offsets: np.ndarray, same: float) -> float | None:
+def _partner(root: float, offsets: np.ndarray, same: float, reach: float) -> float | None:
     """The nearest other root the pencil at ``root`` sees (its smallest real offset
-    beyond ``same``, relative), or None."""
-    real = offsets[(np.abs(offsets.imag) <= 1e-6 * np.abs(offsets)) & (np.abs(offsets) > same * root)].real
+    beyond ``same`` and within ``reach``, relative), or None."""
+    real = offsets[(np.abs(offsets.imag) <= 1e-6 * np.abs(offsets)) & (np.abs(offsets) > same * root)
+                   & (np.abs(offsets) <= reach * root)].real
     return float(root - real[np.argmin(np.abs(real))]) if real.size else None
 
 

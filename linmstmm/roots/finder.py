@@ -73,6 +73,11 @@ class RootFinder:
     #: is their enclosure: :meth:`_isolate` reports them at its middle, for
     #: ``natural_frequencies`` to separate in mpmath (:attr:`unseparated`).
     CERTIFIED_WIDTH = 1e-9
+    #: A pencil offset |μ|/ω beyond this is past the linearisation's reach: a Newton
+    #: step that long is lost, and no partner root is sought there (:func:`pencil.polish`,
+    #: ``predicted._partner``). A varied model's partner at −3e16 rad/s had the compiled
+    #: kernels cut its beams into some 1e8 pieces (76 s, for a value then discarded).
+    NEWTON_REACH = 0.5
     #: Offsets |μ|/ω below this are polished as members of the same cluster.
     CLUSTER_WINDOW = 2e-3
     #: :meth:`_narrowed` evaluates this many − 1 equally spaced points per bracket and round.

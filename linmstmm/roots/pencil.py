@@ -60,7 +60,8 @@ def polish(finder, starts, iterations: int = 40, early: bool = False):
     of smallest size. Stops at |μ| <= xtol·ω, or when the steps stop
     shrinking below UNCERTAIN·ω (the rounding floor of Ū_all); gives up
     on a start whose step twice fails to shrink above that, or is twice
-    mostly imaginary and above SPLIT·ω (not near a real root).
+    mostly imaginary and above SPLIT·ω (not near a real root), or once
+    reaches beyond NEWTON_REACH·ω.
     ``early``: also stop a round sooner where convergence to a simple root
     is quadratic (:meth:`_quadratic`), for a caller that counts all its
     roots at the end (a double root whose second offset shows only within
@@ -83,6 +84,8 @@ def polish(finder, starts, iterations: int = 40, early: bool = False):
             if mu.size == 0:
                 continue
             step = abs(mu[0])
+            if step > finder.NEWTON_REACH * omega[i]:  # lost: not evaluated where it lands
+                continue
             omega[i] -= mu[0].real
             settled = step > previous[i] / 2  # no longer shrinking: the rounding floor
             converged = (step <= finder.xtol * omega[i] or (settled and step <= finder.UNCERTAIN * omega[i])

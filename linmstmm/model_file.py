@@ -239,7 +239,7 @@ def _validate(data, file):
 
     elements = {"rigid": [], "beam": [], "spring": []}
     owners = {}
-    for kind, check in (("rigid", _check_rigid), ("beam", _check_beam), ("spring", _check_spring)):
+    for kind, check in ELEMENT_CHECKS.items():
         for index, table in enumerate(top.array_of_tables(kind)):
             element = _element_table(file, kind, index, table)
             fields = check(element, points, tol)
@@ -262,14 +262,18 @@ def _validate(data, file):
             raise points_table.error(point, "point is not used by any element")
     _check_connected(file, elements, owners)
 
-    total_mass = (sum(f["mass"] for f in elements["rigid"])
-                  + sum(f["rho"] * f["A"] * f["length"] for f in elements["beam"]))
-    if not total_mass > 0:
-        raise ModelError(file, "model has no mass: every rigid body has mass 0 "
-                               "and every beam has rho = 0")
+    check_mass(file, [f["mass"] for f in elements["rigid"]],
+               [f["rho"] * f["A"] * f["length"] for f in elements["beam"]])
     return {"name": name, "description": description, "points": points,
             "rigids": elements["rigid"], "beams": elements["beam"],
             "springs": elements["spring"], "boundary": boundary, "damping": damping}
+
+
+def check_mass(file, rigid_masses, beam_masses):
+    """ModelError unless the model has mass: rigid bodies' masses and beams' ρ A L, kg."""
+    if not sum(rigid_masses) + sum(beam_masses) > 0:
+        raise ModelError(file, "model has no mass: every rigid body has mass 0 "
+                               "and every beam has rho = 0")
 
 
 def _check_connected(file, elements, labels):
@@ -491,3 +495,7 @@ def _check_damping(t):
     """(alpha, beta), each >= 0, missing ones 0."""
     t.check_keys((), ("alpha", "beta"))
     return (t.number("alpha", ">= 0", default=0.0), t.number("beta", ">= 0", default=0.0))
+
+
+#: Element kind in the file -> the check of one of its tables, (table, points, tol) -> fields.
+ELEMENT_CHECKS = {"rigid": _check_rigid, "beam": _check_beam, "spring": _check_spring}

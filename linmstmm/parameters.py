@@ -28,7 +28,7 @@ import re
 
 import numpy as np
 
-from linmstmm.model import Model, ModelError
+from linmstmm.model import Model, ModelError, with_numbers
 
 #: Element section of a key -> the Model attribute holding its records.
 SECTIONS = {"rigid": "rigids", "spring": "springs", "beam": "beams"}
@@ -205,8 +205,15 @@ def with_values(model: Model, edits: dict[Key, float]) -> Model:
         (file, element, key) if the edited model breaks the model contract,
         as :func:`linmstmm.model.load_model` would for that file.
     """
+    return with_numbers(model, *_edited_numbers(model, edits))
+
+
+def _edited_numbers(model: Model, edits: dict[Key, float]) -> tuple[dict, dict, tuple | None]:
+    """(points, changed records by name, damping) of ``model`` with ``edits``, as
+    :func:`linmstmm.model.with_numbers` takes them (unchecked)."""
     points = dict(model.points)
-    records = {record.name: record for record in model.elements}
+    original = {record.name: record for record in model.elements}
+    records = dict(original)
     damping = model.damping
     for key, value in edits.items():
         value = float(value)
@@ -223,10 +230,7 @@ def with_values(model: Model, edits: dict[Key, float]) -> Model:
     for record in model.beams:
         if moved & set(record.ends):
             records[record.name] = _beam_on(records[record.name], points)
-    return dataclasses.replace(
-        model, points=points, damping=damping,
-        **{attribute: tuple(records[r.name] for r in getattr(model, attribute))
-           for attribute in SECTIONS.values()})
+    return points, {name: record for name, record in records.items() if record is not original[name]}, damping
 
 
 def _split(text: str) -> Key | None:
@@ -280,7 +284,7 @@ def _beam_on(beam, points):
     local y made normal to the new axis (as the loader treats a file's ``y_axis``)."""
     a, b = (np.asarray(points[p], float) for p in beam.ends)
     length = float(np.linalg.norm(b - a))
-    x = (b - a) / length if length > 0 else beam.axes[0]
+    x = (b - a) / length if 0 < length < np.inf else beam.axes[0]
     y = beam.axes[1] - (beam.axes[1] @ x) * x
     if not np.linalg.norm(y) > _PARALLEL:  # the model's own check names the breach
         return dataclasses.replace(beam, length=length)

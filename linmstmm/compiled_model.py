@@ -27,6 +27,7 @@ from linmstmm.deduction import Deduction
 from linmstmm.determinant import determinant, kernels_loaded, resolved_engine
 from linmstmm.model import Model
 from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
+from linmstmm.program import forget_layouts
 from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.roots.settings import FLOOR_RATIO
 from linmstmm.topology import build_topology
@@ -116,7 +117,9 @@ def _compiled_now(model: Model, root: str | None, cut_at: tuple, engine: str) ->
 
 
 def forget_compiled_models() -> None:
-    """Drop every compiled system and coarse FE pencil kept so far: the next solve of any
-    model compiles it anew, as in a new process (the benchmarks time first solves so)."""
+    """Drop every compiled system, program walk (:func:`linmstmm.program.compile_program`)
+    and coarse FE pencil kept so far: the next solve of any model compiles it anew, as
+    in a new process (the benchmarks time first solves so)."""
     _compiled.cache_clear()
     coarse_pencil.cache_clear()
+    forget_layouts()

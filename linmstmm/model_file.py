@@ -272,8 +272,7 @@ def _validate(data, file):
 def check_mass(file, rigid_masses, beam_masses):
     """ModelError unless the model has mass: rigid bodies' masses and beams' ρ A L, kg."""
     if not sum(rigid_masses) + sum(beam_masses) > 0:
-        raise ModelError(file, "model has no mass: every rigid body has mass 0 "
-                               "and every beam has rho = 0")
+        raise ModelError(file, "model has no mass: every rigid body has mass 0 and every beam has rho = 0")
 
 
 def _check_connected(file, elements, labels):

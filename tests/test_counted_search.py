@@ -20,7 +20,7 @@ class KnownRoots:
     counter answers J(ω) for them; a cluster polish that returns the roots within
     1e-6 of where it starts, as the pencil does."""
 
-    xtol, CERTIFIED_WIDTH = 1e-14, 1e-9
+    xtol, rtol, CERTIFIED_WIDTH = 1e-14, 1e-9, 1e-9
 
     def __init__(self, roots, undecided=()):
         self.roots, self.undecided, self.last_step, self.evaluations = np.sort(roots), undecided, {}, 0
@@ -49,6 +49,17 @@ def test_simple_roots_and_a_close_pair_are_each_found_in_their_bracket():
 def test_a_double_root_comes_whole_from_the_cluster_polish():
     finder = KnownRoots([4.0, 9.0, 9.0, 15.0])
     assert counted_segment(finder, 1.0, 20.0) == pytest.approx([4.0, 9.0, 9.0, 15.0], rel=1e-13)
+
+
+def test_a_close_pair_the_pencil_merges_into_one_double_root_is_parted_by_the_counts():
+    """The pencil takes offsets below SPLIT (1e-4) for one multiple root: a cantilever's
+    pair 2.5e-6 apart came back as a double root at the lower member, the other 2.5 rtol
+    off at rtol 1e-6. The counts across it show one root within rtol: bisection parts them."""
+    pair = [9.0, 9.0 * (1 + 2.5e-6)]
+    finder = KnownRoots([4.0, *pair, 15.0])
+    finder.rtol = 1e-6
+    finder.cluster = lambda omega: [pair[0], pair[0]] if abs(omega - 9.0) < 1e-4 * 9.0 else []
+    assert counted_segment(finder, 1.0, 20.0) == pytest.approx([4.0, *pair, 15.0], rel=1e-13)
 
 
 def test_an_undecided_count_or_an_unresolved_cluster_hands_the_segment_back():

@@ -33,16 +33,13 @@ from __future__ import annotations
 import numpy as np
 
 from linmstmm.counting import deflated
+from linmstmm.secant import secant_roots
 
 #: Predictions closer than this (relative) are a cluster: a member's secant result
 #: stands only where it converged to xtol (see :func:`_secant_polished`).
 CLUSTER = 1e-3
-#: Relative size of the secant's first step (its second point).
-FIRST_STEP = 1e-7
 #: Halvings of the range by counts before a stretch that misses a root is searched whole.
 REPAIR_DEPTH = 8
-#: Secant steps before a root that has not settled is handed to the pencil.
-SECANT_STEPS = 12
 #: Rounds of the secant on det with the known roots divided out (:func:`_deflated_polished`).
 DEFLATION_ROUNDS = 3
 #: A root the deflated secant finds this close (relative) to a known one is not taken:
@@ -82,61 +79,6 @@ def _in_cluster(predictions: np.ndarray) -> np.ndarray:
     for group in _clusters(predictions):
         in_cluster[group] = len(group) > 1
     return in_cluster
-
-
-def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
-    """Simple real roots of det near ``starts`` (rad/s) by the secant method on det.
-
-    log_det : callable ω (n,) -> (sign (n,), log|det| (n,)). xtol : relative
-    step that ends the iteration; floor : a step below this (relative) that no
-    longer shrinks has reached the rounding floor of det, and is accepted with
-    that step as its uncertainty.
-    Each step evaluates det once per root still moving, all in one call;
-    det's ratio at two points is formed from the log magnitudes, so no value
-    overflows. Returns (roots, last relative steps); a root that did not
-    settle within SECANT_STEPS is NaN.
-    """
-    x_old = np.asarray(starts, dtype=float)
-    if not x_old.size:
-        return np.zeros(0), np.zeros(0)
-    x = x_old * (1 + FIRST_STEP)
-    sign_old, log_old = log_det(x_old)
-    sign, log_abs = log_det(x)
-    roots = np.full(x.size, np.nan)
-    steps = np.full(x.size, np.inf)
-    active = np.arange(x.size)
-    previous = before = np.full(x.size, np.inf)
-    for _ in range(SECANT_STEPS):
-        with np.errstate(divide="ignore", invalid="ignore"):  # sign 0: det exactly 0, x is a root
-            ratio = (sign_old / sign).real * np.exp(np.clip(log_old - log_abs, -700, 700))  # det(x_old)/det(x)
-            step = -(x - x_old) / (1 - ratio)
-        step = np.where(np.isfinite(step), step, 0.0)
-        new = x + step
-        size = np.abs(step) / np.abs(new)
-        # The secant converges superlinearly (order 1.6): after a step s_k that
-        # followed s_(k-1), the error left is about s_k^2 / s_(k-1), so a step whose
-        # square is xtol/10 of the one before needs no evaluation to confirm it.
-        # A step measures the error only while the secant converges: the first one
-        # (from two points FIRST_STEP apart, a Newton step), or one shorter than the
-        # step before, itself at most half of the one before it. From a point far
-        # off, with det there much larger, the step is short whatever the error:
-        # a step back from an overshoot is as long as the overshoot, and on a
-        # cantilever's pair 2.5e-6 apart the step of 1.4e-9 after two of 1.1e-3
-        # stopped the secant between the two roots, at det's extremum.
-        converging = ~np.isfinite(previous) | ((size < previous) & (previous <= before / 2))
-        ahead = np.where(converging & np.isfinite(previous), size * size / previous, np.inf)
-        done = (((size <= xtol) & converging) | (ahead <= xtol / 10) | ((size >= previous / 2) & (size <= floor))
-                | (sign == 0))
-        roots[active[done]] = np.where(sign[done] == 0, x[done], new[done])
-        steps[active[done]] = np.minimum(size[done], ahead[done])
-        keep = ~done
-        if not keep.any():
-            break
-        active, previous, before = active[keep], size[keep], previous[keep]
-        x_old, sign_old, log_old = x[keep], sign[keep], log_abs[keep]
-        x = new[keep]
-        sign, log_abs = log_det(x)
-    return roots, steps
 
 
 def predicted_roots(finder, predictions: np.ndarray, count: int):
@@ -242,7 +184,7 @@ def _coincident(predictions: np.ndarray, indices: np.ndarray) -> tuple[np.ndarra
     (a steel rod with Iy = Iz: its bending roots to the last digit). The secant on
     det creeps to a multiple root, where det keeps its sign, and a value that
     coincides with another prediction never stands (half the gap to it is zero):
-    the secant spent its SECANT_STEPS on each member in vain, 24 evaluations a
+    the secant spent its twelve steps on each member in vain, 24 evaluations a
     double root. A leader goes to Newton on the pencil, which converges to a
     multiple root as fast as to a simple one; its followers go to the
     Wittrick–Williams counts around it, which give its multiplicity."""

@@ -356,7 +356,7 @@ def _repaired(finder, roots: list[float], lo: float, hi: float, depth: int):
     if extra == 0:
         return roots
     lo = finder.floor if lo is None else lo
-    inside = [r for r in roots if lo < r <= hi]
+    inside = sorted({r for r in roots if lo < r <= hi})  # distinct: a count on a multiple root cannot decide
     if depth == 0 or len(inside) <= 2:
         outside = [r for r in roots if not lo < r <= hi]
         try:

@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from linmstmm.roots.certify import near_widths
+
 #: A piece narrower than this (relative) that still holds several roots is polished
 #: as a cluster on the pencil rather than halved again.
 CLUSTER_WIDTH = 1e-4
@@ -73,18 +75,23 @@ def _pieces(finder, lo: float, hi: float, below: int, above: int, depth: int) ->
 
 
 def _split_across(finder, members: list[float]) -> bool:
-    """True where the counts across a root repeated in ``members`` (rad/s) show fewer
-    than its multiplicity within the finder's rtol of it: a close pair the pencil
-    took for one multiple root (it merges offsets below SPLIT), which bisection
-    must then part. A cantilever's pair 2.5e-6 apart at rtol 1e-6 came back as a
-    double root at the lower one, the other member 2.5 rtol off. A count that
-    cannot decide keeps the members as the pencil found them."""
+    """True where the counts across a root repeated in ``members`` (rad/s), at the
+    narrowest of the certifying widths where they decide
+    (:func:`~linmstmm.roots.certify.near_widths`), show fewer than its multiplicity:
+    a close pair the pencil took for one multiple root (it merges offsets below
+    SPLIT), which bisection must then part. A cantilever's pair 2.5e-6 apart at rtol
+    1e-6 came back as a double root at the lower one, the other 2.5 rtol off; one
+    1e-6 apart at the default rtol, where the counts at ±1e-9 beside a root cannot
+    decide, 1000 rtol off. Where no width decides, the members stand as the pencil
+    found them."""
     for root in sorted(set(members)):
         multiplicity = members.count(root)
-        if multiplicity > 1:
-            below, above = finder.counter(root * (1 - finder.rtol)), finder.counter(root * (1 + finder.rtol))
-            if below is not None and above is not None and above - below < multiplicity:
-                return True
+        for width in near_widths(finder.rtol) if multiplicity > 1 else ():
+            below, above = finder.counter(root * (1 - width)), finder.counter(root * (1 + width))
+            if below is not None and above is not None:
+                if above - below < multiplicity:
+                    return True
+                break
     return False
 
 

@@ -171,23 +171,30 @@ def test_forced_cut_on_a_ring_without_boundary():
 
 def test_a_cluster_float64_cannot_separate_is_separated_in_mpmath():
     """Loops 32 at 40 modes: a root 3e-5 below another at 2663 Hz, which float64 Ū_all
-    cannot tell apart. The float64 search flags what it could not separate
-    (RootSearchResult.unseparated; the FE root lies within the radius it gives: they had come
-    back as one double root, silently, and since the bisection on the count encloses
-    such a root it is one root at an interval's middle); natural_frequencies then
-    finds it in mpmath, and all 40 agree with FE. (The predicted search's secant on
-    det itself splits the pair in float64, 1.9e-14 from FE; the flag is checked on
-    the scan-based search, which the predicted one hands over to.)"""
+    cannot tell apart. Without the Wittrick–Williams counter, the float64 search flags
+    what it could not separate (RootSearchResult.unseparated; the FE root lies within the
+    radius it gives: they had come back as one double root, silently, and since the
+    bisection on the count encloses such a root it is one root at an interval's middle);
+    natural_frequencies then finds it in mpmath. With it, the counts at the ends of the
+    small circle that tells a multiple root from a cluster part them in float64 (they
+    come from the dynamic stiffness, not from Ū_all). Either way all 40 agree with FE.
+    (The predicted search's secant on det itself splits the pair in float64, 1.9e-14
+    from FE; the flag is checked on the scan-based search, which the predicted one
+    hands over to.)"""
     from linmstmm.solve import frequency_finder
 
     model = random_model("loops", 32)
     reference = 2 * np.pi * fe_frequencies(model, count=40).frequencies_hz
     _, finder, _ = frequency_finder(model)
-    finder.predictor = None  # the scan-based search: the predicted one's secant on det splits them in float64
+    finder.predictor, finder.counter = None, None  # the scan-based search, by Ū_all alone
     search = finder.find(40, None)
     assert search.unseparated
     for root, (_, radius) in search.unseparated.items():
         assert np.min(np.abs(reference - root)) <= radius
+    _, finder, _ = frequency_finder(model)
+    finder.predictor = None
+    search = finder.find(40, None)
+    assert not search.unseparated and relative(np.array(search.roots), reference) <= AGREEMENT
     result = natural_frequencies(model, 40)
     assert result.note == ""
     assert relative(result.frequencies_hz, reference / (2 * np.pi)) <= AGREEMENT

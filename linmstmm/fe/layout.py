@@ -143,6 +143,13 @@ class _Triplets:
         self.n_rows += count
         return np.arange(first, first + count)
 
+    def copy(self) -> "_Triplets":
+        """A twin to add to: the same entries (arrays shared, never written), its own lists."""
+        twin = _Triplets(self.repeats)
+        twin.rows, twin.cols, twin.values = list(self.rows), list(self.cols), list(self.values)
+        twin.n_rows = self.n_rows
+        return twin
+
     def extend(self, other: "_Triplets"):
         """Append the rows of ``other`` after these (renumbered)."""
         for rows, cols, values in zip(other.rows, other.cols, other.values):

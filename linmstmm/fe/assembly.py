@@ -119,8 +119,8 @@ def constrained_parts(model: Model, elements_per_beam: int, nodes: NodeConstrain
     shares them among a model's meshes). Its rigid mass triplets are the parts'
     own: a caller that adds to them copies them first.
     """
-    layout = _layout(model, elements_per_beam)
     nodes = node_constraints(model) if nodes is None else nodes
+    layout = _layout(model, elements_per_beam, nodes.layout)
     maps = element_maps(layout.beam_table, _beam_axes(model.beams))
     beam_rows = _Triplets()
     _add_beam_constraints(model.beams, maps, elements_per_beam, beam_rows)

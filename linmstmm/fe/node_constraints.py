@@ -38,6 +38,8 @@ class NodeConstraints:
 
     Attributes
     ----------
+    layout : linmstmm.fe.layout._Layout
+        The points and mass centres (the layout of one element per beam).
     n_full : int
         6 per point and mass centre.
     port_map : Compressed
@@ -58,6 +60,7 @@ class NodeConstraints:
         where no beam declares a direction rigid, else None.
     """
 
+    layout: object
     n_full: int
     port_map: Compressed
     kept: np.ndarray
@@ -106,7 +109,7 @@ def node_constraints(model: Model) -> NodeConstraints:
         t0_csr = scipy_csr(t0)
         t1, masters = _eliminate(reduced_constraints(rows, t0_csr))
         elimination = ((t0_csr @ scipy_csr(t1)).tocsr(), kept[masters])
-    return NodeConstraints(n_full, t0, kept, rows, strains, stiffness, mass, elimination)
+    return NodeConstraints(layout, n_full, t0, kept, rows, strains, stiffness, mass, elimination)
 
 
 #: :func:`node_constraints` kept per model object (a Model cannot change): made on the

@@ -36,9 +36,12 @@ def equilibration(matrix: np.ndarray, sweeps: int = 4, start=None):
     cols = np.ones(matrix.shape[:-2] + matrix.shape[-1:])
     if start is not None:
         rows, cols = rows * start[0], cols * start[1]
+    weighted = rows[..., :, None] * size  # the rows' part of the scaled |a|, formed once per change of rows
+    scaled = np.empty_like(weighted)
     for _ in range(sweeps):
-        rows *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-1))
-        cols *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-2))
+        rows *= power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-1))
+        weighted = rows[..., :, None] * size
+        cols *= power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-2))
     return rows, cols
 
 

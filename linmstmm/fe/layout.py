@@ -150,7 +150,7 @@ class _Triplets:
         self.n_rows += count
         return np.arange(first, first + count)
 
-    def copy(self) -> "_Triplets":
+    def copy(self) -> _Triplets:
         """A twin to add to: the same entries (arrays shared, never written), its own lists."""
         twin = _Triplets(self.repeats)
         twin.rows, twin.cols, twin.values = list(self.rows), list(self.cols), list(self.values)

@@ -30,11 +30,9 @@ from linmstmm.fe.assembly import assemble, assembled, constrained_parts
 from linmstmm.fe.layout import _layout
 from linmstmm.fe.products import (
     congruence,
-    csr_product,
     dense_product,
     dense_rows,
     rows_scaled,
-    sparse_product,
     transposed,
 )
 from linmstmm.fe.rigid_motions import _held_everywhere, _rigid_motions, rigid_mode_count
@@ -116,27 +114,6 @@ def test_congruence_of_kept_dofs_is_scipys():
             square[touched[0], (touched[0] + 1) % n] = 1.0
         square = square.tocsr()
         assert np.array_equal(congruence(T, square), (T.T @ square @ T).toarray())
-
-
-def test_sparse_products_are_stored_as_scipy_stores_them():
-    """The product's entries, their order in each row (scipy's latest first met first)
-    and the sums that cancel exactly (left out) are scipy's, for rows in any order;
-    and so is the CSR matrix made of them, index types included."""
-    rng = np.random.default_rng(5)
-    for trial in range(300):
-        n, m, p = rng.integers(1, 30, 3)
-        a, b = random_sparse(rng, n, m, rng.uniform(0.05, 0.6)), random_sparse(rng, m, p, rng.uniform(0.05, 0.6))
-        if trial % 4 == 0:                                 # every entry cancels exactly
-            a, b = sp.hstack([a, a]).tocsr(), sp.vstack([b, -b]).tocsr()
-        if trial % 3 == 0:                                 # a product's rows are not sorted
-            a = a @ random_sparse(rng, a.shape[1], a.shape[1], 0.3)
-        reference = (a @ b).tocsr()
-        ours = sparse_product(a, b)
-        assert all(np.array_equal(x, y) for x, y in zip((ours.indptr, ours.indices, ours.data),
-                                                        (reference.indptr, reference.indices, reference.data)))
-        made = csr_product(a, b)
-        assert same_csr(made, reference) and made.indices.dtype == reference.indices.dtype
-        assert made.has_sorted_indices == reference.has_sorted_indices
 
 
 def test_products_would_differ_in_another_order():

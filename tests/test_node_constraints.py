@@ -1,7 +1,5 @@
 """The nodes' constraint elimination, made once and extended to every mesh.
 
-* the nodes' T = T0 T1, formed in numpy, is the matrix scipy.sparse's product
-  stores (entries, their order, index types);
 * the T and masters a mesh takes from its nodes' elimination (an identity block
   for the interior beam nodes) are the arrays that eliminating that mesh's
   constraints from the start gives, bit for bit, on the launchers, random
@@ -23,10 +21,8 @@ from test_fe_assembly import mixed_model
 from linmstmm.coarse_prediction import coarse_pencil
 from linmstmm.compiled_model import forget_compiled_models
 from linmstmm.fe.assembly import _add_beam_constraints
-from linmstmm.fe.constraints import _eliminate, reduced_constraints
 from linmstmm.fe.layout import _beam_axes, _layout, _Triplets, element_maps
 from linmstmm.fe.node_constraints import kept_node_constraints, node_constraints
-from linmstmm.fe.sparse import scipy_csr
 from linmstmm.model import load_model
 from linmstmm.wittrick_williams import mode_counter
 
@@ -49,21 +45,6 @@ def eliminations(model, n):
     nodes = node_constraints(model)
     return (nodes.eliminated(beam_rows, 6 * layout.n_nodes),
             replace(nodes, elimination=None).eliminated(beam_rows, 6 * layout.n_nodes))
-
-
-@pytest.mark.parametrize("name", MODELS)
-def test_nodes_elimination_is_scipys_product(name):
-    """T = T0 T1 formed in numpy (:func:`~linmstmm.fe.products.sparse_product`) is the
-    matrix scipy.sparse's product stores."""
-    model = MODELS[name]()
-    nodes = node_constraints(model)
-    if nodes.elimination is None:
-        return
-    t1, _ = _eliminate(reduced_constraints(nodes.rows, nodes.port_map))
-    reference = (scipy_csr(nodes.port_map) @ scipy_csr(t1)).tocsr()
-    T = nodes.elimination[0]
-    for ours, theirs in ((T.indptr, reference.indptr), (T.indices, reference.indices), (T.data, reference.data)):
-        assert ours.dtype == theirs.dtype and np.array_equal(ours, theirs)
 
 
 @pytest.mark.parametrize("name", MODELS)

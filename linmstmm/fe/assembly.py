@@ -18,7 +18,7 @@ from linmstmm.fe.layout import (
 )
 from linmstmm.fe.masses import _negligible_mass_removed
 from linmstmm.fe.node_constraints import NodeConstraints, node_constraints
-from linmstmm.fe.products import congruence, csr_product, dense_product, small, transposed
+from linmstmm.fe.products import congruence, dense_product, small, transposed
 from linmstmm.fe.rigid_motions import rigid_modes
 from linmstmm.fe.sparse import scipy_csr, symmetric_part
 from linmstmm.model import Model
@@ -228,7 +228,7 @@ def assembled(model: Model, elements_per_beam: int, constraints_of=node_constrai
     strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
     stiffness += parts.spring_stiffness
 
-    G = csr_product(strains.compressed(n_full), T)
+    G = (strains.matrix(n_full) @ T).tocsr()
     D = np.concatenate(stiffness) if stiffness else np.zeros(0)
     mass = mass.compressed(n_full, n_full)
     weighted = transposed(G, D)                 # Gᵀ diag(D), G's own arrays

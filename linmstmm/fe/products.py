@@ -12,9 +12,8 @@ adds them with :func:`numpy.bincount`, which adds in the order given.
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 
-from linmstmm.fe.sparse import Compressed, compressed_rows, scipy_csr, stored_entries
+from linmstmm.fe.sparse import Compressed, compressed_rows, stored_entries
 
 #: Largest dense intermediate (rows × columns) for the callers that choose between
 #: :func:`dense_product` and scipy.sparse: clearing and scanning a dense result costs
@@ -50,56 +49,6 @@ def dense_product(a, b) -> np.ndarray:
     position = rows[entry] * n_cols + b.indices[taken]
     summed = np.bincount(position, a.data[entry] * b.data[taken], minlength=n_rows * n_cols)
     return summed.reshape(n_rows, n_cols)
-
-
-def sparse_product(a, b) -> Compressed:
-    """``a @ b`` of CSR matrices as scipy.sparse stores it, without a scipy object.
-
-    scipy forms row i of the product by running through ``a``'s row i in stored
-    order and, for each of its entries, ``b``'s row of that index: each entry a
-    running sum from zero in that order (as :func:`dense_product` sums it), the
-    row's columns stored latest first met first, entries whose sum is exactly
-    zero left out.
-
-    Parameters
-    ----------
-    a : (n, m) scipy CSR matrix or :class:`Compressed` CSR. b : (m, p) the same.
-
-    Returns
-    -------
-    Compressed, CSR (n, p): scipy's indptr, indices (in its order) and data.
-    """
-    n_rows, n_cols = a.shape[0], b.shape[1]
-    lines = np.repeat(np.arange(n_rows), np.diff(a.indptr))
-    entry, taken = stored_entries(b.indptr, a.indices)
-    position = lines[entry] * n_cols + b.indices[taken]
-    sums = np.bincount(position, a.data[entry] * b.data[taken], minlength=n_rows * n_cols)
-    met, first = np.unique(position, return_index=True)       # each position and the term that first met it
-    row = met // n_cols
-    order = np.lexsort((-first, row))                          # by row, latest first met first
-    order = order[sums[met[order]] != 0]
-    indptr = np.zeros(n_rows + 1, int)
-    np.cumsum(np.bincount(row[order], minlength=n_rows), out=indptr[1:])
-    data = sums[met[order]].astype(float, copy=False)          # (bincount of no terms is int)
-    return Compressed("csr", indptr, met[order] % n_cols, data, (n_rows, n_cols))
-
-
-def csr_product(a, b) -> sp.csr_matrix:
-    """``(a @ b).tocsr()`` of CSR matrices (scipy or :class:`Compressed`): by
-    :func:`sparse_product` where the result is small (:func:`small`), by scipy.sparse
-    otherwise; the same arrays either way.
-
-    Parameters
-    ----------
-    a : (n, m) CSR. b : (m, p) CSR.
-
-    Returns
-    -------
-    scipy.sparse.csr_matrix, (n, p).
-    """
-    if small(a.shape[0], b.shape[1]):
-        return scipy_csr(sparse_product(a, b), sorted_rows=False)
-    return (scipy_csr(a) @ scipy_csr(b)).tocsr()
 
 
 def rows_scaled(matrix, factors: np.ndarray) -> Compressed:

@@ -131,21 +131,18 @@ def stored_entries(indptr: np.ndarray, which: np.ndarray) -> tuple[np.ndarray, n
     return owner, indptr[which][owner] + np.arange(len(owner)) - (np.cumsum(lengths) - lengths)[owner]
 
 
-def scipy_csr(matrix, sorted_rows: bool = True) -> sp.csr_matrix:
-    """The scipy CSR matrix of a dense array, of a CSR :class:`Compressed`, or of a scipy
-    sparse matrix (itself if CSR). The index arrays are made of the type scipy would
-    choose, once, here.
+def scipy_csr(matrix) -> sp.csr_matrix:
+    """The scipy CSR matrix of a dense array, of a CSR :class:`Compressed` whose indices
+    ascend in each row, or of a scipy sparse matrix (itself if CSR). The index arrays
+    are made of the type scipy would choose, once, here.
 
     Parameters
     ----------
     matrix : numpy.ndarray (n, p), Compressed or scipy sparse.
-    sorted_rows : bool
-        Whether a Compressed ``matrix``'s indices ascend in each row (then the result
-        is flagged so); False leaves scipy to find out, as for its own products.
 
     Returns
     -------
-    scipy.sparse.csr_matrix
+    scipy.sparse.csr_matrix, flagged as having sorted indices where made here.
     """
     if isinstance(matrix, np.ndarray):
         matrix = compressed_rows(matrix)
@@ -154,8 +151,7 @@ def scipy_csr(matrix, sorted_rows: bool = True) -> sp.csr_matrix:
     index = np.int32 if max(matrix.shape[1], len(matrix.data)) < 2 ** 31 else np.int64
     csr = sp.csr_matrix((matrix.data, matrix.indices.astype(index, copy=False),
                          matrix.indptr.astype(index, copy=False)), shape=matrix.shape)
-    if sorted_rows:
-        csr.has_sorted_indices = True
+    csr.has_sorted_indices = True
     return csr
 
 

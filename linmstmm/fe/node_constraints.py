@@ -77,6 +77,8 @@ class NodeConstraints:
         interior = np.arange(self.n_full, n_full)
         if not beam_rows.n_rows and self.elimination is not None:
             T, masters = self.elimination
+            if not interior.size:       # the nodes themselves (one element per beam)
+                return T, masters
             return _with_identity(T, len(interior)), np.concatenate([masters, interior])
         t0 = scipy_csr(_with_identity(self.port_map, len(interior)))
         t1, masters = _eliminate(reduced_constraints(_stacked(beam_rows.compressed(n_full), self.rows), t0))

@@ -149,7 +149,8 @@ def _pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
     K, M = (matrix if isinstance(matrix, np.ndarray) else matrix.toarray() for matrix in (fe.K, fe.M))
     size = np.where(np.diag(M) > 0, np.diag(M), np.abs(np.diag(K)))
     scale = 1 / np.sqrt(np.where(size > 0, size, 1.0))
-    K, M = K * np.outer(scale, scale), M * np.outer(scale, scale)
+    both = np.outer(scale, scale)
+    K, M = K * both, M * both
     for matrix in (K, M):
         matrix.setflags(write=False)  # shared by every prediction of this model
     rigid = rigid_mode_count(fe.model, fe.parts.layout, fe.parts.masters, fe.M)

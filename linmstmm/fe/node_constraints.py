@@ -71,9 +71,23 @@ class NodeConstraints:
     elimination: tuple | None
 
     def eliminated(self, beam_rows: _Triplets, n_full: int) -> tuple[sp.csr_matrix, np.ndarray]:
-        """(T (n_full, n_dof) scipy CSR, masters (n_dof,)) of a mesh of ``n_full`` DOFs
-        whose beams add the constraint rows ``beam_rows`` (taken before the nodes'
-        ones): the same arrays as eliminating that mesh's constraints anew."""
+        """The elimination of a mesh's constraints: the same arrays as eliminating them anew.
+
+        Parameters
+        ----------
+        beam_rows : linmstmm.fe.layout._Triplets
+            The constraint rows the mesh's beams add (directions a beam declares
+            rigid), on its full DOFs; taken before the nodes' rows.
+        n_full : int
+            The mesh's full DOFs: these nodes' ``n_full``, then 6 per interior beam node.
+
+        Returns
+        -------
+        T : scipy.sparse.csr_matrix, shape (n_full, n_dof)
+            The full vector is ``T @ q``.
+        masters : numpy.ndarray, shape (n_dof,)
+            The full DOFs kept as the reduced ones, ascending.
+        """
         interior = np.arange(self.n_full, n_full)
         if not beam_rows.n_rows and self.elimination is not None:
             T, masters = self.elimination

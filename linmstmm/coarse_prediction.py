@@ -17,6 +17,7 @@ import numpy as np
 import scipy.linalg
 
 from linmstmm.elements.beam import bending_wavenumber
+from linmstmm.fe.node_constraints import kept_node_constraints
 from linmstmm.model import Model
 
 #: Radians of a bending wave per element of the predicting mesh: its frequencies are
@@ -115,24 +116,54 @@ class CoarsePencil:
     scale: np.ndarray
 
 
-@functools.lru_cache(maxsize=PENCILS_KEPT)
 def coarse_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
     """The :class:`CoarsePencil` of ``model`` meshed with ``elements_per_beam``: assembled
-    on the first call for this model object (about 1.2 ms on the launcher, its
-    rigid-body modes counted, not formed), the same after (a Model cannot change;
-    see :mod:`linmstmm.compiled_model`)."""
+    on the first call for this model object (its nodes' constraints eliminated once
+    for this and the Wittrick–Williams counter's mesh,
+    :func:`~linmstmm.fe.node_constraints.kept_node_constraints`; its rigid-body
+    modes counted, not formed), the same after (a Model cannot change; see
+    :mod:`linmstmm.compiled_model`). ``coarse_pencil.cache_clear()`` drops every
+    pencil and every node elimination kept.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    elements_per_beam : int
+        Hermite elements per beam, >= 1.
+
+    Returns
+    -------
+    CoarsePencil
+    """
+    return _pencil(model, elements_per_beam)
+
+
+@functools.lru_cache(maxsize=PENCILS_KEPT)
+def _pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
+    """:func:`coarse_pencil` made anew."""
     from linmstmm.fe.assembly import assembled
     from linmstmm.fe.rigid_motions import rigid_mode_count
 
-    fe = assembled(model, elements_per_beam)
+    fe = assembled(model, elements_per_beam, kept_node_constraints)
     K, M = (matrix if isinstance(matrix, np.ndarray) else matrix.toarray() for matrix in (fe.K, fe.M))
     size = np.where(np.diag(M) > 0, np.diag(M), np.abs(np.diag(K)))
     scale = 1 / np.sqrt(np.where(size > 0, size, 1.0))
-    K, M = K * np.outer(scale, scale), M * np.outer(scale, scale)
+    both = np.outer(scale, scale)
+    K, M = K * both, M * both
     for matrix in (K, M):
         matrix.setflags(write=False)  # shared by every prediction of this model
     rigid = rigid_mode_count(fe.model, fe.parts.layout, fe.parts.masters, fe.M)
     return CoarsePencil(fe, rigid, K, M, scale)
+
+
+def _forget_pencils() -> None:
+    """Drop every coarse pencil and node elimination kept (:func:`coarse_pencil`)."""
+    _pencil.cache_clear()
+    kept_node_constraints.cache_clear()
+
+
+coarse_pencil.cache_clear = _forget_pencils
 
 
 def _finest_mesh(model: Model) -> int:

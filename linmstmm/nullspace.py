@@ -36,13 +36,16 @@ def equilibration(matrix: np.ndarray, sweeps: int = 4, start=None):
     cols = np.ones(matrix.shape[:-2] + matrix.shape[-1:])
     if start is not None:
         rows, cols = rows * start[0], cols * start[1]
+    weighted = rows[..., :, None] * size  # the rows' part of the scaled |a|, formed once per change of rows
+    scaled = np.empty_like(weighted)
     for _ in range(sweeps):
-        rows *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-1))
-        cols *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-2))
+        rows *= power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-1))
+        weighted = rows[..., :, None] * size
+        cols *= power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-2))
     return rows, cols
 
 
-def own_units_start(deduction):
+def own_units_start(deduction, frequency: float | None = None):
     """The scales that write Ū_all in the model's own units, to start :func:`equilibration` from.
 
     Each row and unknown of the plain Ū_all is divided, or multiplied, by the
@@ -59,6 +62,9 @@ def own_units_start(deduction):
     ----------
     deduction : linmstmm.deduction.Deduction
         The deduced system, as it stands (less released unknowns).
+    frequency : float, optional
+        rad/s, the lowest of its :func:`characteristic_frequencies` where the
+        caller has them already (found here otherwise).
 
     Returns
     -------
@@ -67,7 +73,9 @@ def own_units_start(deduction):
     cols : numpy.ndarray, shape (N,)
         Size of each unknown's kind (m, rad, N m or N in the model's units).
     """
-    sizes = unit_sizes(deduction.topology, min(characteristic_frequencies(deduction.topology)))
+    if frequency is None:
+        frequency = min(characteristic_frequencies(deduction.topology))
+    sizes = unit_sizes(deduction.topology, frequency)
     row_kinds, column_kinds = deduction.kinds()
     return 1 / sizes[row_kinds], sizes[column_kinds]
 
@@ -198,17 +206,22 @@ def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINAT
     """
     if probe is None and _statically_determinate(deduction.topology):
         return 0
-    if probe is None:  # the first scale whose probes can be read
-        scales = characteristic_frequencies(deduction.topology)
-        for scale in scales[:-1]:
-            try:
-                with np.errstate(over="ignore", invalid="ignore"):  # an overflowing scale is the next one's turn
-                    return release_indeterminate(deduction, np.asarray(PROBES) * scale, screen=screen)
-            except (RuntimeError, np.linalg.LinAlgError):
-                continue
-        probe = np.asarray(PROBES) * scales[-1]
-    probe = np.asarray(probe, dtype=float)
-    start = own_units_start(deduction)
+    scales = characteristic_frequencies(deduction.topology)
+    start = own_units_start(deduction, min(scales))   # the same for every probe: made once
+    if probe is not None:
+        return _released_at(deduction, np.asarray(probe, dtype=float), tolerance, screen, start)
+    for scale in scales[:-1]:  # the first scale whose probes can be read
+        try:
+            with np.errstate(over="ignore", invalid="ignore"):  # an overflowing scale is the next one's turn
+                return _released_at(deduction, np.asarray(PROBES) * scale, tolerance, screen, start)
+        except (RuntimeError, np.linalg.LinAlgError):
+            continue
+    return _released_at(deduction, np.asarray(PROBES) * scales[-1], tolerance, screen, start)
+
+
+def _released_at(deduction, probe: np.ndarray, tolerance: float, screen, start) -> int:
+    """:func:`release_indeterminate` at the frequencies ``probe`` (rad/s), balancing from
+    ``start`` (:func:`own_units_start`)."""
     if screen is not None and _clearly_regular(screen(probe), SCREEN_MARGIN * tolerance, start):
         return 0
     samples = deduction.matrix(probe)
@@ -224,7 +237,7 @@ def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINAT
         if (np.abs(sample @ right_null).max() > 1e-9 * scale
                 or np.abs(left_null.T @ sample).max() > 1e-9 * scale):
             if tolerance > ROUNDING_TOLERANCE:
-                return release_indeterminate(deduction, probe, ROUNDING_TOLERANCE)
+                return _released_at(deduction, probe, ROUNDING_TOLERANCE, None, start)
             raise RuntimeError("Ū_all is singular at every frequency with a null space that "
                                "moves with frequency: the model has a mechanism")
     released_columns = scipy.linalg.qr(right_null.T, pivoting=True)[2][:r]

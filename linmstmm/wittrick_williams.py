@@ -36,6 +36,7 @@ import scipy.linalg.lapack as lapack
 from linmstmm.determinant import resolved_engine
 from linmstmm.dynamic_stiffness import BeamTable, clamped_counts_at, dynamic_stiffnesses
 from linmstmm.fe.assembly import constrained_parts
+from linmstmm.fe.node_constraints import kept_node_constraints
 from linmstmm.fe.products import (
     congruence,
     dense_product,
@@ -100,7 +101,7 @@ class ModeCounter:
 
     def __init__(self, model: Model, engine: str = "auto"):
         self.engine = resolved_engine(engine)
-        parts = constrained_parts(model, 1)
+        parts = constrained_parts(model, 1, kept_node_constraints(model))  # shared with the coarse predictions
         T, n = parts.T, parts.T.shape[1]
         # dense, each entry summed as scipy.sparse sums it (linmstmm.fe.products)
         springs = compressed_rows(dense_product(parts.spring_strains.compressed(parts.n_full), T))
@@ -110,7 +111,6 @@ class ModeCounter:
         self._mass = congruence(T, parts.rigid_mass.compressed(parts.n_full, parts.n_full))
         self._beams = BeamTable.of(model.beams)
         self._maps, self._columns = _beam_maps(parts)
-        self._scatter = (self._columns[:, :, None] * (n + 1) + self._columns[:, None, :]).ravel()
         self._answers: dict[float, int | None] = {}
         self._table = None  # the beams as the compiled kernels take them, on their first call
         self._scratch = None  # this counter's own buffers for the compiled kernel, on its first call
@@ -222,7 +222,8 @@ class ModeCounter:
         local = dynamic_stiffnesses(self._beams, omegas)                 # (m, n_beams, 12, 12)
         parts = np.swapaxes(self._maps, 1, 2) @ local @ self._maps       # (m, n_beams, k, k)
         size = self.n_dof + 1                                            # + a row for padding
-        scatter = (self._scatter + size * size * np.arange(omegas.size)[:, None]).ravel()
+        scatter = (self._columns[:, :, None] * size + self._columns[:, None, :]).ravel()   # the beams' places in D
+        scatter = (scatter + size * size * np.arange(omegas.size)[:, None]).ravel()
         length = omegas.size * size * size
         beams = np.bincount(scatter, parts.ravel(), minlength=length).reshape(-1, size, size)
         magnitude = np.bincount(scatter, np.abs(parts).ravel(), minlength=length).reshape(-1, size, size)

@@ -86,6 +86,36 @@ def test_products_are_summed_as_scipy_sums_them():
         assert np.array_equal(dense_rows(unsorted, rows), unsorted[rows.ravel()].toarray().reshape(3, 4, m))
 
 
+def test_congruence_of_kept_dofs_is_scipys():
+    """A congruence whose T keeps every DOF the matrix touches as it is (one 1.0 in a
+    column of its own) moves the matrix's entries; T that joins two of them, scales
+    one or slaves one to others, and a matrix with entries off those rows, take the
+    general route. Each is scipy's product, entry for entry."""
+    rng = np.random.default_rng(4)
+    for trial in range(300):
+        n, m = rng.integers(8, 40), rng.integers(4, 30)
+        T = random_sparse(rng, n, m, 0.2).tolil()
+        touched = rng.choice(n, rng.integers(1, min(n, m) + 1), replace=False)
+        columns = rng.choice(m, touched.size, replace=False)
+        for dof, column in zip(touched, columns):
+            T[dof, :] = 0.0
+            T[dof, column] = 1.0
+        if trial % 4 == 1:                                  # two DOFs moved to one column
+            T[touched[0], :] = T[touched[-1], :]
+        if trial % 4 == 2:                                  # one scaled, or slaved to several
+            T[touched[0], columns[0]] = rng.choice([2.0, -1.0])
+            T[touched[0], (columns[0] + 1) % m] = rng.standard_normal()
+        T = T.tocsr()
+        T.eliminate_zeros()
+        square = sp.lil_matrix((n, n))
+        block = random_sparse(rng, touched.size, touched.size, 0.6).toarray()
+        square[np.ix_(touched, touched)] = block + block.T
+        if trial % 4 == 3:                                  # an entry on a DOF T does not keep
+            square[touched[0], (touched[0] + 1) % n] = 1.0
+        square = square.tocsr()
+        assert np.array_equal(congruence(T, square), (T.T @ square @ T).toarray())
+
+
 def test_products_would_differ_in_another_order():
     """The comparisons above can fail: a dense BLAS product rounds otherwise."""
     rng = np.random.default_rng(2)

@@ -22,6 +22,7 @@ from linmstmm.deduction import Deduction
 from linmstmm.determinant import CompiledDeterminant
 from linmstmm.model import load_model
 from linmstmm.nullspace import PROBES, characteristic_frequencies, equilibration, release_indeterminate
+from linmstmm.numeric import power_of_two_scale
 from linmstmm.solve import natural_frequencies
 from linmstmm.topology import build_topology
 
@@ -144,3 +145,23 @@ def test_a_program_compiled_before_a_release_is_not_used_after_it():
     compiled, reference = (natural_frequencies(model, 6, engine=engine) for engine in ("compiled", "numpy"))
     assert compiled.indeterminate_released == reference.indeterminate_released == 1
     np.testing.assert_allclose(compiled.frequencies_hz, reference.frequencies_hz, rtol=1e-10)
+
+
+def test_equilibration_is_the_plain_sweeps():
+    """The balance equals the plain sweeps it is written for (the rows' part of each
+    product formed once per change of rows): the same scales, bit for bit."""
+    def plain(matrix, sweeps, start):
+        size = np.abs(matrix)
+        rows, cols = np.ones(matrix.shape[:-1]) * start[0], np.ones(matrix.shape[:-2] + matrix.shape[-1:]) * start[1]
+        for _ in range(sweeps):
+            rows *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-1))
+            cols *= power_of_two_scale((rows[..., :, None] * size * cols[..., None, :]).max(axis=-2))
+        return rows, cols
+
+    rng = np.random.default_rng(7)
+    for trial in range(400):
+        shape = tuple(rng.integers(1, 30, 2)) if trial % 2 else (3, *rng.integers(1, 30, 2))
+        matrix = rng.standard_normal(shape) * 10.0 ** rng.integers(-150, 150, shape) * (rng.random(shape) < 0.6)
+        start = (rng.uniform(1e-5, 1e5, shape[:-1]), rng.uniform(1e-5, 1e5, shape[:-2] + shape[-1:]))
+        for ours, theirs in zip(equilibration(matrix, start=start), plain(matrix, 4, start)):
+            assert np.array_equal(ours, theirs)

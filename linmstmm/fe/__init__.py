@@ -103,6 +103,9 @@ Modules
 * :mod:`~linmstmm.fe.elements` — the frame element and its dispersion error;
 * :mod:`~linmstmm.fe.masses` — negligible masses removed;
 * :mod:`~linmstmm.fe.constraints` — master–slave constraint elimination;
+* :mod:`~linmstmm.fe.node_constraints` — the springs, boundaries, ports and rigid
+  masses on the model's nodes and their constraints' elimination, made once per
+  model and extended to any mesh;
 * :mod:`~linmstmm.fe.rigid_motions` — rigid-body modes counted structurally;
 * :mod:`~linmstmm.fe.assembly` — :class:`FEModel` and :func:`assemble`;
 * :mod:`~linmstmm.fe.flexibility` — K⁺ by the mixed system, static displacements;

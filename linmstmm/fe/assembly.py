@@ -8,7 +8,6 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from linmstmm.fe.constraints import _eliminate, reduced_constraints
 from linmstmm.fe.elements import frame_elements
 from linmstmm.fe.layout import (
     DofIndex,
@@ -16,12 +15,12 @@ from linmstmm.fe.layout import (
     _layout,
     _Triplets,
     element_maps,
-    spring_rows,
 )
 from linmstmm.fe.masses import _negligible_mass_removed
+from linmstmm.fe.node_constraints import NodeConstraints, node_constraints
 from linmstmm.fe.products import congruence, dense_product, small, transposed
 from linmstmm.fe.rigid_motions import rigid_modes
-from linmstmm.fe.sparse import Compressed, scipy_csr, symmetric_part
+from linmstmm.fe.sparse import scipy_csr, symmetric_part
 from linmstmm.model import Model
 
 
@@ -79,82 +78,6 @@ def _add_beam_constraints(beams, maps, n, constraints):
                     elements.rows[rigid])
 
 
-def _add_springs(model, layout, strains, stiffness, constraints):
-    """Finite spring directions become strains, ``inf`` ones constraints, released ones nothing
-    (each kind written as one block of rows, in the springs' order)."""
-    owners, components, cols, values = spring_rows(model.springs, layout.index, kept_only=True)
-    k = np.array([spring.k for spring in model.springs], float).reshape(-1, 6)[owners, components]
-    rigid = np.isinf(k)
-    strains.add(strains.new_rows(np.count_nonzero(~rigid))[:, None], cols[~rigid], values[~rigid])
-    stiffness.append(k[~rigid])
-    constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None], cols[rigid], values[rigid])
-
-
-def _add_rigid_masses(model, layout, mass):
-    """Each body's mass and inertia on the DOFs of its mass centre."""
-    dofs = 6 * np.array([layout.index.rigids[body.name] for body in model.rigids], int)[:, None] + np.arange(6)
-    blocks = np.zeros((len(dofs), 6, 6))
-    blocks[:, [0, 1, 2], [0, 1, 2]] = np.array([body.mass for body in model.rigids], float)[:, None]
-    blocks[:, 3:, 3:] = np.array([body.inertia for body in model.rigids], float).reshape(-1, 3, 3)
-    mass.add(dofs[:, :, None], dofs[:, None, :], blocks)
-
-
-def _add_boundaries(model, layout, constraints):
-    """Every fixed component of a point becomes a constraint row of its own."""
-    dofs = [layout.index.point(point)[np.asarray(fixed, bool)] for point, fixed in model.boundary.items()]
-    dofs = np.concatenate(dofs) if dofs else np.zeros(0, int)
-    constraints.add(constraints.new_rows(len(dofs)), dofs, 1.0)
-
-
-def _port_kinematics(ports, centres) -> np.ndarray:
-    """(p, 6, 6) maps body-centre DOFs -> port DOFs: u_p = u_c + θ × (p − c), θ_p = θ.
-
-    ports, centres : (p, 3) positions of the ports and of their bodies' mass centres, m.
-    """
-    r = ports - centres
-    cross = np.zeros((len(r), 3, 3))
-    cross[:, [0, 0, 1, 1, 2, 2], [1, 2, 0, 2, 0, 1]] = np.stack([-r[:, 2], r[:, 1], r[:, 2], -r[:, 0],
-                                                               -r[:, 1], r[:, 0]], axis=1)
-    block = np.zeros((len(r), 6, 6))
-    block[:, np.arange(6), np.arange(6)] = 1.0
-    block[:, :3, 3:] = -cross
-    return block
-
-
-def _port_map(model, layout, constraints):
-    """Sparse T0 (full x q0): each port moves with the first body that owns it.
-
-    A point that is a port of several bodies gets six constraint rows per
-    further body (the bodies are rigidly joined there).
-    """
-    n_full = 6 * layout.n_nodes
-    bodies = [(body, port) for body in model.rigids for port in body.ports]
-    owned = {}
-    first = np.array([owned.setdefault(port, i) == i for i, (_, port) in enumerate(bodies)], bool)
-    port_nodes = np.array([layout.index.points[port] for _, port in bodies], int)
-    centre_nodes = np.array([layout.index.rigids[body.name] for body, _ in bodies], int)
-    ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
-    kinematics = _port_kinematics(layout.positions[port_nodes], layout.positions[centre_nodes])
-    if not first.all():
-        joined = constraints.new_rows(6 * np.count_nonzero(~first)).reshape(-1, 6, 1)
-        constraints.add(joined, ports[~first][:, None, :], np.eye(6))
-        constraints.add(joined, centres[~first][:, None, :], -kinematics[~first])
-    slaved = np.zeros(n_full, bool)
-    slaved[ports[first]] = True
-    kept = np.flatnonzero(~slaved)
-    column_of = np.full(n_full, -1)
-    column_of[kept] = np.arange(len(kept))
-    # rows in order: a slaved port DOF holds its body's six centre DOFs (columns
-    # ascending, zeros kept), every other DOF itself
-    indptr = np.zeros(n_full + 1, int)
-    np.cumsum(np.where(slaved, 6, 1), out=indptr[1:])
-    indices, data = np.empty(indptr[-1], int), np.empty(indptr[-1])
-    indices[indptr[kept]], data[indptr[kept]] = np.arange(len(kept)), 1.0
-    held = indptr[ports[first]][..., None] + np.arange(6)                   # (p, 6, 6)
-    indices[held], data[held] = column_of[centres[first]][:, None, :], kinematics[first]
-    return scipy_csr(Compressed("csr", indptr, indices, data, (n_full, len(kept)))), kept
-
-
 @dataclass(frozen=True, eq=False)
 class ConstrainedParts:
     """The nodes and exact constraints of a meshed model, with the parts that are
@@ -186,23 +109,25 @@ class ConstrainedParts:
     beam_maps: tuple
 
 
-def constrained_parts(model: Model, elements_per_beam: int) -> ConstrainedParts:
+def constrained_parts(model: Model, elements_per_beam: int, nodes: NodeConstraints | None = None) -> ConstrainedParts:
     """Lay out ``model`` with ``elements_per_beam`` elements per beam, eliminate its
     constraints, and collect its springs and rigid masses (the beams' own
-    stiffness and mass are left to the caller)."""
-    layout = _layout(model, elements_per_beam)
-    n_full = 6 * layout.n_nodes
-    strains, mass, constraints = _Triplets(), _Triplets(repeats=True), _Triplets()
-    stiffness = []
+    stiffness and mass are left to the caller).
+
+    nodes : the :class:`~linmstmm.fe.node_constraints.NodeConstraints` of ``model``
+    (made here by default; :func:`~linmstmm.fe.node_constraints.kept_node_constraints`
+    shares them among a model's meshes). Its rigid mass triplets are the parts'
+    own: a caller that adds to them copies them first.
+    """
+    nodes = node_constraints(model) if nodes is None else nodes
+    layout = _layout(model, elements_per_beam, nodes.layout)
     maps = element_maps(layout.beam_table, _beam_axes(model.beams))
-    _add_beam_constraints(model.beams, maps, elements_per_beam, constraints)
-    _add_springs(model, layout, strains, stiffness, constraints)
-    _add_rigid_masses(model, layout, mass)
-    _add_boundaries(model, layout, constraints)
-    t0, q0_dofs = _port_map(model, layout, constraints)
-    t1, masters = _eliminate(reduced_constraints(constraints.compressed(n_full), t0))
-    return ConstrainedParts(layout, (t0 @ scipy_csr(t1)).tocsr(), q0_dofs[masters], n_full, strains, stiffness, mass,
-                            maps)
+    beam_rows = _Triplets()
+    _add_beam_constraints(model.beams, maps, elements_per_beam, beam_rows)
+    n_full = 6 * layout.n_nodes
+    T, masters = nodes.eliminated(beam_rows, n_full)
+    return ConstrainedParts(layout, T, masters, n_full, nodes.spring_strains, nodes.spring_stiffness,
+                            nodes.rigid_mass, maps)
 
 
 @dataclass(frozen=True, eq=False)
@@ -284,18 +209,21 @@ class Assembly:
     D: np.ndarray
 
 
-def assembled(model: Model, elements_per_beam: int) -> Assembly:
+def assembled(model: Model, elements_per_beam: int, constraints_of=node_constraints) -> Assembly:
     """The :class:`Assembly` of ``model`` with ``elements_per_beam`` (int >= 1) equal
-    elements per beam.
+    elements per beam; ``constraints_of`` (Model -> NodeConstraints) gives the
+    constraints of its nodes (made anew by default, the kept ones of
+    :func:`~linmstmm.fe.node_constraints.kept_node_constraints` for the coarse
+    predictions).
 
     M = Tᵀ M_full T and K = (Gᵀ D) G are formed densely where their dense
     intermediate (n_dof × n_full) is small (:func:`linmstmm.fe.products.small`), by
     scipy.sparse otherwise: the same matrices bit for bit either way.
     """
     model = _negligible_mass_removed(model)
-    parts = constrained_parts(model, elements_per_beam)
+    parts = constrained_parts(model, elements_per_beam, constraints_of(model))
     T, n_full = parts.T, parts.n_full
-    strains, mass, stiffness = _Triplets(), parts.rigid_mass, []
+    strains, mass, stiffness = _Triplets(), parts.rigid_mass.copy(), []
     _add_beams(_beam_elements(model.beams, parts.beam_maps, elements_per_beam), strains, stiffness, mass)
     strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
     stiffness += parts.spring_stiffness

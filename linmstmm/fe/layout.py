@@ -72,13 +72,20 @@ class _Layout:
         return len(self.positions)
 
 
-def _layout(model: Model, elements_per_beam: int) -> _Layout:
-    """Number the nodes: points, rigid mass centres, interior beam nodes."""
+def _layout(model: Model, elements_per_beam: int, nodes: _Layout | None = None) -> _Layout:
+    """Number the nodes: points, rigid mass centres, interior beam nodes. ``nodes``: the
+    layout of ``model`` with one element per beam (its points and mass centres, which
+    every mesh numbers first), to add the interior nodes to; made here by default."""
     n = elements_per_beam
-    points = {name: i for i, name in enumerate(model.points)}
-    rigids = {body.name: len(points) + i for i, body in enumerate(model.rigids)}
-    placed = np.array([*model.points.values(), *(body.com for body in model.rigids)], float).reshape(-1, 3)
-    ends = np.array([[points[end] for end in beam.ends] for beam in model.beams], int).reshape(-1, 2)
+    if nodes is None:
+        points = {name: i for i, name in enumerate(model.points)}
+        rigids = {body.name: len(points) + i for i, body in enumerate(model.rigids)}
+        placed = np.array([*model.points.values(), *(body.com for body in model.rigids)], float).reshape(-1, 3)
+        ends = np.array([[points[end] for end in beam.ends] for beam in model.beams], int).reshape(-1, 2)
+    else:
+        points, rigids, placed, ends = nodes.index.points, nodes.index.rigids, nodes.positions, nodes.beam_table
+        if n == 1:
+            return nodes
     interior = len(placed) + np.arange(len(ends) * (n - 1)).reshape(len(ends), n - 1)
     table = np.concatenate([ends[:, :1], interior, ends[:, 1:]], axis=1)
     xa, xb = placed[ends[:, 0]], placed[ends[:, 1]]
@@ -142,6 +149,13 @@ class _Triplets:
         first = self.n_rows
         self.n_rows += count
         return np.arange(first, first + count)
+
+    def copy(self) -> _Triplets:
+        """A twin to add to: the same entries (arrays shared, never written), its own lists."""
+        twin = _Triplets(self.repeats)
+        twin.rows, twin.cols, twin.values = list(self.rows), list(self.cols), list(self.values)
+        twin.n_rows = self.n_rows
+        return twin
 
     def extend(self, other: "_Triplets"):
         """Append the rows of ``other`` after these (renumbered)."""

@@ -75,9 +75,13 @@ def congruence(T, matrix) -> np.ndarray:
     Returns
     -------
     numpy.ndarray, (m, m); formed through a dense intermediate (m, the columns of
-    ``matrix`` that hold entries: the others add no term).
+    ``matrix`` that hold entries: the others add no term), or moved where T keeps
+    every DOF ``matrix`` touches (:func:`_moved`).
     """
     used = np.flatnonzero(np.bincount(matrix.indices, minlength=matrix.shape[1]))
+    moved = _moved(T, matrix, used)
+    if moved is not None:
+        return moved
     narrowed = Compressed("csr", matrix.indptr, np.searchsorted(used, matrix.indices), matrix.data,
                           (matrix.shape[0], len(used)))
     line, taken = stored_entries(T.indptr, used)                # the rows of T those columns meet
@@ -85,6 +89,28 @@ def congruence(T, matrix) -> np.ndarray:
     np.cumsum(np.bincount(line, minlength=len(used)), out=indptr[1:])
     rows = Compressed("csr", indptr, T.indices[taken], T.data[taken], (len(used), T.shape[1]))
     return dense_product(compressed_rows(dense_product(transposed(T), narrowed)), rows)
+
+
+def _moved(T, matrix, used: np.ndarray) -> np.ndarray | None:
+    """:func:`congruence` where ``matrix`` (canonical CSR) has entries in the rows ``used``
+    and the same columns, and the row of T at each of them is a single 1.0 in a column
+    of its own (the DOF is kept as it is: a rigid body's free mass centre), else None.
+    Each entry of the product is then one term, 1.0 × a × 1.0 added to zero, which
+    is ``a`` exactly: ``matrix``'s nonzero entries moved to those columns. (An empty
+    ``matrix`` is left to the general route, whose result is of its own type.)"""
+    first = T.indptr[used]
+    if not used.size or np.any(T.indptr[used + 1] - first != 1) or np.any(T.data[first] != 1.0) \
+            or not np.array_equal(np.flatnonzero(np.diff(matrix.indptr)), used):
+        return None
+    column = np.zeros(T.shape[0], int)
+    column[used] = T.indices[first]
+    if np.unique(column[used]).size < used.size:
+        return None
+    lines = np.repeat(np.arange(matrix.shape[0]), np.diff(matrix.indptr))
+    entries = matrix.data != 0
+    moved = np.zeros((T.shape[1], T.shape[1]))
+    moved[column[lines[entries]], column[matrix.indices[entries]]] = matrix.data[entries]
+    return moved
 
 
 def dense_rows(matrix, rows: np.ndarray) -> np.ndarray:

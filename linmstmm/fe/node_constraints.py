@@ -1,0 +1,230 @@
+"""The parts of a meshed model that lie on its nodes alone — springs, boundaries,
+rigid bodies' ports and masses — and the elimination of their constraints, made
+once per model and extended to any mesh.
+
+A mesh numbers the model's points and mass centres first and every interior
+beam node after them (:class:`~linmstmm.fe.layout.DofIndex`), and no spring,
+boundary or port touches an interior node. So the port map T0 of a mesh is the
+nodes' own with an identity row and column for each interior DOF, and where no
+beam declares a direction rigid (the only constraints on interior nodes) the
+elimination T of a mesh is the nodes' own T with the same identity block: the
+same arrays, entry for entry, as eliminating that mesh's constraints from the
+start. The Wittrick–Williams counter (one element per beam) and the coarse
+predicting mesh (two or more) of one model object share one such elimination
+(:func:`kept_node_constraints`); the FE route makes its own.
+"""
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from linmstmm.fe.constraints import _eliminate, reduced_constraints
+from linmstmm.fe.layout import _layout, _Triplets, spring_rows
+from linmstmm.fe.sparse import Compressed, scipy_csr
+from linmstmm.model import Model
+
+#: Model objects whose node constraints are kept (:func:`kept_node_constraints`),
+#: least recently used dropped first.
+CONSTRAINTS_KEPT = 16
+
+
+@dataclass(frozen=True, eq=False)
+class NodeConstraints:
+    """A model's springs, boundaries, ports and rigid masses on its points and mass
+    centres (6 DOFs each, ``n_full`` in all), before any beam is meshed.
+
+    Attributes
+    ----------
+    layout : linmstmm.fe.layout._Layout
+        The points and mass centres (the layout of one element per beam).
+    n_full : int
+        6 per point and mass centre.
+    port_map : Compressed
+        T0 (n_full, q0) CSR: each port moves with the first body that owns it.
+    kept : numpy.ndarray, shape (q0,)
+        The full DOFs T0 keeps, ascending.
+    rows : Compressed
+        (r, n_full) CSR constraint rows: infinite spring directions, fixed
+        boundary components, ports joining further bodies, in that order.
+    spring_strains : linmstmm.fe.layout._Triplets
+        The finite spring directions as strain rows (m or rad) on the full DOFs.
+    spring_stiffness : list of numpy.ndarray
+        Their stiffnesses, N/m or N m/rad.
+    rigid_mass : linmstmm.fe.layout._Triplets
+        The bodies' 6 × 6 mass blocks (kg, kg m²) on their mass centres' DOFs.
+    elimination : tuple or None
+        (T (n_full, n_dof) scipy CSR, masters (n_dof,) full DOFs) of ``rows``
+        where no beam declares a direction rigid, else None.
+    """
+
+    layout: object
+    n_full: int
+    port_map: Compressed
+    kept: np.ndarray
+    rows: Compressed
+    spring_strains: _Triplets
+    spring_stiffness: list
+    rigid_mass: _Triplets
+    elimination: tuple | None
+
+    def eliminated(self, beam_rows: _Triplets, n_full: int) -> tuple[sp.csr_matrix, np.ndarray]:
+        """The elimination of a mesh's constraints: the same arrays as eliminating them anew.
+
+        Parameters
+        ----------
+        beam_rows : linmstmm.fe.layout._Triplets
+            The constraint rows the mesh's beams add (directions a beam declares
+            rigid), on its full DOFs; taken before the nodes' rows.
+        n_full : int
+            The mesh's full DOFs: these nodes' ``n_full``, then 6 per interior beam node.
+
+        Returns
+        -------
+        T : scipy.sparse.csr_matrix, shape (n_full, n_dof)
+            The full vector is ``T @ q``.
+        masters : numpy.ndarray, shape (n_dof,)
+            The full DOFs kept as the reduced ones, ascending.
+        """
+        interior = np.arange(self.n_full, n_full)
+        if not beam_rows.n_rows and self.elimination is not None:
+            T, masters = self.elimination
+            if not interior.size:       # the nodes themselves (one element per beam)
+                return T, masters
+            return _with_identity(T, len(interior)), np.concatenate([masters, interior])
+        t0 = scipy_csr(_with_identity(self.port_map, len(interior)))
+        t1, masters = _eliminate(reduced_constraints(_stacked(beam_rows.compressed(n_full), self.rows), t0))
+        return (t0 @ scipy_csr(t1)).tocsr(), np.concatenate([self.kept, interior])[masters]
+
+
+def node_constraints(model: Model) -> NodeConstraints:
+    """The :class:`NodeConstraints` of ``model``, made anew.
+
+    Parameters
+    ----------
+    model : Model
+        The model; its rigid masses are taken as they are.
+
+    Returns
+    -------
+    NodeConstraints
+    """
+    layout = _layout(model, 1)              # the points and mass centres only
+    n_full = 6 * layout.n_nodes
+    strains, mass, constraints = _Triplets(), _Triplets(repeats=True), _Triplets()
+    stiffness = []
+    _add_springs(model, layout, strains, stiffness, constraints)
+    _add_rigid_masses(model, layout, mass)
+    _add_boundaries(model, layout, constraints)
+    t0, kept = _port_map(model, layout, constraints)
+    rows = constraints.compressed(n_full)
+    elimination = None
+    if all(beam.axial and beam.torsion for beam in model.beams):
+        t0_csr = scipy_csr(t0)
+        t1, masters = _eliminate(reduced_constraints(rows, t0_csr))
+        elimination = ((t0_csr @ scipy_csr(t1)).tocsr(), kept[masters])
+    return NodeConstraints(layout, n_full, t0, kept, rows, strains, stiffness, mass, elimination)
+
+
+#: :func:`node_constraints` kept per model object (a Model cannot change): made on the
+#: first call, shared by the counter's and the coarse predictions' meshes of the model.
+kept_node_constraints = functools.lru_cache(maxsize=CONSTRAINTS_KEPT)(node_constraints)
+
+
+def _with_identity(matrix, extra: int):
+    """``matrix`` (CSR, scipy or :class:`Compressed`) with ``extra`` rows and columns of
+    the identity appended, its own entries stored as they are; of its kind."""
+    n_rows, n_cols = matrix.shape
+    indptr = np.concatenate([matrix.indptr, matrix.indptr[-1] + np.arange(1, extra + 1, dtype=matrix.indptr.dtype)])
+    indices = np.concatenate([matrix.indices, np.arange(n_cols, n_cols + extra, dtype=matrix.indices.dtype)])
+    data = np.concatenate([matrix.data, np.ones(extra)])
+    shape = (n_rows + extra, n_cols + extra)
+    if isinstance(matrix, Compressed):
+        return Compressed("csr", indptr, indices, data, shape)
+    return sp.csr_matrix((data, indices, indptr), shape=shape)
+
+
+def _stacked(top: Compressed, bottom: Compressed) -> Compressed:
+    """The CSR rows of ``top`` above those of ``bottom`` (no wider than ``top``), of
+    ``top``'s width."""
+    indptr = np.concatenate([top.indptr, top.indptr[-1] + bottom.indptr[1:]])
+    return Compressed("csr", indptr, np.concatenate([top.indices, bottom.indices]),
+                      np.concatenate([top.data, bottom.data]), (top.shape[0] + bottom.shape[0], top.shape[1]))
+
+
+def _add_springs(model, layout, strains, stiffness, constraints):
+    """Finite spring directions become strains, ``inf`` ones constraints, released ones nothing
+    (each kind written as one block of rows, in the springs' order)."""
+    owners, components, cols, values = spring_rows(model.springs, layout.index, kept_only=True)
+    k = np.array([spring.k for spring in model.springs], float).reshape(-1, 6)[owners, components]
+    rigid = np.isinf(k)
+    strains.add(strains.new_rows(np.count_nonzero(~rigid))[:, None], cols[~rigid], values[~rigid])
+    stiffness.append(k[~rigid])
+    constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None], cols[rigid], values[rigid])
+
+
+def _add_rigid_masses(model, layout, mass):
+    """Each body's mass and inertia on the DOFs of its mass centre."""
+    dofs = 6 * np.array([layout.index.rigids[body.name] for body in model.rigids], int)[:, None] + np.arange(6)
+    blocks = np.zeros((len(dofs), 6, 6))
+    blocks[:, [0, 1, 2], [0, 1, 2]] = np.array([body.mass for body in model.rigids], float)[:, None]
+    blocks[:, 3:, 3:] = np.array([body.inertia for body in model.rigids], float).reshape(-1, 3, 3)
+    mass.add(dofs[:, :, None], dofs[:, None, :], blocks)
+
+
+def _add_boundaries(model, layout, constraints):
+    """Every fixed component of a point becomes a constraint row of its own."""
+    dofs = [layout.index.point(point)[np.asarray(fixed, bool)] for point, fixed in model.boundary.items()]
+    dofs = np.concatenate(dofs) if dofs else np.zeros(0, int)
+    constraints.add(constraints.new_rows(len(dofs)), dofs, 1.0)
+
+
+def _port_kinematics(ports, centres) -> np.ndarray:
+    """(p, 6, 6) maps body-centre DOFs -> port DOFs: u_p = u_c + θ × (p − c), θ_p = θ.
+
+    ports, centres : (p, 3) positions of the ports and of their bodies' mass centres, m.
+    """
+    r = ports - centres
+    cross = np.zeros((len(r), 3, 3))
+    cross[:, [0, 0, 1, 1, 2, 2], [1, 2, 0, 2, 0, 1]] = np.stack([-r[:, 2], r[:, 1], r[:, 2], -r[:, 0],
+                                                               -r[:, 1], r[:, 0]], axis=1)
+    block = np.zeros((len(r), 6, 6))
+    block[:, np.arange(6), np.arange(6)] = 1.0
+    block[:, :3, 3:] = -cross
+    return block
+
+
+def _port_map(model, layout, constraints):
+    """(T0 (full x q0) CSR rows, (q0,) the full DOFs it keeps): each port moves with the first body that owns it.
+
+    A point that is a port of several bodies gets six constraint rows per
+    further body (the bodies are rigidly joined there).
+    """
+    n_full = 6 * layout.n_nodes
+    bodies = [(body, port) for body in model.rigids for port in body.ports]
+    owned = {}
+    first = np.array([owned.setdefault(port, i) == i for i, (_, port) in enumerate(bodies)], bool)
+    port_nodes = np.array([layout.index.points[port] for _, port in bodies], int)
+    centre_nodes = np.array([layout.index.rigids[body.name] for body, _ in bodies], int)
+    ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
+    kinematics = _port_kinematics(layout.positions[port_nodes], layout.positions[centre_nodes])
+    if not first.all():
+        joined = constraints.new_rows(6 * np.count_nonzero(~first)).reshape(-1, 6, 1)
+        constraints.add(joined, ports[~first][:, None, :], np.eye(6))
+        constraints.add(joined, centres[~first][:, None, :], -kinematics[~first])
+    slaved = np.zeros(n_full, bool)
+    slaved[ports[first]] = True
+    kept = np.flatnonzero(~slaved)
+    column_of = np.full(n_full, -1)
+    column_of[kept] = np.arange(len(kept))
+    # rows in order: a slaved port DOF holds its body's six centre DOFs (columns
+    # ascending, zeros kept), every other DOF itself
+    indptr = np.zeros(n_full + 1, int)
+    np.cumsum(np.where(slaved, 6, 1), out=indptr[1:])
+    indices, data = np.empty(indptr[-1], int), np.empty(indptr[-1])
+    indices[indptr[kept]], data[indptr[kept]] = np.arange(len(kept)), 1.0
+    held = indptr[ports[first]][..., None] + np.arange(6)                   # (p, 6, 6)
+    indices[held], data[held] = column_of[centres[first]][:, None, :], kinematics[first]
+    return Compressed("csr", indptr, indices, data, (n_full, len(kept))), kept

@@ -70,8 +70,9 @@ def find_runs(topology) -> list[Run]:
     chained = np.array([element.kind != "beam" and len(element.inputs) == 1
                         and not (element.kind == "spring" and element.record.released.size)
                         for element in ordered], dtype=bool)
-    entered = [element.ports[element.inputs[0]].link[:2] for element in ordered]
-    follows = np.array([False] + [link == ("element", before) for link, before in zip(entered[1:], order)])
+    entered = [element.ports[element.inputs[0]].link for element in ordered]  # each element's first input
+    follows = np.array([False] + [link[0] == "element" and link[1] == before
+                                  for link, before in zip(entered[1:], order)], dtype=bool)
     values, scales = signatures(ordered, chained)
     chained_from, following_from = _streaks(chained, size + 1), _streaks(follows, size + 1)
     covered, period_of = np.zeros(size, dtype=int), np.zeros(size, dtype=int)

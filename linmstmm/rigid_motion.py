@@ -166,8 +166,8 @@ def _motions(model: Model) -> np.ndarray:
     columns = []
     names = list(model.points)
     parts, segments = _point_labels(model)
-    fixed = np.zeros(len(names), dtype=bool)  # points held in all six directions
-    fixed[[names.index(point) for point, mask in model.boundary.items() if np.all(mask)]] = True
+    fixed = np.array([name in model.boundary and bool(np.all(model.boundary[name])) for name in names],
+                     dtype=bool)  # points held in all six directions
     for members in _members(parts):
         if fixed[members].any() and np.all(segments[members] == segments[members[0]]):
             continue  # one segment held in all six directions: no motion (most grounded models)

@@ -60,39 +60,39 @@ def find_runs(topology) -> list[Run]:
 
     Inside a run every element's only input is the previous element's output,
     and equal cells have equal :func:`signatures` (to 1e-14 of each quantity's
-    own size): the data their transfer matrices are made of.
+    own size): the data their transfer matrices are made of. Runs are taken
+    greedily along the carry order: at each position the run covering the most
+    elements (the shortest cell among equals), if any, and on after its end.
     """
     order = topology.order
-    elements = topology.elements
+    ordered = [topology.elements[e] for e in order]
     size = len(order)
-    chained = np.array([elements[e].kind != "beam" and len(elements[e].inputs) == 1
-                        and not (elements[e].kind == "spring" and elements[e].record.released.size)
-                        for e in order])
-    follows = np.array([i > 0 and elements[order[i]].ports[elements[order[i]].inputs[0]].link[:2]
-                        == ("element", order[i - 1]) for i in range(size)])
-    values, scales = signatures([elements[e] for e in order], chained)
-    streaks = {}
+    chained = np.array([element.kind != "beam" and len(element.inputs) == 1
+                        and not (element.kind == "spring" and element.record.released.size)
+                        for element in ordered], dtype=bool)
+    entered = [element.ports[element.inputs[0]].link for element in ordered]  # each element's first input
+    follows = np.array([False] + [link[0] == "element" and link[1] == before
+                                  for link, before in zip(entered[1:], order)], dtype=bool)
+    values, scales = signatures(ordered, chained)
+    chained_from, following_from = _streaks(chained, size + 1), _streaks(follows, size + 1)
+    covered, period_of = np.zeros(size, dtype=int), np.zeros(size, dtype=int)
     for period in range(1, min(MAX_PERIOD, size - 1) + 1):
         # good[j]: element j + period repeats element j and is chained to its predecessor
         tolerance = SAME * np.maximum(scales[:-period], scales[period:])
         good = (np.all(np.abs(values[:-period] - values[period:]) <= tolerance, axis=1)
                 & chained[period:] & follows[period:])
-        streaks[period] = _streaks(good, size + 1)
-    runs, i = [], 0
-    while i < size:
-        best = None
-        for period, streak in streaks.items():
-            if i + period > size or not chained[i:i + period].all() or not follows[i + 1:i + period].all():
-                continue
-            repetitions = 1 + streak[i] // period
-            if repetitions >= MIN_REPETITIONS and (best is None or repetitions * period
-                                                   > best.repetitions * len(best.cell)):
-                best = Run(i, tuple(order[i:i + period]), int(repetitions))
-        if best is None:
-            i += 1
-        else:
-            runs.append(best)
-            i = best.stop
+        repetitions = 1 + _streaks(good, size)[:size] // period
+        # a cell at i: chained elements i .. i + period - 1, each after the one before
+        cell = (chained_from[:size] >= period) & (following_from[1:] >= period - 1)
+        cover = np.where(cell & (repetitions >= MIN_REPETITIONS), repetitions * period, 0)
+        longer = cover > covered
+        covered[longer], period_of[longer] = cover[longer], period
+    runs, starts = [], np.flatnonzero(covered)
+    i = 0
+    while (k := np.searchsorted(starts, i)) < starts.size:
+        i, period = int(starts[k]), int(period_of[starts[k]])
+        runs.append(Run(i, tuple(order[i:i + period]), int(covered[i]) // period))
+        i += int(covered[i])
     return runs
 
 
@@ -118,30 +118,33 @@ def signatures(elements, chained) -> tuple[np.ndarray, np.ndarray]:
     and its axes. Differences of positions, not positions: a chain's cells far from
     the origin are equal to their size, not to the origin's distance. Elements not
     ``chained`` get NaN (equal to nothing); the first entry tells the kinds apart.
+    The records' arrays are gathered in lists and converted once (a chain has
+    thousands: one numpy call per element took most of the time).
     """
     values = np.full((len(elements), SIGNATURE_SIZE), np.nan)
     scales = np.zeros((len(elements), SIGNATURE_SIZE))
-    kinds = np.array([element.kind if ok else "" for element, ok in zip(elements, chained)])
-    rigid = np.flatnonzero(kinds == "rigid")
-    if rigid.size:  # gathered in lists, computed in one go: a chain has thousands
+    kinds = [element.kind if ok else "" for element, ok in zip(elements, chained.tolist())]
+    rigid = [i for i, kind in enumerate(kinds) if kind == "rigid"]
+    if rigid:
         bodies = [elements[i] for i in rigid]
         start = np.array([body.ports[body.inputs[0]].position for body in bodies], dtype=float)
         arms = np.hstack([np.array([body.record.com for body in bodies], dtype=float) - start,
                           np.array([body.ports[body.output].position for body in bodies], dtype=float) - start])
         mass = np.array([body.record.mass for body in bodies], dtype=float)
-        inertia = np.array([np.ravel(body.record.inertia) for body in bodies], dtype=float)
-        values[rigid] = np.hstack([np.ones((rigid.size, 1)), mass[:, None], inertia, arms])
+        inertia = np.array([body.record.inertia for body in bodies], dtype=float).reshape(len(bodies), 9)
+        values[rigid] = np.hstack([np.ones((len(rigid), 1)), mass[:, None], inertia, arms])
         scales[rigid, 1:] = np.hstack([np.abs(mass)[:, None],
                                        np.repeat(np.abs(inertia).max(axis=1, keepdims=True), 9, axis=1),
                                        np.repeat(np.abs(arms).max(axis=1, keepdims=True), 6, axis=1)])
-    spring = np.flatnonzero(kinds == "spring")
-    if spring.size:
-        compliance = 1 / np.array([elements[i].record.k for i in spring], dtype=float)
-        axes = np.array([np.ravel(elements[i].record.axes) for i in spring], dtype=float)
-        values[spring] = np.hstack([np.full((spring.size, 1), 2.0), compliance, axes, np.zeros((spring.size, 1))])
+    spring = [i for i, kind in enumerate(kinds) if kind == "spring"]
+    if spring:
+        records = [elements[i].record for i in spring]
+        compliance = 1 / np.array([record.k for record in records], dtype=float)
+        axes = np.array([record.axes for record in records], dtype=float).reshape(len(spring), 9)
+        values[spring] = np.hstack([np.full((len(spring), 1), 2.0), compliance, axes, np.zeros((len(spring), 1))])
         scales[spring, 1:16] = np.hstack([np.repeat(np.abs(compliance).max(axis=1, keepdims=True), 6, axis=1),
-                                          np.ones((spring.size, 9))])
-    junction = np.flatnonzero(kinds == "junction")
+                                          np.ones((len(spring), 9))])
+    junction = [i for i, kind in enumerate(kinds) if kind == "junction"]
     values[junction] = 0.0
     values[junction, 0] = 3.0
     return values, scales

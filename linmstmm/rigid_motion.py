@@ -22,6 +22,8 @@ rotary inertia has three rigid-body modes, not six.
 """
 from __future__ import annotations
 
+from itertools import chain
+
 import numpy as np
 import scipy.linalg as la
 
@@ -43,33 +45,54 @@ def connected_parts(model: Model) -> tuple[list[list[str]], list[list[str]]]:
     Two points are in one part when elements join them (a rigid body's ports,
     a beam's or a spring's ends), in one segment when elements other than
     springs with a released direction join them (a segment moves as one rigid
-    body in a zero-energy motion). The components of the graph of points and
-    elements (:func:`scipy.sparse.csgraph.connected_components`: a 10,000-body
-    chain spent 0.18 s in a union–find written out in Python), its edges
-    listed once for both.
+    body in a zero-energy motion): see :func:`_point_labels`.
     """
-    from scipy.sparse import coo_matrix
+    names = np.array(list(model.points), dtype=object)
+    return tuple([list(names[members]) for members in _members(labels)] for labels in _point_labels(model))
+
+
+def _point_labels(model: Model) -> tuple[np.ndarray, np.ndarray]:
+    """(part, segment): (points,) int each, the connected part and the segment of every
+    point of ``model`` (in ``model.points`` order), each numbered in order of first
+    appearance. The components of the graph of points and elements
+    (:func:`scipy.sparse.csgraph.connected_components`, on edges gathered as arrays:
+    a 10,000-body chain spent 0.18 s in a union–find written out in Python, and
+    tens of milliseconds in loops over its elements and points), its edges listed
+    once for both.
+    """
+    from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import connected_components
 
-    names = list(model.points)
-    number = {name: i for i, name in enumerate(names)}
-    first, other, joint = [], [], []
-    for element in model.elements:
-        ends = element.ports if element.kind == "rigid" else element.ends
-        first += [number[ends[0]]] * (len(ends) - 1)
-        other += [number[end] for end in ends[1:]]
-        joint += [element.kind == "spring" and element.released.size > 0] * (len(ends) - 1)
-    first, other, joint = np.array(first, dtype=int), np.array(other, dtype=int), np.array(joint, dtype=bool)
+    number = {name: i for i, name in enumerate(model.points)}
+    ends = [element.ports if element.kind == "rigid" else element.ends for element in model.elements]
+    sizes = np.fromiter(map(len, ends), dtype=int, count=len(ends))
+    point = np.fromiter(map(number.__getitem__, chain.from_iterable(ends)), dtype=int, count=int(sizes.sum()))
+    owner = np.repeat(np.arange(sizes.size), sizes)
+    later = np.ones(point.size, dtype=bool)  # every end but an element's first, joined to that first
+    later[(np.cumsum(sizes) - sizes)[sizes > 0]] = False
+    first, other = point[(np.cumsum(sizes) - sizes)[owner[later]]], point[later]
+    joint = np.array([element.kind == "spring" and element.released.size > 0 for element in model.elements],
+                     dtype=bool)[owner[later]]
 
-    def components(kept: np.ndarray) -> list[list[str]]:
-        graph = coo_matrix((np.ones(kept.sum()), (first[kept], other[kept])), shape=(len(names), len(names)))
-        _, labels = connected_components(graph, directed=False)
-        grouped: dict[int, list[str]] = {}
-        for name, label in zip(names, labels.tolist()):
-            grouped.setdefault(label, []).append(name)
-        return list(grouped.values())
+    def components(kept: np.ndarray) -> np.ndarray:
+        rows = first[kept]  # the graph in compressed rows at once (a COO matrix cost as much again)
+        graph = csr_matrix((np.ones(rows.size), other[kept][np.argsort(rows, kind="stable")],
+                            np.r_[0, np.cumsum(np.bincount(rows, minlength=len(number)))]), shape=(len(number),) * 2)
+        labels = connected_components(graph, directed=False)[1]
+        appears = np.full(labels.max(initial=-1) + 1, labels.size)
+        np.minimum.at(appears, labels, np.arange(labels.size))
+        rank = np.empty_like(appears)
+        rank[np.argsort(appears)] = np.arange(appears.size)
+        return rank[labels]
 
-    return components(np.ones(first.size, dtype=bool)), components(~joint)
+    segments = components(~joint)
+    return (components(np.ones(first.size, dtype=bool)) if joint.any() else segments), segments
+
+
+def _members(labels: np.ndarray) -> list[np.ndarray]:
+    """The indices carrying each label 0, 1, ... of ``labels`` ((n,) int), ascending."""
+    by_label = np.argsort(labels, kind="stable")
+    return np.split(by_label, np.cumsum(np.bincount(labels))[:-1]) if labels.size else []
 
 
 def unit_motions(positions: np.ndarray, centre: np.ndarray, size: float) -> np.ndarray:
@@ -134,47 +157,51 @@ def rigid_body_motions(model: Model) -> dict[str, np.ndarray]:
     each connected part are orthonormal in its segments' unit motions and move
     mass (see :data:`MASSLESS_MOTION`).
     """
+    stacked = _motions(model)
+    return {name: stacked[i] for i, name in enumerate(model.points)}
+
+
+def _motions(model: Model) -> np.ndarray:
+    """(points, 6, r): :func:`rigid_body_motions` of every point, in ``model.points`` order."""
     columns = []
     names = list(model.points)
-    number = {name: i for i, name in enumerate(names)}
-    parts, all_segments = connected_parts(model)
-    segment_of = {p: s for s, segment in enumerate(all_segments) for p in segment}
-    for part in parts:
-        if _clamped_whole(model, part, segment_of):
-            continue
-        members = set(part)
-        positions = np.array([model.points[p] for p in part])
-        coms = [body.com for body in model.rigids if body.ports[0] in members]
-        extent = np.vstack([positions] + [np.asarray(c, float)[None] for c in coms])
-        centre = extent.mean(axis=0)
-        size = float(np.abs(extent - centre).max()) or 1.0
-        segments = list(dict.fromkeys(segment_of[p] for p in part))  # this part's, in order
-        field = _segment_field(unit_motions(positions, centre, size), [segments.index(segment_of[p]) for p in part],
-                               len(segments))
-        index = {p: i for i, p in enumerate(part)}
-        held = _held_motions(model, part, index, field, size, segment_of)
-        allowed = la.null_space(held, rcond=GEOMETRIC_RANK) if held.size else np.eye(field.shape[2])
-        if not allowed.shape[1]:
-            continue
-        kinetic = la.block_diag(*[_kinetic_matrix(model, {p for p in part if segment_of[p] == segment},
-                                                  centre, size) for segment in segments])
-        energy, directions = la.eigh(allowed.T @ kinetic @ allowed)
-        moving = allowed @ directions[:, energy > MASSLESS_MOTION * max(np.abs(kinetic).max(), 0.0)]
-        if not moving.shape[1]:
-            continue
-        motion = np.zeros((len(names), 6, moving.shape[1]))
-        motion[[number[p] for p in part]] = field @ moving
-        columns.append(motion)
-    stacked = np.concatenate(columns, axis=2) if columns else np.zeros((len(names), 6, 0))
-    return {name: stacked[i] for i, name in enumerate(names)}
+    parts, segments = _point_labels(model)
+    fixed = np.array([name in model.boundary and bool(np.all(model.boundary[name])) for name in names],
+                     dtype=bool)  # points held in all six directions
+    for members in _members(parts):
+        if fixed[members].any() and np.all(segments[members] == segments[members[0]]):
+            continue  # one segment held in all six directions: no motion (most grounded models)
+        part = [names[i] for i in members]
+        segment_of = dict(zip(part, segments[members].tolist()))
+        motion = _part_motions(model, part, segment_of)
+        if motion is not None:
+            columns.append(np.zeros((len(names), 6, motion.shape[2])))
+            columns[-1][members] = motion
+    return np.concatenate(columns, axis=2) if columns else np.zeros((len(names), 6, 0))
 
 
-def _clamped_whole(model: Model, part: list, segment_of: dict) -> bool:
-    """True where ``part`` is one segment (no joint inside it) with a point whose six
-    components are all fixed: it cannot move at all, so it has no zero-frequency
-    motion (most grounded models; nothing else need be formed for them)."""
-    clamped = [p for p in part if p in model.boundary and np.all(model.boundary[p])]
-    return bool(clamped) and len({segment_of[p] for p in part}) == 1
+def _part_motions(model: Model, part: list, segment_of: dict) -> np.ndarray | None:
+    """(len(part), 6, r) motions of the points of one connected part (names ``part``,
+    ``segment_of``: name -> segment) in its r zero-frequency modes, or None if none."""
+    members = set(part)
+    positions = np.array([model.points[p] for p in part])
+    coms = [body.com for body in model.rigids if body.ports[0] in members]
+    extent = np.vstack([positions] + [np.asarray(c, float)[None] for c in coms])
+    centre = extent.mean(axis=0)
+    size = float(np.abs(extent - centre).max()) or 1.0
+    segments = list(dict.fromkeys(segment_of[p] for p in part))  # this part's, in order
+    field = _segment_field(unit_motions(positions, centre, size), [segments.index(segment_of[p]) for p in part],
+                           len(segments))
+    index = {p: i for i, p in enumerate(part)}
+    held = _held_motions(model, part, index, field, size, segment_of)
+    allowed = la.null_space(held, rcond=GEOMETRIC_RANK) if held.size else np.eye(field.shape[2])
+    if not allowed.shape[1]:
+        return None
+    kinetic = la.block_diag(*[_kinetic_matrix(model, {p for p in part if segment_of[p] == segment},
+                                              centre, size) for segment in segments])
+    energy, directions = la.eigh(allowed.T @ kinetic @ allowed)
+    moving = allowed @ directions[:, energy > MASSLESS_MOTION * max(np.abs(kinetic).max(), 0.0)]
+    return field @ moving if moving.shape[1] else None
 
 
 def _segment_field(field: np.ndarray, segment: list, count: int) -> np.ndarray:
@@ -207,5 +234,4 @@ def _held_motions(model: Model, part: list, index: dict, field: np.ndarray, size
 
 def rigid_body_mode_count(model: Model) -> int:
     """Number of zero-frequency (rigid-body) modes of ``model``: see the module text."""
-    motions = rigid_body_motions(model)
-    return next(iter(motions.values())).shape[1] if motions else 0
+    return _motions(model).shape[2]

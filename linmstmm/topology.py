@@ -15,7 +15,6 @@ root state and enters the first as a tip state, and the two are equal.
 """
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -37,7 +36,7 @@ class Boundary:
     fixed: np.ndarray
 
 
-@dataclass
+@dataclass(slots=True)
 class Port:
     """One end of a transfer element.
 
@@ -51,7 +50,7 @@ class Port:
     link: tuple = ()
 
 
-@dataclass
+@dataclass(slots=True)
 class TransferElement:
     """An element in the transfer graph (a model element or a junction).
 
@@ -100,38 +99,43 @@ class Topology:
         return self.boundaries[index].label if kind == "boundary" else self.cuts[index].point
 
 
-def _model_elements(model: Model) -> list[TransferElement]:
-    """Transfer elements for the model's own elements, with their ports."""
+def _model_elements(model: Model) -> tuple[list[TransferElement], dict[str, list[tuple[int, int]]]]:
+    """Transfer elements for the model's own elements, with their ports, and the
+    (element, port) ends at each point (a tip body's free far side at none)."""
+    points = model.points
+    at_point: dict[str, list[tuple[int, int]]] = {p: [] for p in points}
     elements = []
-    for rigid in model.rigids:
-        ports = [Port(p, model.points[p]) for p in rigid.ports]
+    for e, record in enumerate(model.elements):
+        names = record.ports if record.kind == "rigid" else record.ends
+        ports = []
+        for p, name in enumerate(names):
+            ports.append(Port(name, points[name]))
+            at_point[name].append((e, p))
         if len(ports) == 1:  # a tip body: its far side is a free boundary end
-            ports.append(Port(f"{rigid.name} free end", model.points[rigid.ports[0]],
-                              ("free-end",)))
-        elements.append(TransferElement(rigid.name, "rigid", rigid, ports))
-    for element in model.beams + model.springs:
-        ports = [Port(p, model.points[p]) for p in element.ends]
-        elements.append(TransferElement(element.name, element.kind, element, ports))
-    return elements
+            ports.append(Port(f"{record.name} free end", points[names[0]], ("free-end",)))
+        elements.append(TransferElement(record.name, record.kind, record, ports))
+    return elements, at_point
 
 
-def _link_points(model: Model, elements: list[TransferElement]) -> list[Boundary]:
-    """Connect ports at shared points, add junctions, return the boundary ends."""
-    at_point: dict[str, list[tuple[int, int]]] = {p: [] for p in model.points}
+def _link_points(model: Model, elements: list[TransferElement], at_point: dict) -> tuple[list[Boundary], list]:
+    """Connect ports at shared points (``at_point``: point -> its (element, port) ends),
+    add junctions; return the boundary ends and the (element, port) linked to each."""
     boundaries: list[Boundary] = []
+    ends_of: list[tuple[int, int]] = []  # the port linked to each boundary end
+
+    def bound(e, p, label, position, fixed):
+        elements[e].ports[p].link = ("boundary", len(boundaries))
+        boundaries.append(Boundary(label, position, fixed))
+        ends_of.append((e, p))
+
     for e, element in enumerate(elements):
-        for p, port in enumerate(element.ports):
-            if port.link == ("free-end",):
-                port.link = ("boundary", len(boundaries))
-                boundaries.append(Boundary(port.point, port.position, np.zeros(6, dtype=bool)))
-            else:
-                at_point[port.point].append((e, p))
+        if element.kind == "rigid" and element.ports[-1].link:  # ("free-end",)
+            bound(e, len(element.ports) - 1, element.ports[-1].point, element.ports[-1].position,
+                  np.zeros(6, dtype=bool))
     held = {point for point, mask in model.boundary.items() if mask.any()}  # points with a fixed component
     for point, ends in at_point.items():
         if len(ends) == 1:
-            e, p = ends[0]
-            elements[e].ports[p].link = ("boundary", len(boundaries))
-            boundaries.append(Boundary(point, model.points[point], model.fixed_mask(point)))
+            bound(*ends[0], point, model.points[point], model.fixed_mask(point))
         elif len(ends) == 2 and point not in held:
             (e, p), (f, q) = ends
             elements[e].ports[p].link = ("element", f, q)
@@ -144,9 +148,9 @@ def _link_points(model: Model, elements: list[TransferElement]) -> list[Boundary
                 elements[e].ports[p].link = ("element", j, len(junction.ports))
                 junction.ports.append(Port(point, model.points[point], ("element", e, p)))
             if point in held:
-                junction.ports.append(Port(point, model.points[point], ("boundary", len(boundaries))))
-                boundaries.append(Boundary(point, model.points[point], model.fixed_mask(point)))
-    return boundaries
+                junction.ports.append(Port(point, model.points[point]))
+                bound(j, len(junction.ports) - 1, point, model.points[point], model.fixed_mask(point))
+    return boundaries, ends_of
 
 
 def _choose_root(model, elements, boundaries, root_point):
@@ -163,42 +167,33 @@ def _choose_root(model, elements, boundaries, root_point):
     return max(range(len(boundaries)), key=lambda b: (boundaries[b].fixed.sum(), -b))
 
 
-def _find_port(elements, link):
-    for e, element in enumerate(elements):
-        for p, port in enumerate(element.ports):
-            if port.link == link:
-                return e, p
-    raise AssertionError(f"no port has link {link}")
-
-
 def _grow_tree(elements, start, cuts):
     """Breadth-first spanning tree from element ``start`` (its output already set).
 
     Sets every reached element's output and inputs, turns every non-tree
     connection into a cut. Returns the visiting order (root element first).
     """
-    visited = {start}
-    order = []
-    queue = deque([start])
-    while queue:
-        e = queue.popleft()
-        order.append(e)
+    visited = [False] * len(elements)
+    visited[start] = True
+    order = [start]
+    for e in order:  # the list grows as it is read: the queue
         element = elements[e]
-        element.inputs = [p for p in range(len(element.ports)) if p != element.output]
+        ports, output = element.ports, element.output
+        element.inputs = [1 - output] if len(ports) == 2 else [p for p in range(len(ports)) if p != output]
         for p in element.inputs:
-            link = element.ports[p].link
+            link = ports[p].link
             if link[0] != "element":
                 continue
             _, f, q = link
-            if f in visited:  # a second path to f: close the loop by a cut here
+            if visited[f]:  # a second path to f: close the loop by a cut here
                 c = len(cuts)
-                cuts.append(Cut(element.ports[p].point, ((e, p), (f, q))))
-                element.ports[p].link = ("cut", c, 0)
+                cuts.append(Cut(ports[p].point, ((e, p), (f, q))))
+                ports[p].link = ("cut", c, 0)
                 elements[f].ports[q].link = ("cut", c, 1)
             else:
-                visited.add(f)
+                visited[f] = True
                 elements[f].output = q
-                queue.append(f)
+                order.append(f)
     return order
 
 
@@ -226,14 +221,14 @@ def build_topology(model: Model, root: str | None = None, cut_at=()) -> Topology
     where the spanning tree closes them); in a model with no boundary end
     the first of them is where the structure is closed.
     """
-    elements = _model_elements(model)
-    boundaries = _link_points(model, elements)
+    elements, at_point = _model_elements(model)
+    boundaries, ends_of = _link_points(model, elements, at_point)
     cuts: list[Cut] = []
     b = _choose_root(model, elements, boundaries, root)
     closing_point = cut_at[0] if (b is None and cut_at) else None
     _cut_connections(model, elements, [p for p in cut_at if p != closing_point], cuts)
     if b is not None:
-        start, port = _find_port(elements, ("boundary", b))
+        start, port = ends_of[b]
         root_link = ("boundary", b)
     else:  # no boundary at all: close the structure at cut_at[0], else its first connection
         start, port = next((e, p) for e, el in enumerate(elements)

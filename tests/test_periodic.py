@@ -14,8 +14,10 @@ import pytest
 from test_extremes import chain_along_x, chain_reference_hz
 
 from linmstmm import periodic
+from linmstmm.builders import fixed, make_rigid, make_spring
 from linmstmm.deduction import Deduction
 from linmstmm.elements.frames import SYMPLECTIC_FORM
+from linmstmm.model import Model
 from linmstmm.solve import natural_frequencies
 from linmstmm.topology import build_topology
 
@@ -136,3 +138,72 @@ def test_streaks_count_consecutive_repeats_as_a_loop_does():
             for j in range(size - 1, -1, -1):
                 looped[j] = looped[j + 1] + 1 if good[j] else 0
             assert np.array_equal(_streaks(good, size + 1), looped)
+
+
+def sequence_model(letters: str, name: str):
+    """A grounded line of elements, one per letter: springs A (k = 1e6) and B (3e6), rigid
+    bodies X (1 kg) and Y (2 kg) 1 m long, each after the one before; a tip body ends it."""
+    points, rigids, springs, x = {"p0": np.zeros(3)}, [], [], 0.0
+    for i, letter in enumerate(letters + ("X" if letters[-1] in "AB" else "")):
+        a, b = f"p{i}", f"p{i + 1}"
+        if letter in "XY":
+            x += 1.0
+            points[b] = np.array([x, 0.0, 0.0])
+            rigids.append(make_rigid(f"r{i}", (a, b), 1.0 if letter == "X" else 2.0, (x - 0.5, 0.0, 0.0),
+                                     (0.1, 0.1, 0.1)))
+        else:
+            points[b] = np.array([x, 0.0, 0.0])
+            springs.append(make_spring(f"s{i}", a, b, [1e6 if letter == "A" else 3e6] * 6))
+    return Model(name, points, rigids=tuple(rigids), springs=tuple(springs), boundary={"p0": fixed()})
+
+
+def runs_position_by_position(topology) -> list:
+    """The greedy choice of find_runs written out plainly: at each position of the carry
+    order, every cell length and its repetitions counted one element at a time; the run
+    covering the most elements (the shortest cell among equals) taken, else the next position."""
+    order, elements = topology.order, topology.elements
+    ordered = [elements[e] for e in order]
+    chained = [el.kind != "beam" and len(el.inputs) == 1 and not (el.kind == "spring" and el.record.released.size)
+               for el in ordered]
+    follows = [i > 0 and el.ports[el.inputs[0]].link[:2] == ("element", order[i - 1]) for i, el in enumerate(ordered)]
+    values, scales = periodic.signatures(ordered, np.array(chained))
+
+    def same(i, j):  # element j repeats element i, chained after its predecessor
+        tolerance = periodic.SAME * np.maximum(scales[i], scales[j])
+        return bool(np.all(np.abs(values[i] - values[j]) <= tolerance)) and chained[j] and follows[j]
+
+    runs, i = [], 0
+    while i < len(order):
+        best = None
+        for period in range(1, min(periodic.MAX_PERIOD, len(order) - 1) + 1):
+            if i + period > len(order) or not all(chained[i:i + period]) or not all(follows[i + 1:i + period]):
+                continue
+            streak = 0
+            while i + streak + period < len(order) and same(i + streak, i + streak + period):
+                streak += 1
+            repetitions = 1 + streak // period
+            if repetitions >= periodic.MIN_REPETITIONS and (best is None or repetitions * period
+                                                            > best.repetitions * len(best.cell)):
+                best = periodic.Run(i, tuple(order[i:i + period]), repetitions)
+        if best is None:
+            i += 1
+        else:
+            runs.append(best)
+            i = best.stop
+    return runs
+
+
+def test_runs_are_the_plain_greedy_choice_on_mixed_lines():
+    """find_runs (the cover of every position computed at once) against the choice made
+    position by position, on 120 random lines of repeated cells of 1 to 4 elements."""
+    rng = np.random.default_rng(5)
+    with_runs = 0
+    for t in range(120):
+        letters = "A" + "".join("".join(rng.choice(list("AXBY"), size=int(rng.integers(1, 5))))
+                                * int(rng.integers(1, 20)) for _ in range(int(rng.integers(1, 4))))
+        letters = "".join(c for i, c in enumerate(letters) if i == 0 or not (c in "AB" and letters[i - 1] in "AB"))
+        topology = build_topology(sequence_model(letters, f"line {t}"))
+        expected = runs_position_by_position(topology)
+        assert periodic.find_runs(topology) == expected
+        with_runs += bool(expected)
+    assert with_runs > 60

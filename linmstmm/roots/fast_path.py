@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.counting import count_zeros, deflated, divided_out
+from linmstmm.counting import deflated, divided_out, zero_free
 from linmstmm.roots.brackets import quiet_minima
 from linmstmm.roots.settings import DEFLATED_POINTS, FINE_SCAN_RATIO, FIRST_CHUNK_RATIO
 
@@ -228,11 +228,9 @@ def scanned(finder, lo: float, hi: float, below) -> tuple:
 
 def holds_no_roots(finder, lo: float, hi: float) -> bool:
     """True if a count over (lo, hi) from DEFLATED_POINTS starting points finds
-    no root (False also when it cannot count)."""
-    try:
-        return count_zeros(finder.log_det, lo, hi, initial_points=DEFLATED_POINTS) == 0
-    except RuntimeError:
-        return False
+    no root (False also when it cannot count, and without counting where det has
+    opposite signs at lo and hi: :func:`~linmstmm.counting.zero_free`)."""
+    return zero_free(finder.log_det, lo, hi, initial_points=DEFLATED_POINTS)
 
 
 def quick_grid(finder, lo: float, hi: float) -> np.ndarray:

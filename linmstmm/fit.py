@@ -31,8 +31,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from linmstmm.model import Model, ModelError
-from linmstmm.parameters import get_value, model_file, parse_key, unit, with_values
+from linmstmm.model import Model, ModelError, model_file
+from linmstmm.parameters import get_value, parse_key, unit, with_values
 from linmstmm.sweep import ENGINE, solve_step
 
 #: Shape components a measured-shapes column may name, in the order of a point's 6 values.

@@ -234,13 +234,29 @@ def load_model(path) -> Model:
 _RECORD_KINDS = {"rigids": ("rigid", Rigid), "beams": ("beam", Beam), "springs": ("spring", Spring)}
 
 
+def model_file(model: Model) -> str:
+    """Where ``model`` comes from, for the messages of a ModelError.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+
+    Returns
+    -------
+    str
+        Its file, or ``model 'name'`` for a model built in code.
+    """
+    return model.source if isinstance(model.source, str) else f"model {model.name!r}"
+
+
 def _check_records(model):
     """Validate ``model`` by the loader's checks on its records written in the file's form.
 
     A beam's ``length`` and ``axes`` are not keys of the file (the loader derives
     them from the ends and ``y_axis``): they must agree with what it would derive.
     """
-    file = model.source if isinstance(model.source, str) else f"model {model.name!r}"
+    file = model_file(model)
     fields = _validate(_document(model, file), file)
     tol = _length_tol(fields["points"])
     for beam, derived in zip(model.beams, fields["beams"]):
@@ -276,9 +292,9 @@ def with_numbers(model: Model, points: dict, records: dict, damping) -> Model:
         point (or all of them where the model's size, and so its length
         tolerance, changed), the damping and the total mass. Names, ports,
         ends, boundary and connectivity cannot change, so are not checked again:
-        a scene sweep's model costs 0.2 ms here against 1.6 ms for the full check.
+        a launcher scene's edit costs 0.6 ms here against 2.3 ms for the full check.
     """
-    file = model.source if isinstance(model.source, str) else f"model {model.name!r}"
+    file = model_file(model)
     moved = {name for name, position in points.items() if position is not model.points[name]}
     point_table = _Table(file, _plain({name: points[name] for name in points if name in moved}), "[points]")
     for name in point_table.table:

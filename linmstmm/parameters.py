@@ -28,7 +28,7 @@ import re
 
 import numpy as np
 
-from linmstmm.model import Model, ModelError, with_numbers
+from linmstmm.model import Model, ModelError, model_file, with_numbers
 
 #: Element section of a key -> the Model attribute holding its records.
 SECTIONS = {"rigid": "rigids", "spring": "springs", "beam": "beams"}
@@ -292,19 +292,3 @@ def _beam_on(beam, points):
     axes = np.array([x, y, np.cross(x, y)])
     axes.flags.writeable = False
     return dataclasses.replace(beam, length=length, axes=axes)
-
-
-def model_file(model: Model) -> str:
-    """Where ``model`` comes from, for the messages of a ModelError.
-
-    Parameters
-    ----------
-    model : Model
-        The model.
-
-    Returns
-    -------
-    str
-        Its file, or ``model 'name'`` for a model built in code.
-    """
-    return model.source if isinstance(model.source, str) else f"model {model.name!r}"

@@ -10,6 +10,7 @@ import pytest
 
 import linmstmm.roots.segments as segments
 from linmstmm import fe_frequencies, load_model, natural_frequencies
+from linmstmm.roots import certify
 from linmstmm.roots.counted_search import counted_segment
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -21,6 +22,7 @@ class KnownRoots:
     1e-6 of where it starts, as the pencil does."""
 
     xtol, rtol, CERTIFIED_WIDTH = 1e-14, 1e-9, 1e-9
+    stiffness_count = certify.stiffness_count  # J(hi) − J(lo) by the counter below, as the finder's
 
     def __init__(self, roots, undecided=()):
         self.roots, self.undecided, self.last_step, self.evaluations = np.sort(roots), undecided, {}, 0

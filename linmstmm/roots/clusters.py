@@ -138,15 +138,6 @@ def unseparated_among(finder, roots) -> dict:
     return {r: finder.unseparated[r] for r in sorted(set(roots)) if r in finder.unseparated}
 
 
-def _counted_across(finder, root: float, radius: float) -> int | None:
-    """Natural frequencies within ``radius`` (rad/s) of ``root`` by the Wittrick–Williams
-    counts at its two ends; None without a counter or where either cannot decide."""
-    if finder.counter is None:
-        return None
-    below, above = finder.counter(root - radius), finder.counter(root + radius)
-    return None if below is None or above is None else above - below
-
-
 def multiplicity(finder, root: float, others=()) -> int | None:
     """How many roots sit at ``root``: the circle count already made for it while
     finding the roots, else one made now (:meth:`multiplicities`)."""
@@ -177,7 +168,7 @@ def separated(finder, roots: list[float]) -> list[float]:
     if not multiple:
         return roots
     radii = [finder._circle_radius(r, distinct) for r in multiple]
-    tight = [_counted_across(finder, r, radius / 100) for r, radius in zip(multiple, radii)]
+    tight = [finder.stiffness_count([], r - radius / 100, r + radius / 100) for r, radius in zip(multiple, radii)]
     undecided = [i for i, count in enumerate(tight) if count is None]
     circles = count_zeros_many(finder.log_det, [(multiple[i] - radii[i] / 100, multiple[i] + radii[i] / 100)
                                                 for i in undecided],

@@ -87,9 +87,9 @@ def _split_across(finder, members: list[float]) -> bool:
     for root in sorted(set(members)):
         multiplicity = members.count(root)
         for width in near_widths(finder.rtol) if multiplicity > 1 else ():
-            below, above = finder.counter(root * (1 - width)), finder.counter(root * (1 + width))
-            if below is not None and above is not None:
-                if above - below < multiplicity:
+            counted = finder.stiffness_count([], root * (1 - width), root * (1 + width))
+            if counted is not None:
+                if counted < multiplicity:
                     return True
                 break
     return False

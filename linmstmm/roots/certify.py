@@ -219,7 +219,7 @@ def _counted_widths(finder, known: list[float], roots: list[float]) -> tuple[dic
         for root, widths in list(pending.items()):
             width = widths[level]
             below, above = finder.counter(root * (1 - width)), finder.counter(root * (1 + width))
-            if below is None or above is None:
+            if below is None or above is None or _on_an_end(known, root, width):
                 continue
             first.setdefault(root, (above - below, width))
             if above - below == _known_within(known, root, width):
@@ -227,6 +227,14 @@ def _counted_widths(finder, known: list[float], roots: list[float]) -> tuple[dic
                 del pending[root]
         level += 1
     return first, held
+
+
+def _on_an_end(known: list[float], root: float, width: float) -> bool:
+    """Whether one of ``known`` lies within a tenth of ``width`` of an end of the count
+    across ``root`` (relative ±``width``): which side of it the root lies is then not
+    known, and the count there says nothing about it (a rod's pair exactly 1e-7 apart:
+    a duplicate of one member and the other on the end made the count at 1e-7 hold)."""
+    return any(abs(abs(r - root) - width * root) < 0.1 * width * root for r in known)
 
 
 def _known_within(known: list[float], root: float, width: float) -> int:

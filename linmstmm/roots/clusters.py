@@ -27,12 +27,13 @@ def clusters(finder, starts, confirm: bool = True) -> list[list[float]]:
     a spurious near offset: polishing every one cost MLRS 6 ms).
     """
     polished = finder.polish(starts, early=not confirm)
+    near = beside(finder, polished) if confirm else [[] for _ in polished]
     groups, members_from = [], []
-    for (centre, mu), multiplicity in zip(polished, finder._multiplicities(polished, confirm)):
+    for (centre, mu), multiplicity, others in zip(polished, finder._multiplicities(polished, confirm, near), near):
         if centre is None:
             groups.append([])
             continue
-        groups.append([centre] * multiplicity)
+        groups.append([centre] * multiplicity + others)
         real = mu[np.abs(mu.imag) <= 1e-6 * np.abs(mu)].real
         outside = np.abs(real) >= finder.SPLIT * centre
         if confirm:
@@ -57,8 +58,10 @@ def clusters(finder, starts, confirm: bool = True) -> list[list[float]]:
     return [sorted(group) for group in groups]
 
 
-def centre_multiplicities(finder, polished, confirm: bool = True) -> list[int]:
-    """How many roots sit at each polished centre, given its pencil offsets mu.
+def centre_multiplicities(finder, polished, confirm: bool = True, near=None) -> list[int]:
+    """How many roots sit at each polished centre, given its pencil offsets mu, and
+    ``near``: for each, the distinct roots found within SPLIT of it (:func:`beside`),
+    which its circle leaves out.
 
     A root of multiplicity m leaves m offsets near zero, split by rounding
     to about √eps and not always real (7 arms of NAFEMS FV2: up to 6e-5).
@@ -77,11 +80,14 @@ def centre_multiplicities(finder, polished, confirm: bool = True) -> list[int]:
     multiplicities = [1] * len(polished)
     asked, intervals = [], []
     for i, (centre, mu) in enumerate(polished):
+        if centre is None:
+            continue
         size = np.abs(mu)
-        if centre is None or np.sum(size < finder.SPLIT * centre) <= 1:
+        within = min([finder.SPLIT * centre] + [abs(other - centre) / 2 for other in (near[i] if near else [])])
+        if np.sum(size < within) <= 1:
             continue
         farther = size[size >= finder.SPLIT * centre]
-        radius = min(finder.SPLIT * centre, farther.min() / 2 if farther.size else np.inf)
+        radius = min(within, farther.min() / 2 if farther.size else np.inf)
         asked.append(i)
         intervals.append((centre - radius, centre + radius))
     counts = (count_zeros_many(finder.log_det, intervals, max_points=CIRCLE_MAX_POINTS, initial_points=CIRCLE_POINTS)
@@ -89,6 +95,7 @@ def centre_multiplicities(finder, polished, confirm: bool = True) -> list[int]:
     for i, count in zip(asked, counts):
         multiplicities[i] = 1 if isinstance(count, RuntimeError) else max(count, 1)
     finder._counted.update((polished[i][0], multiplicities[i]) for i in asked)
+    finder._circles.update((polished[i][0], (hi - lo) / 2) for i, (lo, hi) in zip(asked, intervals))
     return multiplicities
 
 
@@ -110,8 +117,16 @@ def recounted(finder, found: list[float], roots) -> list[float]:
 
 def as_counted(finder, found: list[float]) -> list[float]:
     """``found`` with each root repeated as often as a circle count gave it (:attr:`_counted`),
-    the others as often as they are."""
-    return sorted(r for r in set(found) for _ in range(finder._counted.get(r, found.count(r))))
+    the others as often as they are. A count whose circle holds another root of
+    ``found`` counted that one too: it is forgotten, so that :meth:`_settled` counts
+    again (a rod's root counted double before its neighbour 1e-7 away was found
+    stood double beside it, and a root 3e-3 below was missing)."""
+    distinct = sorted(set(found))
+    for r in [r for r in distinct if r in finder._counted]:
+        radius = finder._circles.get(r, 0.0)
+        if any(other != r and abs(other - r) < radius for other in distinct):
+            del finder._counted[r]
+    return sorted(r for r in distinct for _ in range(finder._counted.get(r, found.count(r))))
 
 
 def circle_radius(finder, root: float, others) -> float:
@@ -128,6 +143,7 @@ def multiplicities(finder, roots, others=()) -> list:
     if not len(roots):
         return []
     radii = [finder._circle_radius(r, others) for r in roots]
+    finder._circles.update(zip(roots, radii))
     counts = count_zeros_many(finder.log_det, [(r - radius, r + radius) for r, radius in zip(roots, radii)],
                               max_points=CIRCLE_MAX_POINTS, initial_points=CIRCLE_POINTS)
     return [None if isinstance(c, RuntimeError) else max(c, 1) for c in counts]
@@ -161,7 +177,10 @@ def separated(finder, roots: list[float]) -> list[float]:
     :attr:`unseparated` says so (root -> (multiplicity, radius, rad/s)):
     ``natural_frequencies`` then separates them in mpmath
     (:func:`~linmstmm.precision.separated_cluster`), or names them in its note.
+    Before any count, a multiple root whose pencil shows a distinct root nearby
+    is split into them (:func:`_apart_by_offsets`).
     """
+    roots = _apart_by_offsets(finder, roots)
     distinct = sorted(set(roots))
     # (a list cut at a count may hold one copy of a root counted as multiple)
     multiple = [r for r in distinct if max(roots.count(r), finder._counted.get(r, 1)) > 1]
@@ -187,3 +206,57 @@ def separated(finder, roots: list[float]) -> list[float]:
             continue
         separated = [x for x in separated if x != r] + members[:roots.count(r)]
     return sorted(separated)
+
+
+
+def beside(finder, polished) -> list[list[float]]:
+    """For each polished (centre, offsets μ) of :meth:`polish`: the distinct roots
+    closer than SPLIT that Newton reaches from its real offsets beyond rtol.
+
+    At a root of multiplicity m the pencil shows m offsets within rounding of zero
+    (1e-16 of ω at a cantilever's double roots; up to 6e-5 at the 7 arms of NAFEMS
+    FV2): Newton from those comes back to the centre. A real offset to a distinct
+    root stays put under Newton: from there it reaches that root, and a count over
+    a circle holding both would read the two as one double root (a cantilever's
+    bending pairs 1e-6 and 1e-7 apart came out as double roots 1e-6 from one
+    member, and one with a root 3e-3 below it missing).
+    """
+    starts, owners = [], []
+    for i, (centre, mu) in enumerate(polished):
+        if centre is None:
+            continue
+        real = mu[np.abs(mu.imag) <= 1e-6 * np.abs(mu)].real
+        ahead = real[(np.abs(real) > finder.rtol * centre) & (np.abs(real) < finder.SPLIT * centre)]
+        starts += (centre - ahead).tolist()
+        owners += [i] * ahead.size
+    near: list[list[float]] = [[] for _ in polished]
+    for i, (root, _) in zip(owners, finder.polish(starts) if starts else []):
+        centre = polished[i][0]
+        if (root is not None and finder.rtol * centre < abs(root - centre) < finder.SPLIT * centre
+                and all(abs(root - other) > finder.rtol * other for other in near[i])):
+            near[i].append(root)
+    return near
+
+
+def _apart_by_offsets(finder, roots: list[float]) -> list[float]:
+    """``roots`` with each multiple one whose pencil shows a distinct root beside it
+    (:func:`beside`) split: that root takes one of its copies. The counts of
+    :func:`separated` only say how many roots a circle holds."""
+    copies = {r: max(roots.count(r), finder._counted.get(r, 1)) for r in set(roots)}
+    multiple = sorted(r for r, m in copies.items() if m > 1)
+    if not multiple:
+        return roots
+    known = [r for r in multiple if finder.offsets_at.get(r, np.zeros(0)).size >= copies[r]]
+    missing = [r for r in multiple if r not in known]
+    offsets = dict(zip(missing, finder._offsets(np.array(missing)) if missing else []))
+    offsets.update((r, finder.offsets_at[r]) for r in known)
+    split = list(roots)
+    for r, near in zip(multiple, beside(finder, [(r, offsets[r]) for r in multiple])):
+        for member in near:
+            if any(abs(member - other) <= finder.rtol * other for other in split):
+                continue  # a root found already
+            if split.count(r) > 1:
+                split.remove(r)
+            finder._counted[r] = max(finder._counted.get(r, 1) - 1, 1)
+            split.append(member)
+    return sorted(split)

@@ -129,6 +129,9 @@ class RootFinder:
         self.points_per_root = points_per_root
         #: root -> relative size of the last Newton step that reached it
         self.last_step: dict[float, float] = {}
+        #: root -> the pencil's offsets μ (rad/s, complex, by size) seen from it when
+        #: Newton reached it (:func:`~linmstmm.roots.pencil.polish`)
+        self.offsets_at: dict[float, np.ndarray] = {}
         #: why the search ended early, if it did
         self.note = ""
         self._rigid = rigid_body_modes
@@ -149,6 +152,9 @@ class RootFinder:
         self.unseparated: dict[float, tuple[int, float]] = {}
         #: root -> multiplicity a circle count gave it (1 where it could not be made; :meth:`_settled`)
         self._counted: dict[float, int] = {}
+        #: root -> radius (rad/s) of the circle a count of it was made over: a count whose
+        #: circle holds a root found later is stale (:meth:`_as_counted`)
+        self._circles: dict[float, float] = {}
         #: callable omega -> natural frequencies below omega (rad/s), rigid-body modes
         #: included, or None where it cannot decide (a
         #: :class:`~linmstmm.wittrick_williams.ModeCounter`); None: counts by the

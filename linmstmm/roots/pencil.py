@@ -96,6 +96,7 @@ def polish(finder, starts, iterations: int = 40, early: bool = False):
             elif converged:
                 finder.last_step[omega[i]] = step / omega[i]
                 results[i] = (omega[i], mu - mu[0].real)  # offsets seen from the new ω
+                finder.offsets_at[omega[i]] = results[i][1]
             else:
                 # A mostly imaginary nearest offset sees no real root at its distance:
                 # ω creeps by its real part (MLRS above 170 Hz: 40 rounds, 1e-8 each).

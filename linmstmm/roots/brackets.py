@@ -135,11 +135,19 @@ def merge(finder, found: list[float], members, lo, hi) -> None:
 
     Equal entries of ``members`` are one root's multiplicity and go in
     together; a root within SPLIT of one already found is that root (its
-    multiplicity was settled by :meth:`_multiplicities`).
+    multiplicity was settled by :meth:`_multiplicities`). A multiplicity
+    counted over a circle that reaches out of (lo, hi] may hold a root outside:
+    it is counted again over a circle inside (a rod's pair 1e-7 apart across a
+    segment's end came in as a double root at rtol 1e-6, and the segment's other
+    root, 3e-3 below, was taken as found).
     """
     for value in sorted(set(m for m in members if lo < m <= hi)):
         if not any(abs(value - r) <= finder.SPLIT * r for r in found):
-            found += [m for m in members if m == value]
+            copies = members.count(value)
+            if copies > 1 and finder._circles.get(value, 0.0) >= min(value - lo, hi - value):
+                copies = finder.multiplicities([value], [lo, hi])[0] or 1
+                finder._counted[value] = copies
+            found += [value] * copies
 
 
 def polished(finder, starts, found: list[float], confirm: bool = True) -> list[float]:

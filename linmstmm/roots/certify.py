@@ -211,6 +211,7 @@ def _counted_widths(finder, known: list[float], roots: list[float]) -> tuple[dic
     (:meth:`~linmstmm.wittrick_williams.ModeCounter.prefetch`, shared among the cores)."""
     pending = {root: _widths(finder, root) for root in roots}
     first, held, level = {}, {}, 0
+    ordered = np.sort(np.asarray(known, dtype=float))
     prefetch = getattr(finder.counter, "prefetch", None)
     while pending:
         pending = {root: widths for root, widths in pending.items() if level < len(widths)}
@@ -219,7 +220,7 @@ def _counted_widths(finder, known: list[float], roots: list[float]) -> tuple[dic
         for root, widths in list(pending.items()):
             width = widths[level]
             below, above = finder.counter(root * (1 - width)), finder.counter(root * (1 + width))
-            if below is None or above is None or _on_an_end(known, root, width):
+            if below is None or above is None or _on_an_end(ordered, root, width):
                 continue
             first.setdefault(root, (above - below, width))
             if above - below == _known_within(known, root, width):
@@ -229,12 +230,15 @@ def _counted_widths(finder, known: list[float], roots: list[float]) -> tuple[dic
     return first, held
 
 
-def _on_an_end(known: list[float], root: float, width: float) -> bool:
-    """Whether one of ``known`` lies within a tenth of ``width`` of an end of the count
-    across ``root`` (relative ±``width``): which side of it the root lies is then not
-    known, and the count there says nothing about it (a rod's pair exactly 1e-7 apart:
-    a duplicate of one member and the other on the end made the count at 1e-7 hold)."""
-    return any(abs(abs(r - root) - width * root) < 0.1 * width * root for r in known)
+def _on_an_end(ordered: np.ndarray, root: float, width: float) -> bool:
+    """Whether one of the known roots ``ordered`` (rad/s, ascending) lies within a tenth
+    of ``width`` of an end of the count across ``root`` (relative ±``width``): which
+    side of it the root lies is then not known, and the count there says nothing
+    about it (a rod's pair exactly 1e-7 apart: a duplicate of one member and the
+    other on the end made the count at 1e-7 hold)."""
+    band = 0.1 * width * root
+    ends = np.array([root * (1 - width), root * (1 + width)])
+    return bool(np.any(np.searchsorted(ordered, ends + band) > np.searchsorted(ordered, ends - band)))
 
 
 def _known_within(known: list[float], root: float, width: float) -> int:
@@ -270,10 +274,11 @@ def counted_multiplicities(finder, roots: list[float], lo: float | None, hi: flo
     if finder.counter is None:
         return roots
     start, counted = 0.0 if lo is None else lo, []
+    ordered = np.sort(np.asarray(roots, dtype=float))
     for root in sorted(set(roots)):
         have = roots.count(root)
         if start < root < hi:
-            near = _count_near(finder, root)
+            near = _count_near(finder, root, ordered)
             if near is not None:
                 # the count sees close neighbours too: this root holds what they leave
                 counted_here = near[0] - (_known_within(roots, root, near[1]) - have)
@@ -284,11 +289,13 @@ def counted_multiplicities(finder, roots: list[float], lo: float | None, hi: flo
     return counted
 
 
-def _count_near(finder, root: float) -> tuple[int, float] | None:
+def _count_near(finder, root: float, ordered: np.ndarray) -> tuple[int, float] | None:
     """(natural frequencies within ±width of ``root``, width (relative)) at the
-    narrowest width of :func:`_counts_near` where the count decides; None where
+    narrowest width of :func:`_counts_near` where the count decides and no root of
+    ``ordered`` (rad/s, ascending) lies on an end (:func:`_on_an_end`); None where
     none does."""
-    return next(((count, width) for count, width in _counts_near(finder, root) if count is not None), None)
+    return next(((count, width) for count, width in _counts_near(finder, root)
+                 if count is not None and not _on_an_end(ordered, root, width)), None)
 
 
 def _counts_near(finder, root: float):

@@ -117,16 +117,8 @@ def recounted(finder, found: list[float], roots) -> list[float]:
 
 def as_counted(finder, found: list[float]) -> list[float]:
     """``found`` with each root repeated as often as a circle count gave it (:attr:`_counted`),
-    the others as often as they are. A count whose circle holds another root of
-    ``found`` counted that one too: it is forgotten, so that :meth:`_settled` counts
-    again (a rod's root counted double before its neighbour 1e-7 away was found
-    stood double beside it, and a root 3e-3 below was missing)."""
-    distinct = sorted(set(found))
-    for r in [r for r in distinct if r in finder._counted]:
-        radius = finder._circles.get(r, 0.0)
-        if any(other != r and abs(other - r) < radius for other in distinct):
-            del finder._counted[r]
-    return sorted(r for r in distinct for _ in range(finder._counted.get(r, found.count(r))))
+    the others as often as they are."""
+    return sorted(r for r in set(found) for _ in range(finder._counted.get(r, found.count(r))))
 
 
 def circle_radius(finder, root: float, others) -> float:
@@ -206,7 +198,6 @@ def separated(finder, roots: list[float]) -> list[float]:
             continue
         separated = [x for x in separated if x != r] + members[:roots.count(r)]
     return sorted(separated)
-
 
 
 def beside(finder, polished) -> list[list[float]]:

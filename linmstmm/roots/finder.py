@@ -152,8 +152,8 @@ class RootFinder:
         self.unseparated: dict[float, tuple[int, float]] = {}
         #: root -> multiplicity a circle count gave it (1 where it could not be made; :meth:`_settled`)
         self._counted: dict[float, int] = {}
-        #: root -> radius (rad/s) of the circle a count of it was made over: a count whose
-        #: circle holds a root found later is stale (:meth:`_as_counted`)
+        #: root -> radius (rad/s) of the circle a count of it was made over (a circle that
+        #: reaches out of a segment may hold a root outside it: :meth:`_merge`)
         self._circles: dict[float, float] = {}
         #: callable omega -> natural frequencies below omega (rad/s), rigid-body modes
         #: included, or None where it cannot decide (a

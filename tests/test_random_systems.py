@@ -169,32 +169,25 @@ def test_forced_cut_on_a_ring_without_boundary():
     assert [(cut.point, cut.closing) for cut in cuts] == [(point, True)]
 
 
-def test_a_cluster_float64_cannot_separate_is_separated_in_mpmath():
-    """Loops 32 at 40 modes: a root 3e-5 below another at 2663 Hz, which float64 Ū_all
-    cannot tell apart. Without the Wittrick–Williams counter, the float64 search flags
-    what it could not separate (RootSearchResult.unseparated; the FE root lies within the
-    radius it gives: they had come back as one double root, silently, and since the
-    bisection on the count encloses such a root it is one root at an interval's middle);
-    natural_frequencies then finds it in mpmath. With it, the counts at the ends of the
-    small circle that tells a multiple root from a cluster part them in float64 (they
-    come from the dynamic stiffness, not from Ū_all). Either way all 40 agree with FE.
-    (The predicted search's secant on det itself splits the pair in float64, 1.9e-14
-    from FE; the flag is checked on the scan-based search, which the predicted one
-    hands over to.)"""
+def test_a_pair_closer_than_a_circle_count_resolves_is_separated_in_float64():
+    """Loops 32 at 40 modes: a root 3e-5 below another at 2663 Hz. By Ū_all alone (no
+    Wittrick–Williams counter, the scan-based search) a circle count held both and
+    read them as one double root: the search flagged it as a cluster float64 could not
+    separate, for mpmath. The pencil's offset at one member points at the other, and
+    Newton from there reaches it (roots.clusters.beside): float64 separates them, and
+    all 40 agree with FE. With the counter, and by natural_frequencies, likewise.
+    (Clusters that float64 cannot separate go to mpmath: test_close_roots.py.)"""
     from linmstmm.solve import frequency_finder
 
     model = random_model("loops", 32)
     reference = 2 * np.pi * fe_frequencies(model, count=40).frequencies_hz
-    _, finder, _ = frequency_finder(model)
-    finder.predictor, finder.counter = None, None  # the scan-based search, by Ū_all alone
-    search = finder.find(40, None)
-    assert search.unseparated
-    for root, (_, radius) in search.unseparated.items():
-        assert np.min(np.abs(reference - root)) <= radius
-    _, finder, _ = frequency_finder(model)
-    finder.predictor = None
-    search = finder.find(40, None)
-    assert not search.unseparated and relative(np.array(search.roots), reference) <= AGREEMENT
+    for counter in (False, True):
+        _, finder, _ = frequency_finder(model)
+        finder.predictor = None  # the scan-based search
+        if not counter:
+            finder.counter = None
+        search = finder.find(40, None)
+        assert not search.unseparated and relative(np.array(search.roots), reference) <= AGREEMENT
     result = natural_frequencies(model, 40)
     assert result.note == ""
     assert relative(result.frequencies_hz, reference / (2 * np.pi)) <= AGREEMENT

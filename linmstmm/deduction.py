@@ -40,7 +40,7 @@ from linmstmm.elements.rigid import (
     position_incidence,
     rigid_transfer_parts,
 )
-from linmstmm.elements.spring import joint_force, joint_jump, spring_transfer
+from linmstmm.elements.spring import joint_force, joint_jump, spring_constant_transfer
 from linmstmm.godunov import PortState, _Orthonormaliser, _row_kinds
 from linmstmm.load_jumps import _Loads
 from linmstmm.model import COMPONENTS
@@ -151,7 +151,7 @@ class Deduction:
                     record.mass, record.com, record.inertia,
                     element.ports[element.inputs[0]].position, element.ports[element.output].position)))
             elif element.kind == "spring":
-                parts = (spring_transfer(numbers(record.k, exact), record.axes, np.zeros(1), record.release)[0],
+                parts = (spring_constant_transfer(numbers(record.k, exact), record.axes, record.release),
                          None)
             else:  # junction: a massless rigid body whose ports coincide
                 parts = (np.eye(12), None)

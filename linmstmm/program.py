@@ -26,7 +26,7 @@ import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import _state_rotation
-from linmstmm.elements.spring import joint_force
+from linmstmm.program_constants import Constants
 
 # Operation codes (first entry of each record in Program.operations).
 #: TIP dst constant: the slot holds a constant (12, k) selection, reference 1.
@@ -135,7 +135,7 @@ class _Planner:
         self.orthos: list[tuple] = []
         self.ortho_blocks: list[tuple] = []
         self.beams: list[int] = []  # element index of each BEAM record
-        self.recipes: list[tuple[int, tuple]] = []  # (matrix index, recipe) of the model's numbers
+        self.constants = Constants()  # where the model's numbers go among the matrices
 
     # -- storage ----------------------------------------------------------------------
     def slot(self, rows: int, columns) -> int:
@@ -146,13 +146,22 @@ class _Planner:
 
     def matrix(self, matrix) -> int:
         """Index of a new constant: one the topology alone fixes (a selection, a sign)."""
-        self.matrices.append(_padded(matrix))
+        self.matrices.append(matrix)
         return len(self.matrices) - 1
 
-    def valued(self, recipe: tuple) -> int:
-        """Index of a new constant made from the model's numbers by ``recipe`` (:func:`_valued`)."""
-        self.recipes.append((len(self.matrices), recipe))
-        return self.matrix(_valued(self.deduction, recipe))
+    def valued(self) -> int:
+        """Index of a new constant made from the model's numbers, which the caller enters
+        in ``self.constants`` (:class:`~linmstmm.program_constants.Constants`)."""
+        return self.matrix(None)
+
+    def all_matrices(self) -> np.ndarray:
+        """(K, 12, 12) every constant: the topology's, padded, and the model's numbers'."""
+        matrices = np.zeros((len(self.matrices), 12, 12))
+        for index, matrix in enumerate(self.matrices):
+            if matrix is not None:
+                matrices[index, :matrix.shape[0], :matrix.shape[1]] = matrix
+        self.constants.fill(self.deduction, matrices)
+        return matrices
 
     def place(self, columns, onto) -> int:
         self.places.append(np.searchsorted(onto, columns).astype(np.int64))
@@ -218,12 +227,12 @@ def compile_program(deduction: Deduction) -> Program:
 class _Layout:
     """A walk of the carry: its program, and how the model's numbers enter it.
 
-    recipes : (matrix index, recipe) of every constant made from the model's
-    numbers (:func:`_valued`); beams : (nb,) element index of each BEAM record.
+    constants : where each constant made from the model's numbers goes among the
+    program's matrices; beams : (nb,) element index of each BEAM record.
     """
 
     program: Program
-    recipes: tuple
+    constants: Constants
     beams: tuple
 
 
@@ -255,34 +264,9 @@ def _structure(deduction: Deduction) -> tuple:
 def _revalued(layout: _Layout, deduction: Deduction) -> Program:
     """``layout``'s program with the numbers of ``deduction`` (of the same structure)."""
     matrices = layout.program.matrices.copy()
-    for index, recipe in layout.recipes:
-        matrices[index] = _padded(_valued(deduction, recipe))
+    layout.constants.fill(deduction, matrices)
     return replace(layout.program, matrices=matrices, beams=_beam_parameters(deduction, layout.beams),
                    beam_rotation=_beam_rotations(deduction, layout.beams))
-
-
-def _valued(deduction: Deduction, recipe: tuple) -> np.ndarray:
-    """The constant ``recipe`` names, from the deduction's numbers: ("kinematic", e) and
-    ("inertial", e) U0 and U2 of element e, ("forces", e, k) and ("incidence", e, k)
-    U_{j,Ik} and H_{j,Ik} of its input k + 2, ("joint", e) the forces along a joint's
-    released directions, ("jump", e) its jumps' state E Δ."""
-    kind, e = recipe[:2]
-    if kind in ("kinematic", "inertial"):
-        return deduction._polynomial_parts(e)[kind == "inertial"]
-    if kind in ("forces", "incidence"):
-        return deduction._other_inputs(e)[recipe[2]][1 if kind == "forces" else 2]
-    record = deduction.topology.elements[e].record
-    if kind == "joint":
-        return joint_force(record.axes, record.released)
-    return deduction.jump_state(e, 1).matrix[0]
-
-
-def _padded(matrix) -> np.ndarray:
-    """``matrix`` (at most 12 × 12) in the top left corner of a float (12, 12) of zeros."""
-    padded = np.zeros((12, 12))
-    matrix = np.asarray(matrix, dtype=float)
-    padded[:matrix.shape[0], :matrix.shape[1]] = matrix
-    return padded
 
 
 def _beam_parameters(deduction: Deduction, beams) -> np.ndarray:
@@ -383,23 +367,30 @@ def _planned(deduction: Deduction) -> _Layout:
             plan.emit(BEAM, state, index, 0, records if len(plan.orthos) > records else -1)
             terms = [(state, -1)]
         else:
-            inertial = deduction._polynomial_parts(e)[1]
             carried = plan.slot(12, plan.columns(inputs[0]))
-            plan.emit(CARRY, carried, inputs[0], plan.valued(("kinematic", e)),
-                      -1 if inertial is None else plan.valued(("inertial", e)))
+            kinematic = plan.valued()
+            inertial = plan.valued() if element.kind == "rigid" else -1  # U2 = 0: none
+            if element.kind == "rigid":
+                plan.constants.rigid.append((e, kinematic, inertial))
+            elif element.kind == "spring":
+                plan.constants.spring.append((e, kinematic))
+            else:
+                plan.constants.junction.append(kinematic)
+            plan.emit(CARRY, carried, inputs[0], kinematic, inertial)
             terms = [(carried, -1)]
             if e in deduction.jump_columns:
                 terms.append((_joint(plan, deduction, e, inputs[0], rows), -1))
-        for k, ((label, _, _), other) in enumerate(zip(deduction._other_inputs(e), inputs[1:])):
-            terms.append((other, plan.valued(("forces", e, k))))
+        for k, other in enumerate(inputs[1:]):
+            forces, incidence = plan.valued(), plan.valued()
+            plan.constants.other_input.append((e, k, forces, incidence))
+            terms.append((other, forces))
             first = inputs[0]
             union = np.unique(np.concatenate([plan.columns(first), plan.columns(other)]))
             row = plan.slot(6, union)
-            plan.emit(GEOMETRIC, row, first, other, plan.valued(("incidence", e, k)),
-                      len(plan.places))
+            plan.emit(GEOMETRIC, row, first, other, incidence, len(plan.places))
             plan.place(plan.columns(first), union)
             plan.place(plan.columns(other), union)
-            rows.append([label, row, 6, -1])
+            rows.append([f"{element.name} input {element.ports[element.inputs[k + 1]].point}", row, 6, -1])
         state = terms[0][0] if len(terms) == 1 else plan.combined(terms)
         open_states[e] = orthonormalise(state)
     root = open_states[topology.order[-1]]
@@ -421,7 +412,7 @@ def _planned(deduction: Deduction) -> _Layout:
         terms=np.array(plan.terms, dtype=np.int64).reshape(-1, 3),
         places=np.concatenate(plan.places).astype(np.int64) if plan.places else np.zeros(0, np.int64),
         places_start=places_start.astype(np.int64),
-        matrices=np.array(plan.matrices).reshape(-1, 12, 12),
+        matrices=plan.all_matrices(),
         orthos=np.array(plan.orthos, dtype=np.int64).reshape(-1, 5),
         ortho_blocks=np.array(plan.ortho_blocks, dtype=np.int64).reshape(-1, 6),
         beams=_beam_parameters(deduction, plan.beams),
@@ -434,7 +425,7 @@ def _planned(deduction: Deduction) -> _Layout:
         kept_columns=np.setdiff1d(np.arange(order), deduction.released_columns).astype(np.int64),
         row_kinds=np.concatenate([_row_kinds(count, forces) for _, _, count, forces in rows]).astype(np.int64),
     )
-    return _Layout(program, tuple(plan.recipes), tuple(plan.beams))
+    return _Layout(program, plan.constants, tuple(plan.beams))
 
 
 def _row_kinds(count: int, forces: int) -> np.ndarray:
@@ -453,10 +444,12 @@ def _joint(plan: _Planner, deduction: Deduction, e: int, state: int, rows: list)
     (a constant, ``E Δ``) to add to its output."""
     record = deduction.topology.elements[e].record
     row = plan.slot(record.released.size, plan.columns(state))
-    plan.emit(JOINT, row, state, plan.valued(("joint", e)))
+    force, jump = plan.valued(), plan.valued()
+    plan.constants.joint.append((e, force, jump))
+    plan.emit(JOINT, row, state, force)
     rows.append([f"{record.name} released", row, record.released.size, int(np.sum(record.released < 3))])
     slot = plan.slot(12, deduction.jump_state(e, 1).columns)
-    plan.emit(TIP, slot, plan.valued(("jump", e)))
+    plan.emit(TIP, slot, jump)
     return slot
 
 

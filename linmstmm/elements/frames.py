@@ -24,9 +24,15 @@ SYMPLECTIC_FORM[FORCE_INDEX, np.arange(6)] = -1.0
 
 
 def skew(r) -> np.ndarray:
-    """(3, 3) cross-product matrix: ``skew(r) @ v == np.cross(r, v)``."""
-    x, y, z = np.asarray(r)  # float, or mpmath numbers (then an object array)
-    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]], dtype=number_type(r))
+    """(..., 3, 3) cross-product matrices of (..., 3) vectors: ``skew(r) @ v == np.cross(r, v)``.
+
+    r : float, or mpmath numbers (then an object array, its zeros the float 0.0).
+    """
+    r = np.asarray(r)
+    x, y, z = r[..., 0], r[..., 1], r[..., 2]
+    zero = np.zeros(x.shape)
+    entries = np.stack([zero, -z, y, z, zero, -x, -y, x, zero], axis=-1)
+    return entries.reshape(r.shape[:-1] + (3, 3)).astype(number_type(r), copy=False)
 
 
 def state_rotation(axes) -> np.ndarray:

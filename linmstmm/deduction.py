@@ -195,29 +195,43 @@ class Deduction:
     # -- boundary states ------------------------------------------------------------
     def tip_state(self, link, n) -> PortState:
         """State of a boundary end or cut side in terms of its unknowns (less released ones)."""
-        if link[0] == "boundary":
-            columns = self._boundary_columns[link[1]]
-            selection = boundary_selection(self.topology.boundaries[link[1]].fixed)
-        else:
-            _, c, side = link
-            columns = self._cut_columns[c]
-            selection = np.eye(12) if (side == 0 or self.topology.cuts[c].closing) else _CUT_SIGN
-        if link not in self._tips:
-            kept = ~np.isin(columns, self.released_columns)
-            self._tips[link] = (columns[kept], selection[:, kept])
-        columns, selection = self._tips[link]
+        columns, selection = self.tip_selection(link)
         return PortState(columns, np.broadcast_to(selection, (n,) + selection.shape), np.ones(n))
+
+    def tip_selection(self, link) -> tuple[np.ndarray, np.ndarray]:
+        """(columns (k,), selection (12, k)) of a boundary end or cut side: its state is
+        ``selection @ z̄[columns]`` (less released unknowns); found once per link."""
+        if link not in self._tips:
+            if link[0] == "boundary":
+                columns = self._boundary_columns[link[1]]
+                selection = boundary_selection(self.topology.boundaries[link[1]].fixed)
+            else:
+                _, c, side = link
+                columns = self._cut_columns[c]
+                selection = np.eye(12) if (side == 0 or self.topology.cuts[c].closing) else _CUT_SIGN
+            self._tips[link] = self._kept(columns, selection)
+        return self._tips[link]
+
+    def _kept(self, columns: np.ndarray, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``columns`` and ``matrix``'s columns, less the released unknowns."""
+        if not self.released_columns.size:
+            return columns, matrix
+        kept = ~np.isin(columns, self.released_columns)
+        return columns[kept], matrix[:, kept]
 
     def jump_state(self, e, n) -> PortState:
         """The jumps across the released directions of joint ``e`` as a state:
         ``E Δ`` on their columns (less released ones)."""
-        if ("jump", e) not in self._tips:
-            columns, record = self.jump_columns[e], self.topology.elements[e].record
-            kept = ~np.isin(columns, self.released_columns)
-            jump = joint_jump(record.axes, record.released)
-            self._tips["jump", e] = (columns[kept], jump[:, kept])
-        columns, jump = self._tips["jump", e]
+        columns, jump = self.jump_selection(e)
         return PortState(columns, np.broadcast_to(jump, (n,) + jump.shape), np.ones(n))
+
+    def jump_selection(self, e) -> tuple[np.ndarray, np.ndarray]:
+        """(columns (k,), E (12, k)) of the jumps across the released directions of joint
+        ``e``: the state ``E Δ`` (less released unknowns); found once per joint."""
+        if ("jump", e) not in self._tips:
+            record = self.topology.elements[e].record
+            self._tips["jump", e] = self._kept(self.jump_columns[e], joint_jump(record.axes, record.released))
+        return self._tips["jump", e]
 
     def _joint_row(self, e, state: PortState) -> list:
         """[label, columns, (n, r, k) F S_I, kinds]: no force along the released

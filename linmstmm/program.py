@@ -138,11 +138,21 @@ class _Planner:
         self.constants = Constants()  # where the model's numbers go among the matrices
 
     # -- storage ----------------------------------------------------------------------
-    def slot(self, rows: int, columns) -> int:
-        columns = np.asarray(columns, dtype=np.int64)
+    def slot(self, rows: int, columns: np.ndarray, column_set: frozenset | None = None) -> int:
+        """A new slot of ``rows`` rows on ``columns`` (sorted int64; ``column_set`` the same
+        columns as a set, if the caller has it: slots share both, neither is ever changed)."""
         self.slots.append((rows, columns))
-        self.column_sets.append(frozenset(columns.tolist()))
+        self.column_sets.append(frozenset(columns.tolist()) if column_set is None else column_set)
         return len(self.slots) - 1
+
+    def slot_like(self, rows: int, slot: int) -> int:
+        """A new slot of ``rows`` rows on the columns of ``slot``."""
+        return self.slot(rows, self.slots[slot][1], self.column_sets[slot])
+
+    def union(self, slots) -> tuple[np.ndarray, frozenset]:
+        """(sorted int64 array, set) of the columns of all of ``slots``."""
+        union = frozenset().union(*[self.column_sets[s] for s in slots])
+        return np.array(sorted(union), dtype=np.int64), union
 
     def matrix(self, matrix) -> int:
         """Index of a new constant: one the topology alone fixes (a selection, a sign)."""
@@ -164,7 +174,7 @@ class _Planner:
         return matrices
 
     def place(self, columns, onto) -> int:
-        self.places.append(np.searchsorted(onto, columns).astype(np.int64))
+        self.places.append(np.searchsorted(onto, columns))
         return len(self.places) - 1
 
     def emit(self, *record) -> None:
@@ -173,8 +183,7 @@ class _Planner:
     # -- blocks -----------------------------------------------------------------------
     def tip(self, link, negate: bool = False) -> int:
         """Slot of a boundary end's or cut side's state in its (kept) unknowns."""
-        given = self.deduction.tip_state(link, 1)
-        columns, selection = given.columns, given.matrix[0]
+        columns, selection = self.deduction.tip_selection(link)
         slot = self.slot(12, columns)
         self.emit(TIP, slot, self.matrix(-selection if negate else selection))
         return slot
@@ -184,8 +193,8 @@ class _Planner:
 
     def combined(self, sources: list[tuple[int, int]]) -> int:
         """New slot = Σ matrix @ source over the union of the sources' columns."""
-        union = np.unique(np.concatenate([self.columns(s) for s, _ in sources]))
-        dst = self.slot(12, union)
+        union, union_set = self.union([s for s, _ in sources])
+        dst = self.slot(12, union, union_set)
         first = len(self.terms)
         for src, matrix in sources:
             self.terms.append((src, matrix, self.place(self.columns(src), union)))
@@ -286,10 +295,19 @@ def _beam_rotations(deduction: Deduction, beams) -> np.ndarray:
 def _planned(deduction: Deduction) -> _Layout:
     """The walk of ``deduction``'s carry, recorded."""
     plan = _Planner(deduction)
+    rows, root = _walked(plan)
+    return _Layout(_assembled(plan, rows, root), plan.constants, tuple(plan.beams))
+
+
+def _walked(plan: _Planner) -> tuple[list, int]:
+    """Walk the carry of ``plan``'s deduction, recording it in ``plan``; returns the row
+    blocks of Ū_all ([slot, rows, forces] each, the root's known side first) and the
+    slot of the root's carried state."""
+    deduction = plan.deduction
     topology = deduction.topology
     elements = topology.elements
     root_given = topology.root if topology.root[0] == "boundary" else ("cut", topology.root[1], 0)
-    rows: list[list] = [["root", plan.tip(root_given, negate=True), 12, -1]]  # [label, slot, rows, forces]
+    rows: list[list] = [[plan.tip(root_given, negate=True), 12, -1]]  # [slot, rows, forces]
     open_states: dict[int, int] = {}
     waiting: dict[tuple, int] = {}
 
@@ -299,29 +317,30 @@ def _planned(deduction: Deduction) -> _Layout:
         emit : False to record it without an ORTHO operation (a beam's pieces
         after the first run it themselves)."""
         columns = set(plan.column_sets[state])
-        others = ([("row", i, r[1]) for i, r in enumerate(rows)]
+        others = ([("row", i, r[0]) for i, r in enumerate(rows)]
                   + [("state", key, slot) for key, slot in open_states.items()]
                   + [("waiting", key, slot) for key, slot in waiting.items()])
         held = [plan.column_sets[slot] for *_, slot in others]
-        chosen: set[int] = set()
-        while True:
-            more = {i for i, cs in enumerate(held) if i not in chosen and not cs.isdisjoint(columns)}
-            if not more:
-                break
-            chosen |= more
-            for i in more:
-                columns |= held[i]
-        blocks = [others[i] for i in sorted(chosen)] + [("self", None, state)]
-        union = np.array(sorted(columns), dtype=np.int64)
-        block_rows = [rows[key][2] if kind == "row" else 12 for kind, key, _ in blocks]
-        block_forces = [rows[key][3] if kind == "row" else -1 for kind, key, _ in blocks]
-        if sum(block_rows) < union.size:  # fewer rows than columns: never orthonormalised
+        chosen = [False] * len(others)
+        grown = True
+        while grown:  # every block that shares a column with those gathered so far
+            grown = False
+            for i, block_columns in enumerate(held):
+                if not chosen[i] and not block_columns.isdisjoint(columns):
+                    chosen[i] = grown = True
+                    columns |= block_columns
+        blocks = [block for block, taken in zip(others, chosen) if taken] + [("self", None, state)]
+        block_rows = [rows[key][1] if kind == "row" else 12 for kind, key, _ in blocks]
+        if sum(block_rows) < len(columns):  # fewer rows than columns: never orthonormalised
             return state
+        block_forces = [rows[key][2] if kind == "row" else -1 for kind, key, _ in blocks]
+        union_set = frozenset(columns)
+        union = np.array(sorted(union_set), dtype=np.int64)
         first = len(plan.ortho_blocks)
         new_slots = []
         for (kind, key, src), count, forces in zip(blocks, block_rows, block_forces):
             same = len(plan.column_sets[src]) == union.size  # its columns are among the union's
-            dst = src if same else plan.slot(count, union)
+            dst = src if same else plan.slot(count, union, union_set)
             place = -1 if same else plan.place(plan.columns(src), union)
             plan.ortho_blocks.append((src, dst, count, ROW_BLOCK if kind == "row" else STATE_BLOCK, place,
                                       forces))
@@ -331,7 +350,7 @@ def _planned(deduction: Deduction) -> _Layout:
             plan.emit(ORTHO, len(plan.orthos) - 1)
         for kind, key, dst in new_slots:
             if kind == "row":
-                rows[key][1] = dst
+                rows[key][0] = dst
             elif kind == "state":
                 open_states[key] = dst
             elif kind == "waiting":
@@ -367,7 +386,7 @@ def _planned(deduction: Deduction) -> _Layout:
             plan.emit(BEAM, state, index, 0, records if len(plan.orthos) > records else -1)
             terms = [(state, -1)]
         else:
-            carried = plan.slot(12, plan.columns(inputs[0]))
+            carried = plan.slot_like(12, inputs[0])
             kinematic = plan.valued()
             inertial = plan.valued() if element.kind == "rigid" else -1  # U2 = 0: none
             if element.kind == "rigid":
@@ -385,23 +404,28 @@ def _planned(deduction: Deduction) -> _Layout:
             plan.constants.other_input.append((e, k, forces, incidence))
             terms.append((other, forces))
             first = inputs[0]
-            union = np.unique(np.concatenate([plan.columns(first), plan.columns(other)]))
-            row = plan.slot(6, union)
+            union, union_set = plan.union([first, other])
+            row = plan.slot(6, union, union_set)
             plan.emit(GEOMETRIC, row, first, other, incidence, len(plan.places))
             plan.place(plan.columns(first), union)
             plan.place(plan.columns(other), union)
-            rows.append([f"{element.name} input {element.ports[element.inputs[k + 1]].point}", row, 6, -1])
+            rows.append([row, 6, -1])
         state = terms[0][0] if len(terms) == 1 else plan.combined(terms)
         open_states[e] = orthonormalise(state)
     root = open_states[topology.order[-1]]
     if topology.root[0] == "boundary":
         _leave_final_orthos_to_the_lu(plan)
+    return rows, root
 
+
+def _assembled(plan: _Planner, rows: list, root: int) -> Program:
+    """The program ``plan`` recorded, as arrays (``rows`` and ``root`` as :func:`_walked` gives them)."""
+    deduction = plan.deduction
     sizes = np.array([r * len(c) for r, c in plan.slots], dtype=np.int64)
     starts = np.cumsum([0] + [len(c) for _, c in plan.slots])
     places_start = np.cumsum([0] + [p.size for p in plan.places])
     order = deduction.full_order
-    program = Program(
+    return Program(
         slot_offset=np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64),
         slot_rows=np.array([r for r, _ in plan.slots], dtype=np.int64),
         slot_width=np.array([len(c) for _, c in plan.slots], dtype=np.int64),
@@ -418,14 +442,20 @@ def _planned(deduction: Deduction) -> _Layout:
         beams=_beam_parameters(deduction, plan.beams),
         beam_rotation=_beam_rotations(deduction, plan.beams),
         root=root,
-        root_row=rows[0][1],
-        geometric_rows=np.array([r[1] for r in rows[1:]], dtype=np.int64),
+        root_row=rows[0][0],
+        geometric_rows=np.array([r[0] for r in rows[1:]], dtype=np.int64),
         order=order,
-        kept_rows=np.setdiff1d(np.arange(order), deduction.released_rows).astype(np.int64),
-        kept_columns=np.setdiff1d(np.arange(order), deduction.released_columns).astype(np.int64),
-        row_kinds=np.concatenate([_row_kinds(count, forces) for _, _, count, forces in rows]).astype(np.int64),
+        kept_rows=_kept(order, deduction.released_rows),
+        kept_columns=_kept(order, deduction.released_columns),
+        row_kinds=np.concatenate([_row_kinds(count, forces) for _, count, forces in rows]).astype(np.int64),
     )
-    return _Layout(program, plan.constants, tuple(plan.beams))
+
+
+def _kept(order: int, released: np.ndarray) -> np.ndarray:
+    """(order - released,) int64: 0..order-1, less the indices ``released``, ascending."""
+    kept = np.ones(order, dtype=bool)
+    kept[released] = False
+    return np.flatnonzero(kept).astype(np.int64, copy=False)
 
 
 def _row_kinds(count: int, forces: int) -> np.ndarray:
@@ -443,12 +473,12 @@ def _joint(plan: _Planner, deduction: Deduction, e: int, state: int, rows: list)
     ``state``) as :meth:`Deduction._carry` does, and return the slot of its jumps' state
     (a constant, ``E Δ``) to add to its output."""
     record = deduction.topology.elements[e].record
-    row = plan.slot(record.released.size, plan.columns(state))
+    row = plan.slot_like(record.released.size, state)
     force, jump = plan.valued(), plan.valued()
     plan.constants.joint.append((e, force, jump))
     plan.emit(JOINT, row, state, force)
-    rows.append([f"{record.name} released", row, record.released.size, int(np.sum(record.released < 3))])
-    slot = plan.slot(12, deduction.jump_state(e, 1).columns)
+    rows.append([row, record.released.size, int(np.sum(record.released < 3))])
+    slot = plan.slot(12, deduction.jump_selection(e)[0])
     plan.emit(TIP, slot, jump)
     return slot
 

@@ -64,7 +64,7 @@ class Constants:
         for e, force, jump in self.joint:
             record = elements[e].record
             matrices[force] = padded(joint_force(record.axes, record.released))
-            matrices[jump] = padded(deduction.jump_state(e, 1).matrix[0])
+            matrices[jump] = padded(deduction.jump_selection(e)[1])
 
 
 def _fill_rigid(elements, index: np.ndarray, matrices: np.ndarray) -> None:

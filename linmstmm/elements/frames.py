@@ -30,9 +30,11 @@ def skew(r) -> np.ndarray:
     """
     r = np.asarray(r)
     x, y, z = r[..., 0], r[..., 1], r[..., 2]
-    zero = np.zeros(x.shape)
-    entries = np.stack([zero, -z, y, z, zero, -x, -y, x, zero], axis=-1)
-    return entries.reshape(r.shape[:-1] + (3, 3)).astype(number_type(r), copy=False)
+    out = np.zeros(r.shape[:-1] + (3, 3)).astype(number_type(r), copy=False)
+    out[..., 0, 1], out[..., 0, 2] = -z, y
+    out[..., 1, 0], out[..., 1, 2] = z, -x
+    out[..., 2, 0], out[..., 2, 1] = -y, x
+    return out
 
 
 def state_rotation(axes) -> np.ndarray:

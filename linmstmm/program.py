@@ -130,7 +130,7 @@ class _Planner:
         self.column_sets: list[frozenset] = []  # each slot's columns, for the orthonormalisations' unions
         self.operations: list[tuple] = []
         self.terms: list[tuple] = []
-        self.places: list[np.ndarray] = []
+        self.places: list[tuple[np.ndarray, np.ndarray]] = []  # (columns, onto): see place
         self.matrices: list[np.ndarray] = []
         self.orthos: list[tuple] = []
         self.ortho_blocks: list[tuple] = []
@@ -173,8 +173,10 @@ class _Planner:
         self.constants.fill(self.deduction, matrices)
         return matrices
 
-    def place(self, columns, onto) -> int:
-        self.places.append(np.searchsorted(onto, columns))
+    def place(self, columns: np.ndarray, onto: np.ndarray) -> int:
+        """Index of a new place: where each of ``columns`` is among ``onto`` (both sorted,
+        ``columns`` among ``onto``), found for all places at once by :func:`_places`."""
+        self.places.append((columns, onto))
         return len(self.places) - 1
 
     def emit(self, *record) -> None:
@@ -316,46 +318,39 @@ def _walked(plan: _Planner) -> tuple[list, int]:
 
         emit : False to record it without an ORTHO operation (a beam's pieces
         after the first run it themselves)."""
-        columns = set(plan.column_sets[state])
-        others = ([("row", i, r[0]) for i, r in enumerate(rows)]
-                  + [("state", key, slot) for key, slot in open_states.items()]
-                  + [("waiting", key, slot) for key, slot in waiting.items()])
-        held = [plan.column_sets[slot] for *_, slot in others]
+        sets = plan.column_sets
+        # every other block: (holder, key) such that holder[key] is its slot, slot, rows, forces, kind
+        others = [(row, 0, row[0], row[1], row[2], ROW_BLOCK) for row in rows]
+        others += [(open_states, key, slot, 12, -1, STATE_BLOCK) for key, slot in open_states.items()]
+        others += [(waiting, key, slot, 12, -1, STATE_BLOCK) for key, slot in waiting.items()]
+        columns = set(sets[state])
         chosen = [False] * len(others)
         grown = True
         while grown:  # every block that shares a column with those gathered so far
             grown = False
-            for i, block_columns in enumerate(held):
-                if not chosen[i] and not block_columns.isdisjoint(columns):
+            for i, block in enumerate(others):
+                if not chosen[i] and not sets[block[2]].isdisjoint(columns):
                     chosen[i] = grown = True
-                    columns |= block_columns
-        blocks = [block for block, taken in zip(others, chosen) if taken] + [("self", None, state)]
-        block_rows = [rows[key][1] if kind == "row" else 12 for kind, key, _ in blocks]
-        if sum(block_rows) < len(columns):  # fewer rows than columns: never orthonormalised
+                    columns |= sets[block[2]]
+        blocks = [block for block, taken in zip(others, chosen) if taken]
+        blocks.append((None, None, state, 12, -1, STATE_BLOCK))
+        if sum(block[3] for block in blocks) < len(columns):  # fewer rows than columns: never orthonormalised
             return state
-        block_forces = [rows[key][2] if kind == "row" else -1 for kind, key, _ in blocks]
         union_set = frozenset(columns)
         union = np.array(sorted(union_set), dtype=np.int64)
         first = len(plan.ortho_blocks)
-        new_slots = []
-        for (kind, key, src), count, forces in zip(blocks, block_rows, block_forces):
-            same = len(plan.column_sets[src]) == union.size  # its columns are among the union's
-            dst = src if same else plan.slot(count, union, union_set)
-            place = -1 if same else plan.place(plan.columns(src), union)
-            plan.ortho_blocks.append((src, dst, count, ROW_BLOCK if kind == "row" else STATE_BLOCK, place,
-                                      forces))
-            new_slots.append((kind, key, dst))
+        for holder, key, src, count, forces, kind in blocks:
+            if len(sets[src]) == union.size:  # its columns are the union's: in place
+                dst, place = src, -1
+            else:
+                dst, place = plan.slot(count, union, union_set), plan.place(plan.columns(src), union)
+            plan.ortho_blocks.append((src, dst, count, kind, place, forces))
+            if holder is not None:
+                holder[key] = dst
         plan.orthos.append((first, len(blocks), len(blocks) - 1, union.size, 0))
         if emit:
             plan.emit(ORTHO, len(plan.orthos) - 1)
-        for kind, key, dst in new_slots:
-            if kind == "row":
-                rows[key][0] = dst
-            elif kind == "state":
-                open_states[key] = dst
-            elif kind == "waiting":
-                waiting[key] = dst
-        return new_slots[-1][2]
+        return dst
 
     def enter_cut_side(link) -> int:
         _, c, side = link
@@ -423,7 +418,7 @@ def _assembled(plan: _Planner, rows: list, root: int) -> Program:
     deduction = plan.deduction
     sizes = np.array([r * len(c) for r, c in plan.slots], dtype=np.int64)
     starts = np.cumsum([0] + [len(c) for _, c in plan.slots])
-    places_start = np.cumsum([0] + [p.size for p in plan.places])
+    places, places_start = _places(plan.places, deduction.full_order)
     order = deduction.full_order
     return Program(
         slot_offset=np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64),
@@ -434,8 +429,8 @@ def _assembled(plan: _Planner, rows: list, root: int) -> Program:
         workspace=int(sizes.sum()),
         operations=np.array(plan.operations, dtype=np.int64).reshape(-1, 6),
         terms=np.array(plan.terms, dtype=np.int64).reshape(-1, 3),
-        places=np.concatenate(plan.places).astype(np.int64) if plan.places else np.zeros(0, np.int64),
-        places_start=places_start.astype(np.int64),
+        places=places,
+        places_start=places_start,
         matrices=plan.all_matrices(),
         orthos=np.array(plan.orthos, dtype=np.int64).reshape(-1, 5),
         ortho_blocks=np.array(plan.ortho_blocks, dtype=np.int64).reshape(-1, 6),
@@ -449,6 +444,23 @@ def _assembled(plan: _Planner, rows: list, root: int) -> Program:
         kept_columns=_kept(order, deduction.released_columns),
         row_kinds=np.concatenate([_row_kinds(count, forces) for _, count, forces in rows]).astype(np.int64),
     )
+
+
+def _places(pairs: list, order: int) -> tuple[np.ndarray, np.ndarray]:
+    """(places, places_start), int64: the positions of each pair's ``columns`` among its
+    ``onto`` (``np.searchsorted(onto, columns)``), one after another, and where each
+    pair's begin. One search for all: pair i's numbers are shifted by i·order, above
+    every column of the pairs before it (columns are below ``order``)."""
+    sizes = np.array([columns.size for columns, _ in pairs], dtype=np.int64)
+    places_start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    if not pairs:
+        return np.zeros(0, np.int64), places_start
+    onto_sizes = np.array([onto.size for _, onto in pairs], dtype=np.int64)
+    onto_start = np.concatenate([[0], np.cumsum(onto_sizes)[:-1]])
+    shift = np.arange(len(pairs), dtype=np.int64) * order
+    onto = np.concatenate([onto for _, onto in pairs]) + np.repeat(shift, onto_sizes)
+    columns = np.concatenate([columns for columns, _ in pairs]) + np.repeat(shift, sizes)
+    return (np.searchsorted(onto, columns) - np.repeat(onto_start, sizes)).astype(np.int64), places_start
 
 
 def _kept(order: int, released: np.ndarray) -> np.ndarray:

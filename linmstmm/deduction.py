@@ -35,22 +35,12 @@ import numpy as np
 
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.elements.frames import FORCE_INDEX
-from linmstmm.elements.rigid import (
-    force_extraction,
-    position_incidence,
-    rigid_transfer_parts,
-)
+from linmstmm.elements.rigid import force_extraction, position_incidence, rigid_transfer_parts
 from linmstmm.elements.spring import joint_force, joint_jump, spring_constant_transfer
 from linmstmm.godunov import PortState, _Orthonormaliser, _row_kinds
 from linmstmm.load_jumps import _Loads
 from linmstmm.model import COMPONENTS
-from linmstmm.numeric import (
-    constant_times,
-    frequencies,
-    is_mp,
-    numbers,
-    zeros_like_stack,
-)
+from linmstmm.numeric import constant_times, frequencies, is_mp, numbers, zeros_like_stack
 from linmstmm.periodic import carry_run, find_runs
 from linmstmm.topology import Topology
 
@@ -151,8 +141,7 @@ class Deduction:
                     record.mass, record.com, record.inertia,
                     element.ports[element.inputs[0]].position, element.ports[element.output].position)))
             elif element.kind == "spring":
-                parts = (spring_constant_transfer(numbers(record.k, exact), record.axes, record.release),
-                         None)
+                parts = (spring_constant_transfer(numbers(record.k, exact), record.axes, record.release), None)
             else:  # junction: a massless rigid body whose ports coincide
                 parts = (np.eye(12), None)
             self._parts[e, exact] = parts
@@ -214,9 +203,7 @@ class Deduction:
 
     def _kept(self, columns: np.ndarray, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``columns`` and ``matrix``'s columns, less the released unknowns."""
-        if not self.released_columns.size:
-            return columns, matrix
-        kept = ~np.isin(columns, self.released_columns)
+        kept = ~np.isin(columns, self.released_columns) if self.released_columns.size else slice(None)
         return columns[kept], matrix[:, kept]
 
     def jump_state(self, e, n) -> PortState:

@@ -306,12 +306,7 @@ def _walked(plan: _Planner) -> tuple[list, int]:
             carried = plan.slot_like(12, inputs[0])
             kinematic = plan.valued()
             inertial = plan.valued() if element.kind == "rigid" else -1  # U2 = 0: none
-            if element.kind == "rigid":
-                plan.constants.rigid.append((e, kinematic, inertial))
-            elif element.kind == "spring":
-                plan.constants.spring.append((e, kinematic))
-            else:
-                plan.constants.junction.append(kinematic)
+            plan.constants.carry(e, element.kind, kinematic, inertial)
             plan.emit(CARRY, carried, inputs[0], kinematic, inertial)
             terms = [(carried, -1)]
             if e in deduction.jump_columns:

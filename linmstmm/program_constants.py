@@ -24,8 +24,8 @@ from linmstmm.elements.spring import joint_force, spring_constant_transfer
 class Constants:
     """Which constant of the model's numbers goes where in a program's ``matrices``.
 
-    The walk appends to these lists as it records the operations that read the
-    constants, with the indices of ``matrices`` it took for them:
+    The walk enters each constant as it records the operation that reads it (an
+    element's U0 and U2 by :meth:`carry`), with the indices of ``matrices`` it took:
     ``rigid`` (element, U0, U2), ``spring`` (element, U0), ``junction`` U0 (the
     identity), ``other_input`` (element, k, U_{j,Ik}, H_{j,Ik}) of its input
     k + 2, ``joint`` (element, F of its released directions, its jumps' E).
@@ -37,6 +37,15 @@ class Constants:
         self.junction: list[int] = []
         self.other_input: list[tuple[int, int, int, int]] = []
         self.joint: list[tuple[int, int, int]] = []
+
+    def carry(self, e: int, kind: str, kinematic: int, inertial: int) -> None:
+        """Element e's U0 goes to ``matrices[kinematic]``, a rigid body's U2 to ``[inertial]``."""
+        if kind == "rigid":
+            self.rigid.append((e, kinematic, inertial))
+        elif kind == "spring":
+            self.spring.append((e, kinematic))
+        else:  # a junction
+            self.junction.append(kinematic)
 
     def fill(self, deduction, matrices: np.ndarray) -> None:
         """Write every constant of ``deduction``'s numbers into ``matrices`` (K, 12, 12), in place.

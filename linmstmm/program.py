@@ -19,6 +19,7 @@ The program's form (its operation codes and arrays, the workspace's slots) is
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from itertools import chain
 
 import numpy as np
 
@@ -52,7 +53,7 @@ class _Planner:
         self.column_sets: list[frozenset] = []  # each slot's columns, for the orthonormalisations' unions
         self.operations: list[tuple] = []
         self.terms: list[tuple] = []
-        self.places: list[tuple[np.ndarray, np.ndarray]] = []  # (columns, onto): see place
+        self.places: list[np.ndarray] = []
         self.matrices: list[np.ndarray] = []
         self.orthos: list[tuple] = []
         self.ortho_blocks: list[tuple] = []
@@ -96,9 +97,8 @@ class _Planner:
         return matrices
 
     def place(self, columns: np.ndarray, onto: np.ndarray) -> int:
-        """Index of a new place: where each of ``columns`` is among ``onto`` (both sorted,
-        ``columns`` among ``onto``), found for all places at once by :func:`_places`."""
-        self.places.append((columns, onto))
+        """Index of a new place: where each of ``columns`` is among ``onto`` (both sorted int64)."""
+        self.places.append(onto.searchsorted(columns))  # the method: np.searchsorted's wrapper cost more
         return len(self.places) - 1
 
     def emit(self, *record) -> None:
@@ -335,7 +335,7 @@ def _assembled(plan: _Planner, rows: list, root: int) -> Program:
     deduction = plan.deduction
     sizes = np.array([r * len(c) for r, c in plan.slots], dtype=np.int64)
     starts = np.cumsum([0] + [len(c) for _, c in plan.slots])
-    places, places_start = _places(plan.places, deduction.full_order)
+    places_start = np.cumsum([0] + [p.size for p in plan.places])
     order = deduction.full_order
     return Program(
         slot_offset=np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64),
@@ -344,13 +344,13 @@ def _assembled(plan: _Planner, rows: list, root: int) -> Program:
         slot_columns=np.concatenate([c for _, c in plan.slots]).astype(np.int64),
         slot_columns_start=starts.astype(np.int64),
         workspace=int(sizes.sum()),
-        operations=np.array(plan.operations, dtype=np.int64).reshape(-1, 6),
-        terms=np.array(plan.terms, dtype=np.int64).reshape(-1, 3),
-        places=places,
-        places_start=places_start,
+        operations=_table(plan.operations, 6),
+        terms=_table(plan.terms, 3),
+        places=np.concatenate(plan.places).astype(np.int64) if plan.places else np.zeros(0, np.int64),
+        places_start=places_start.astype(np.int64),
         matrices=plan.all_matrices(),
-        orthos=np.array(plan.orthos, dtype=np.int64).reshape(-1, 5),
-        ortho_blocks=np.array(plan.ortho_blocks, dtype=np.int64).reshape(-1, 6),
+        orthos=_table(plan.orthos, 5),
+        ortho_blocks=_table(plan.ortho_blocks, 6),
         beams=_beam_parameters(deduction, plan.beams),
         beam_rotation=_beam_rotations(deduction, plan.beams),
         root=root,
@@ -359,25 +359,13 @@ def _assembled(plan: _Planner, rows: list, root: int) -> Program:
         order=order,
         kept_rows=_kept(order, deduction.released_rows),
         kept_columns=_kept(order, deduction.released_columns),
-        row_kinds=np.concatenate([_row_kinds(count, forces) for _, count, forces in rows]).astype(np.int64),
+        row_kinds=np.concatenate([_row_kinds(count, forces) for _, count, forces in rows]),
     )
 
 
-def _places(pairs: list, order: int) -> tuple[np.ndarray, np.ndarray]:
-    """(places, places_start), int64: the positions of each pair's ``columns`` among its
-    ``onto`` (``np.searchsorted(onto, columns)``), one after another, and where each
-    pair's begin. One search for all: pair i's numbers are shifted by i·order, above
-    every column of the pairs before it (columns are below ``order``)."""
-    sizes = np.array([columns.size for columns, _ in pairs], dtype=np.int64)
-    places_start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-    if not pairs:
-        return np.zeros(0, np.int64), places_start
-    onto_sizes = np.array([onto.size for _, onto in pairs], dtype=np.int64)
-    onto_start = np.concatenate([[0], np.cumsum(onto_sizes)[:-1]])
-    shift = np.arange(len(pairs), dtype=np.int64) * order
-    onto = np.concatenate([onto for _, onto in pairs]) + np.repeat(shift, onto_sizes)
-    columns = np.concatenate([columns for columns, _ in pairs]) + np.repeat(shift, sizes)
-    return (np.searchsorted(onto, columns) - np.repeat(onto_start, sizes)).astype(np.int64), places_start
+def _table(records: list[tuple], width: int) -> np.ndarray:
+    """(len(records), width) int64 of ``records``, each ``width`` integers."""
+    return np.fromiter(chain.from_iterable(records), dtype=np.int64, count=width * len(records)).reshape(-1, width)
 
 
 def _kept(order: int, released: np.ndarray) -> np.ndarray:
@@ -393,8 +381,12 @@ def _row_kinds(count: int, forces: int) -> np.ndarray:
     root's state, a geometric equation) three rows per kind (as
     :func:`linmstmm.godunov._row_kinds` weighs them)."""
     if forces >= 0:
-        return np.r_[np.full(forces, 3), np.full(count - forces, 2)]
-    return np.arange(count) // 3
+        return np.repeat(np.array([3, 2], dtype=np.int64), [forces, count - forces])
+    return _THREE_PER_KIND[:count]
+
+
+#: Kinds of the rows of a block of up to 12 rows, three rows per kind (:func:`_row_kinds`).
+_THREE_PER_KIND = np.arange(12, dtype=np.int64) // 3
 
 
 def _joint(plan: _Planner, deduction: Deduction, e: int, state: int, rows: list) -> int:

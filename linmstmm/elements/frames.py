@@ -37,6 +37,15 @@ def skew(r) -> np.ndarray:
     return out
 
 
+def identities(shape: tuple, rows: int, columns: int | None = None, dtype=np.float64) -> np.ndarray:
+    """(*shape, rows, columns) matrices of ``dtype`` (columns = rows if None, rows ≤ columns),
+    each :func:`numpy.eye` (ones on the diagonal, zeros elsewhere); writable."""
+    columns = rows if columns is None else columns
+    out = np.zeros(shape + (rows, columns), dtype=dtype)
+    out.reshape(shape + (rows * columns,))[..., ::columns + 1] = 1  # the diagonal of each
+    return out
+
+
 def state_rotation(axes) -> np.ndarray:
     """(12, 12) map from local to inertial state components.
 

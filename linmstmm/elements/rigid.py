@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.elements.frames import M, Q, R, U, skew
+from linmstmm.elements.frames import M, Q, R, U, identities, skew
 from linmstmm.numeric import frequencies, number_type
 
 
@@ -33,22 +33,18 @@ def rigid_transfer_parts(mass, com, inertia, inp, out) -> tuple[np.ndarray, np.n
     """
     mass, inp, out, com, inertia = (np.asarray(p) for p in (mass, inp, out, com, inertia))
     dtype = number_type(mass, com, inertia, inp, out)
-    kinematic = _identities(mass.shape, dtype)
+    kinematic = identities(mass.shape, 12, dtype=dtype)
     kinematic[..., U, R] = -skew(out - inp)
     kinematic[..., M, Q] = skew(inp - out)
+    weighted = np.zeros(mass.shape + (3, 6)).astype(dtype, copy=False)  # u_c = this @ (u_I, θ_I), times m
+    weighted[..., :3] = np.eye(3)
+    weighted[..., 3:] = -skew(com - inp)
+    weighted *= mass[..., None, None]
     inertial = np.zeros(mass.shape + (12, 12), dtype=dtype)
-    identity = np.broadcast_to(np.eye(3), mass.shape + (3, 3))
-    com_from_input = np.concatenate([identity, -skew(com - inp)], axis=-1)  # u_c = this @ (u_I, θ_I)
-    weighted = mass[..., None, None] * com_from_input
     inertial[..., Q, 0:6] = weighted
     inertial[..., M, 0:6] = -skew(out - com) @ weighted
     inertial[..., M, R] += inertia
     return kinematic, inertial
-
-
-def _identities(shape: tuple, dtype) -> np.ndarray:
-    """(*shape, 12, 12) identity matrices of ``dtype``, writable."""
-    return np.broadcast_to(np.eye(12, dtype=dtype), shape + (12, 12)).copy()
 
 
 def rigid_transfer(mass, com, inertia, inp, out, omega) -> np.ndarray:
@@ -77,6 +73,6 @@ def position_incidence(inp_1, inp_k) -> np.ndarray:
     rows 0:6, the displacement and rotation, as the deduction does directly);
     positions (..., 3) as in :func:`force_extraction`."""
     arm = np.asarray(inp_k) - np.asarray(inp_1)
-    incidence = np.broadcast_to(np.eye(6, 12, dtype=number_type(inp_1, inp_k)), arm.shape[:-1] + (6, 12)).copy()
+    incidence = identities(arm.shape[:-1], 6, 12, dtype=number_type(inp_1, inp_k))
     incidence[..., U, R] = skew(arm)
     return incidence

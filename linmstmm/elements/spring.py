@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.elements.frames import FORCE_INDEX, M, Q, R, U
+from linmstmm.elements.frames import FORCE_INDEX, M, Q, R, U, identities
 from linmstmm.numeric import number_type
 
 
@@ -35,27 +35,24 @@ def spring_compliance(k, axes, release=None) -> tuple[np.ndarray, np.ndarray]:
     """
     k = np.asarray(k, dtype=number_type(k))
     axes = np.asarray(axes, dtype=float)
-    free = np.zeros(k.shape, bool) if release is None else np.broadcast_to(np.asarray(release, bool), k.shape)
-    compliance = 1 / np.where(free, 1, k)  # inf -> 0: rigid direction
-    compliance[free] = 0 * k[free]
-    turned = np.swapaxes(axes, -1, -2)
-    C_t = turned @ _diagonal(compliance[..., :3]) @ axes
-    C_r = turned @ _diagonal(compliance[..., 3:]) @ axes
-    return C_t, C_r
-
-
-def _diagonal(values: np.ndarray) -> np.ndarray:
-    """(..., 3, 3) diagonal matrices of (..., 3) ``values``, as :func:`numpy.diag` of each."""
-    out = np.zeros(values.shape + (3,), dtype=values.dtype)
-    out[..., [0, 1, 2], [0, 1, 2]] = values
-    return out
+    if release is None:
+        compliance = 1 / k  # inf -> 0: rigid direction
+    else:
+        free = np.broadcast_to(np.asarray(release, bool), k.shape)
+        compliance = 1 / np.where(free, 1, k)
+        compliance[free] = 0 * k[free]
+    diagonal = np.zeros(k.shape[:-1] + (2, 9), dtype=k.dtype)  # translational, rotational: diag of each
+    diagonal[..., ::4] = compliance.reshape(k.shape[:-1] + (2, 3))
+    axes = axes[..., None, :, :]
+    both = np.swapaxes(axes, -1, -2) @ diagonal.reshape(k.shape[:-1] + (2, 3, 3)) @ axes
+    return both[..., 0, :, :], both[..., 1, :, :]
 
 
 def spring_constant_transfer(k, axes, release=None) -> np.ndarray:
     """(..., 12, 12) transfer matrix of a spring (it does not depend on ω), or of a
     stack of springs; k, axes, release as :func:`spring_compliance`."""
     C_t, C_r = spring_compliance(k, axes, release)
-    single = np.broadcast_to(np.eye(12, dtype=C_t.dtype), C_t.shape[:-2] + (12, 12)).copy()
+    single = identities(C_t.shape[:-2], 12, dtype=C_t.dtype)
     single[..., U, Q] = -C_t
     single[..., R, M] = -C_r
     return single

@@ -225,15 +225,18 @@ def _planned(deduction: Deduction) -> _Layout:
 
 def _walked(plan: _Planner) -> tuple[list, int]:
     """Walk the carry of ``plan``'s deduction, recording it in ``plan``; returns the row
-    blocks of Ū_all ([slot, rows, forces] each, the root's known side first) and the
+    blocks of Ū_all ([slot, rows, forces, kind] each, the root's known side first) and the
     slot of the root's carried state."""
     deduction = plan.deduction
     topology = deduction.topology
     elements = topology.elements
     root_given = topology.root if topology.root[0] == "boundary" else ("cut", topology.root[1], 0)
-    rows: list[list] = [[plan.tip(root_given, negate=True), 12, -1]]  # [slot, rows, forces]
-    open_states: dict[int, int] = {}
-    waiting: dict[tuple, int] = {}
+    # Blocks, each [slot, rows, forces, kind] (see Program.ortho_blocks), its slot rewritten when
+    # an orthonormalisation widens it: the rows of Ū_all, the root's known side first; the
+    # open states by element; the cut sides waiting to enter by (cut, side).
+    rows: list[list] = [[plan.tip(root_given, negate=True), 12, -1, ROW_BLOCK]]
+    open_states: dict[int, list] = {}
+    waiting: dict[tuple, list] = {}
 
     def orthonormalise(state: int, emit: bool = True) -> int:
         """Mirror of :meth:`_Orthonormaliser.apply`; returns the state's new slot.
@@ -241,34 +244,30 @@ def _walked(plan: _Planner) -> tuple[list, int]:
         emit : False to record it without an ORTHO operation (a beam's pieces
         after the first run it themselves)."""
         sets = plan.column_sets
-        # every other block: (holder, key) such that holder[key] is its slot, slot, rows, forces, kind
-        others = [(row, 0, row[0], row[1], row[2], ROW_BLOCK) for row in rows]
-        others += [(open_states, key, slot, 12, -1, STATE_BLOCK) for key, slot in open_states.items()]
-        others += [(waiting, key, slot, 12, -1, STATE_BLOCK) for key, slot in waiting.items()]
+        others = rows + list(open_states.values()) + list(waiting.values())
         columns = set(sets[state])
         chosen = [False] * len(others)
         grown = True
         while grown:  # every block that shares a column with those gathered so far
             grown = False
             for i, block in enumerate(others):
-                if not chosen[i] and not sets[block[2]].isdisjoint(columns):
+                if not chosen[i] and not sets[block[0]].isdisjoint(columns):
                     chosen[i] = grown = True
-                    columns |= sets[block[2]]
-        blocks = [block for block, taken in zip(others, chosen) if taken]
-        blocks.append((None, None, state, 12, -1, STATE_BLOCK))
-        if sum(block[3] for block in blocks) < len(columns):  # fewer rows than columns: never orthonormalised
+                    columns |= sets[block[0]]
+        blocks = [block for block, taken in zip(others, chosen) if taken] + [_state_block(state)]
+        if sum(block[1] for block in blocks) < len(columns):  # fewer rows than columns: never orthonormalised
             return state
         union_set = frozenset(columns)
         union = np.array(sorted(union_set), dtype=np.int64)
         first = len(plan.ortho_blocks)
-        for holder, key, src, count, forces, kind in blocks:
+        for block in blocks:
+            src, count, forces, kind = block
             if len(sets[src]) == union.size:  # its columns are the union's: in place
                 dst, place = src, -1
             else:
                 dst, place = plan.slot(count, union, union_set), plan.place(plan.columns(src), union)
             plan.ortho_blocks.append((src, dst, count, kind, place, forces))
-            if holder is not None:
-                holder[key] = dst
+            block[0] = dst
         plan.orthos.append((first, len(blocks), len(blocks) - 1, union.size, 0))
         if emit:
             plan.emit(ORTHO, len(plan.orthos) - 1)
@@ -277,8 +276,8 @@ def _walked(plan: _Planner) -> tuple[list, int]:
     def enter_cut_side(link) -> int:
         _, c, side = link
         if (c, side) in waiting:
-            return waiting.pop((c, side))
-        waiting[c, 1 - side] = plan.tip(("cut", c, 1 - side))
+            return waiting.pop((c, side))[0]
+        waiting[c, 1 - side] = _state_block(plan.tip(("cut", c, 1 - side)))
         return plan.tip(link)
 
     for e in topology.order:
@@ -287,7 +286,7 @@ def _walked(plan: _Planner) -> tuple[list, int]:
         for p in element.inputs:
             link = element.ports[p].link
             if link[0] == "element":
-                inputs.append(open_states.pop(link[1]))
+                inputs.append(open_states.pop(link[1])[0])
             elif link[0] == "cut" and not topology.cuts[link[1]].closing:
                 inputs.append(enter_cut_side(link))
             else:
@@ -321,10 +320,10 @@ def _walked(plan: _Planner) -> tuple[list, int]:
             plan.emit(GEOMETRIC, row, first, other, incidence, len(plan.places))
             plan.place(plan.columns(first), union)
             plan.place(plan.columns(other), union)
-            rows.append([row, 6, -1])
+            rows.append([row, 6, -1, ROW_BLOCK])
         state = terms[0][0] if len(terms) == 1 else plan.combined(terms)
-        open_states[e] = orthonormalise(state)
-    root = open_states[topology.order[-1]]
+        open_states[e] = _state_block(orthonormalise(state))
+    root = open_states[topology.order[-1]][0]
     if topology.root[0] == "boundary":
         _leave_final_orthos_to_the_lu(plan)
     return rows, root
@@ -359,8 +358,13 @@ def _assembled(plan: _Planner, rows: list, root: int) -> Program:
         order=order,
         kept_rows=_kept(order, deduction.released_rows),
         kept_columns=_kept(order, deduction.released_columns),
-        row_kinds=np.concatenate([_row_kinds(count, forces) for _, count, forces in rows]),
+        row_kinds=np.concatenate([_row_kinds(count, forces) for _, count, forces, _ in rows]),
     )
+
+
+def _state_block(slot: int) -> list:
+    """A state's block, as the walk holds it: [slot, rows, forces, kind] (:func:`_walked`)."""
+    return [slot, 12, -1, STATE_BLOCK]
 
 
 def _table(records: list[tuple], width: int) -> np.ndarray:
@@ -398,7 +402,7 @@ def _joint(plan: _Planner, deduction: Deduction, e: int, state: int, rows: list)
     force, jump = plan.valued(), plan.valued()
     plan.constants.joint.append((e, force, jump))
     plan.emit(JOINT, row, state, force)
-    rows.append([row, record.released.size, int(np.sum(record.released < 3))])
+    rows.append([row, record.released.size, int(np.sum(record.released < 3)), ROW_BLOCK])
     slot = plan.slot(12, deduction.jump_selection(e)[0])
     plan.emit(TIP, slot, jump)
     return slot

@@ -21,6 +21,7 @@ from linmstmm.model import load_model
 from linmstmm.nullspace import release_indeterminate
 from linmstmm.topology import build_topology
 from random_models import KINDS, random_model
+from test_indeterminate_probes import RELEASING
 from test_joints import beam_on_joint, four_bar, pinned_bars, sliding_carts
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
@@ -35,6 +36,11 @@ def models():
     yield from ((f"{kind} {seed}", random_model(kind, seed)) for kind in KINDS for seed in range(6))
     yield from ((m.name, m) for m in (four_bar(), pinned_bars(), sliding_carts()))
     yield from ((f"beam on a joint {'+'.join(free)}", beam_on_joint(free)) for free in (["rx", "ry"], ["x", "rz"]))
+    yield from ((name, RELEASING[name]()) for name in RELEASED)  # unknowns released
+
+
+#: Models with statically indeterminate unknowns, released before the walk.
+RELEASED = ("varied 24", "varied 358 (two)", "random loops 25", "random tree 19 with joints")
 
 
 def layout_digest(model) -> str:

@@ -35,22 +35,12 @@ import numpy as np
 
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.elements.frames import FORCE_INDEX
-from linmstmm.elements.rigid import (
-    force_extraction,
-    position_incidence,
-    rigid_transfer_parts,
-)
-from linmstmm.elements.spring import joint_force, joint_jump, spring_transfer
+from linmstmm.elements.rigid import force_extraction, position_incidence, rigid_transfer_parts
+from linmstmm.elements.spring import joint_force, joint_jump, spring_constant_transfer
 from linmstmm.godunov import PortState, _Orthonormaliser, _row_kinds
 from linmstmm.load_jumps import _Loads
 from linmstmm.model import COMPONENTS
-from linmstmm.numeric import (
-    constant_times,
-    frequencies,
-    is_mp,
-    numbers,
-    zeros_like_stack,
-)
+from linmstmm.numeric import constant_times, frequencies, is_mp, numbers, zeros_like_stack
 from linmstmm.periodic import carry_run, find_runs
 from linmstmm.topology import Topology
 
@@ -151,8 +141,7 @@ class Deduction:
                     record.mass, record.com, record.inertia,
                     element.ports[element.inputs[0]].position, element.ports[element.output].position)))
             elif element.kind == "spring":
-                parts = (spring_transfer(numbers(record.k, exact), record.axes, np.zeros(1), record.release)[0],
-                         None)
+                parts = (spring_constant_transfer(numbers(record.k, exact), record.axes, record.release), None)
             else:  # junction: a massless rigid body whose ports coincide
                 parts = (np.eye(12), None)
             self._parts[e, exact] = parts
@@ -195,29 +184,41 @@ class Deduction:
     # -- boundary states ------------------------------------------------------------
     def tip_state(self, link, n) -> PortState:
         """State of a boundary end or cut side in terms of its unknowns (less released ones)."""
-        if link[0] == "boundary":
-            columns = self._boundary_columns[link[1]]
-            selection = boundary_selection(self.topology.boundaries[link[1]].fixed)
-        else:
-            _, c, side = link
-            columns = self._cut_columns[c]
-            selection = np.eye(12) if (side == 0 or self.topology.cuts[c].closing) else _CUT_SIGN
-        if link not in self._tips:
-            kept = ~np.isin(columns, self.released_columns)
-            self._tips[link] = (columns[kept], selection[:, kept])
-        columns, selection = self._tips[link]
+        columns, selection = self.tip_selection(link)
         return PortState(columns, np.broadcast_to(selection, (n,) + selection.shape), np.ones(n))
+
+    def tip_selection(self, link) -> tuple[np.ndarray, np.ndarray]:
+        """(columns (k,), selection (12, k)) of a boundary end or cut side: its state is
+        ``selection @ z̄[columns]`` (less released unknowns); found once per link."""
+        if link not in self._tips:
+            if link[0] == "boundary":
+                columns = self._boundary_columns[link[1]]
+                selection = boundary_selection(self.topology.boundaries[link[1]].fixed)
+            else:
+                _, c, side = link
+                columns = self._cut_columns[c]
+                selection = np.eye(12) if (side == 0 or self.topology.cuts[c].closing) else _CUT_SIGN
+            self._tips[link] = self._kept(columns, selection)
+        return self._tips[link]
+
+    def _kept(self, columns: np.ndarray, matrix: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``columns`` and ``matrix``'s columns, less the released unknowns."""
+        kept = ~np.isin(columns, self.released_columns) if self.released_columns.size else slice(None)
+        return columns[kept], matrix[:, kept]
 
     def jump_state(self, e, n) -> PortState:
         """The jumps across the released directions of joint ``e`` as a state:
         ``E Δ`` on their columns (less released ones)."""
-        if ("jump", e) not in self._tips:
-            columns, record = self.jump_columns[e], self.topology.elements[e].record
-            kept = ~np.isin(columns, self.released_columns)
-            jump = joint_jump(record.axes, record.released)
-            self._tips["jump", e] = (columns[kept], jump[:, kept])
-        columns, jump = self._tips["jump", e]
+        columns, jump = self.jump_selection(e)
         return PortState(columns, np.broadcast_to(jump, (n,) + jump.shape), np.ones(n))
+
+    def jump_selection(self, e) -> tuple[np.ndarray, np.ndarray]:
+        """(columns (k,), E (12, k)) of the jumps across the released directions of joint
+        ``e``: the state ``E Δ`` (less released unknowns); found once per joint."""
+        if ("jump", e) not in self._tips:
+            record = self.topology.elements[e].record
+            self._tips["jump", e] = self._kept(self.jump_columns[e], joint_jump(record.axes, record.released))
+        return self._tips["jump", e]
 
     def _joint_row(self, e, state: PortState) -> list:
         """[label, columns, (n, r, k) F S_I, kinds]: no force along the released

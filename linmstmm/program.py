@@ -13,42 +13,22 @@ themselves. A skipped orthonormalisation still lays its blocks out on the
 columns the plan expects (the columns it would have widened them to, with
 zeros), so the plan holds either way.
 
-Slots: every block a carry forms (a port state, a geometric row, a cut side
-waiting to enter, the root's known side) is stored row-major, ``rows ×
-len(columns)``, at its own offset of the workspace. An operation that widens
-a block's columns writes a new slot; one that keeps them writes in place.
+The program's form (its operation codes and arrays, the workspace's slots) is
+:mod:`linmstmm.program_record`'s.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from itertools import chain
 
 import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import _state_rotation
-from linmstmm.elements.spring import joint_force
+from linmstmm.program_constants import Constants
+from linmstmm.program_record import (BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, ROW_BLOCK, STATE_BLOCK, TIP,
+                                     Program)
 
-# Operation codes (first entry of each record in Program.operations).
-#: TIP dst constant: the slot holds a constant (12, k) selection, reference 1.
-TIP = 0
-#: CARRY dst src U0 U2: dst = (U0 + ω² U2) src (U2 = −1: none; only U2[6:, :6] acts).
-CARRY = 1
-#: BEAM slot beam first ortho: the slot carried along the beam; ``first`` = 1: the first
-#: piece only (the piece count decided from the group's largest |ω|); 0: the
-#: other pieces, each followed by orthonormalisation ``ortho`` (in place).
-BEAM = 2
-#: COMBINE dst terms: dst = Σ M_i src_i placed on dst's columns (M_i = −1: identity).
-COMBINE = 3
-#: GEOMETRIC dst first other H: dst = −first[:6] + H other, each placed on dst's columns.
-GEOMETRIC = 4
-#: ORTHO index: orthonormalisation record ``index`` (Program.orthos).
-ORTHO = 5
-#: JOINT dst src F: dst (its r rows) = F[:r] src, the forces along a joint's released
-#: directions (:func:`linmstmm.elements.spring.joint_force`), on src's columns.
-JOINT = 6
-
-#: Block kinds in an orthonormalisation: a formed row (no growth reference), or a state.
-ROW_BLOCK, STATE_BLOCK = 0, 1
 #: An orthonormalisation after which at most this many element carries, and no
 #: beam, remain is left to the final LU: a change of unknowns (every block that
 #: holds its columns is in it) commutes with the carries that follow (they
@@ -62,63 +42,6 @@ ROW_BLOCK, STATE_BLOCK = 0, 1
 #: round the loop (every block holds the closing cut's unknowns there), lest the I
 #: be lost under T_loop's growth (a ring at 1.3e5 rad/s lost 3e-9 in log|det|).
 FINAL_CARRIES = 4
-
-
-@dataclass(frozen=True)
-class Program:
-    """A compiled deduction: everything the kernels need, as plain arrays.
-
-    Attributes
-    ----------
-    slot_offset, slot_rows, slot_width : (S,) int64, where slot s sits in the
-        workspace, its rows and its number of columns.
-    slot_columns, slot_columns_start : the columns (unknowns) of slot s are
-        ``slot_columns[slot_columns_start[s]:slot_columns_start[s + 1]]``.
-    workspace : int, entries per frequency.
-    operations : (P, 6) int64 records ``(code, a, b, c, d, e)``, see the codes above.
-    terms : (T, 3) int64 ``(src, matrix, place)`` of COMBINE records ``a..a+b``;
-        ``place`` indexes ``places``.
-    places, places_start : column positions of a source slot in a destination slot.
-    matrices : (K, 12, 12) float64 constants (selections padded, U0, U2, U_{j,Ik}, H).
-    orthos : (O, 5) int64 ``(first block, number of blocks, state block, columns, layout only)``;
-        ``layout only`` = 1: the blocks are laid out on the columns, never orthonormalised.
-    ortho_blocks : (B, 6) int64 ``(src, dst, rows, kind, place, forces)``: ``place``
-        indexes ``places`` (src's columns in dst), −1 where dst is src; ``forces``:
-        a joint's row block has that many force rows first, moment rows after (their
-        kinds in the row scales), −1 for any other block (three rows per kind).
-    beams : (nb, 10) float64 ``(E, G, rho, A, Iy, Iz, J, Ip, length, flags)``,
-        flags = axial + 2 torsion; beam_rotation : (nb, 12, 12) its state rotation.
-    root, root_row : slots of the carried root state and of −Z_root.
-    geometric_rows : (g,) slots of the geometric and joint rows, in Ū_all's row order.
-    order, kept_rows, kept_columns : order of Ū_all before release, and the rows and
-        columns that remain after it.
-    row_kinds : (order,) int64 what each row of Ū_all before release is (0 a
-        displacement, 1 a rotation, 2 a moment, 3 a force), as
-        :meth:`~linmstmm.deduction.Deduction.kinds` has it.
-    """
-
-    slot_offset: np.ndarray
-    slot_rows: np.ndarray
-    slot_width: np.ndarray
-    slot_columns: np.ndarray
-    slot_columns_start: np.ndarray
-    workspace: int
-    operations: np.ndarray
-    terms: np.ndarray
-    places: np.ndarray
-    places_start: np.ndarray
-    matrices: np.ndarray
-    orthos: np.ndarray
-    ortho_blocks: np.ndarray
-    beams: np.ndarray
-    beam_rotation: np.ndarray
-    root: int
-    root_row: int
-    geometric_rows: np.ndarray
-    order: int
-    kept_rows: np.ndarray
-    kept_columns: np.ndarray
-    row_kinds: np.ndarray
 
 
 class _Planner:
@@ -135,27 +58,47 @@ class _Planner:
         self.orthos: list[tuple] = []
         self.ortho_blocks: list[tuple] = []
         self.beams: list[int] = []  # element index of each BEAM record
-        self.recipes: list[tuple[int, tuple]] = []  # (matrix index, recipe) of the model's numbers
+        self.constants = Constants()  # where the model's numbers go among the matrices
 
     # -- storage ----------------------------------------------------------------------
-    def slot(self, rows: int, columns) -> int:
-        columns = np.asarray(columns, dtype=np.int64)
+    def slot(self, rows: int, columns: np.ndarray, column_set: frozenset | None = None) -> int:
+        """A new slot of ``rows`` rows on ``columns`` (sorted int64; ``column_set`` the same
+        columns as a set, if the caller has it: slots share both, neither is ever changed)."""
         self.slots.append((rows, columns))
-        self.column_sets.append(frozenset(columns.tolist()))
+        self.column_sets.append(frozenset(columns.tolist()) if column_set is None else column_set)
         return len(self.slots) - 1
+
+    def slot_like(self, rows: int, slot: int) -> int:
+        """A new slot of ``rows`` rows on the columns of ``slot``."""
+        return self.slot(rows, self.slots[slot][1], self.column_sets[slot])
+
+    def union(self, slots) -> tuple[np.ndarray, frozenset]:
+        """(sorted int64 array, set) of the columns of all of ``slots``."""
+        union = frozenset().union(*[self.column_sets[s] for s in slots])
+        return np.array(sorted(union), dtype=np.int64), union
 
     def matrix(self, matrix) -> int:
         """Index of a new constant: one the topology alone fixes (a selection, a sign)."""
-        self.matrices.append(_padded(matrix))
+        self.matrices.append(matrix)
         return len(self.matrices) - 1
 
-    def valued(self, recipe: tuple) -> int:
-        """Index of a new constant made from the model's numbers by ``recipe`` (:func:`_valued`)."""
-        self.recipes.append((len(self.matrices), recipe))
-        return self.matrix(_valued(self.deduction, recipe))
+    def valued(self) -> int:
+        """Index of a new constant made from the model's numbers, which the caller enters
+        in ``self.constants`` (:class:`~linmstmm.program_constants.Constants`)."""
+        return self.matrix(None)
 
-    def place(self, columns, onto) -> int:
-        self.places.append(np.searchsorted(onto, columns).astype(np.int64))
+    def all_matrices(self) -> np.ndarray:
+        """(K, 12, 12) every constant: the topology's, padded, and the model's numbers'."""
+        matrices = np.zeros((len(self.matrices), 12, 12))
+        for index, matrix in enumerate(self.matrices):
+            if matrix is not None:
+                matrices[index, :matrix.shape[0], :matrix.shape[1]] = matrix
+        self.constants.fill(self.deduction, matrices)
+        return matrices
+
+    def place(self, columns: np.ndarray, onto: np.ndarray) -> int:
+        """Index of a new place: where each of ``columns`` is among ``onto`` (both sorted int64)."""
+        self.places.append(onto.searchsorted(columns))  # the method: np.searchsorted's wrapper cost more
         return len(self.places) - 1
 
     def emit(self, *record) -> None:
@@ -164,8 +107,7 @@ class _Planner:
     # -- blocks -----------------------------------------------------------------------
     def tip(self, link, negate: bool = False) -> int:
         """Slot of a boundary end's or cut side's state in its (kept) unknowns."""
-        given = self.deduction.tip_state(link, 1)
-        columns, selection = given.columns, given.matrix[0]
+        columns, selection = self.deduction.tip_selection(link)
         slot = self.slot(12, columns)
         self.emit(TIP, slot, self.matrix(-selection if negate else selection))
         return slot
@@ -175,8 +117,8 @@ class _Planner:
 
     def combined(self, sources: list[tuple[int, int]]) -> int:
         """New slot = Σ matrix @ source over the union of the sources' columns."""
-        union = np.unique(np.concatenate([self.columns(s) for s, _ in sources]))
-        dst = self.slot(12, union)
+        union, union_set = self.union([s for s, _ in sources])
+        dst = self.slot(12, union, union_set)
         first = len(self.terms)
         for src, matrix in sources:
             self.terms.append((src, matrix, self.place(self.columns(src), union)))
@@ -192,7 +134,7 @@ def compile_program(deduction: Deduction) -> Program:
     too. A parameter study's models differ in their numbers only, so the last
     LAYOUTS_KEPT walks are kept by structure, and a model with the structure of
     one of them takes that program with its own numbers in it
-    (:func:`_revalued`): on a launcher scene 0.9 ms against 1.9 ms for the walk.
+    (:func:`_revalued`): on the launcher 0.15 ms against 0.6 ms for the walk.
 
     Parameters
     ----------
@@ -218,12 +160,12 @@ def compile_program(deduction: Deduction) -> Program:
 class _Layout:
     """A walk of the carry: its program, and how the model's numbers enter it.
 
-    recipes : (matrix index, recipe) of every constant made from the model's
-    numbers (:func:`_valued`); beams : (nb,) element index of each BEAM record.
+    constants : where each constant made from the model's numbers goes among the
+    program's matrices; beams : (nb,) element index of each BEAM record.
     """
 
     program: Program
-    recipes: tuple
+    constants: Constants
     beams: tuple
 
 
@@ -255,34 +197,9 @@ def _structure(deduction: Deduction) -> tuple:
 def _revalued(layout: _Layout, deduction: Deduction) -> Program:
     """``layout``'s program with the numbers of ``deduction`` (of the same structure)."""
     matrices = layout.program.matrices.copy()
-    for index, recipe in layout.recipes:
-        matrices[index] = _padded(_valued(deduction, recipe))
+    layout.constants.fill(deduction, matrices)
     return replace(layout.program, matrices=matrices, beams=_beam_parameters(deduction, layout.beams),
                    beam_rotation=_beam_rotations(deduction, layout.beams))
-
-
-def _valued(deduction: Deduction, recipe: tuple) -> np.ndarray:
-    """The constant ``recipe`` names, from the deduction's numbers: ("kinematic", e) and
-    ("inertial", e) U0 and U2 of element e, ("forces", e, k) and ("incidence", e, k)
-    U_{j,Ik} and H_{j,Ik} of its input k + 2, ("joint", e) the forces along a joint's
-    released directions, ("jump", e) its jumps' state E Δ."""
-    kind, e = recipe[:2]
-    if kind in ("kinematic", "inertial"):
-        return deduction._polynomial_parts(e)[kind == "inertial"]
-    if kind in ("forces", "incidence"):
-        return deduction._other_inputs(e)[recipe[2]][1 if kind == "forces" else 2]
-    record = deduction.topology.elements[e].record
-    if kind == "joint":
-        return joint_force(record.axes, record.released)
-    return deduction.jump_state(e, 1).matrix[0]
-
-
-def _padded(matrix) -> np.ndarray:
-    """``matrix`` (at most 12 × 12) in the top left corner of a float (12, 12) of zeros."""
-    padded = np.zeros((12, 12))
-    matrix = np.asarray(matrix, dtype=float)
-    padded[:matrix.shape[0], :matrix.shape[1]] = matrix
-    return padded
 
 
 def _beam_parameters(deduction: Deduction, beams) -> np.ndarray:
@@ -302,63 +219,65 @@ def _beam_rotations(deduction: Deduction, beams) -> np.ndarray:
 def _planned(deduction: Deduction) -> _Layout:
     """The walk of ``deduction``'s carry, recorded."""
     plan = _Planner(deduction)
+    rows, root = _walked(plan)
+    return _Layout(_assembled(plan, rows, root), plan.constants, tuple(plan.beams))
+
+
+def _walked(plan: _Planner) -> tuple[list, int]:
+    """Walk the carry of ``plan``'s deduction, recording it in ``plan``; returns the row
+    blocks of Ū_all ([slot, rows, forces, kind] each, the root's known side first) and the
+    slot of the root's carried state."""
+    deduction = plan.deduction
     topology = deduction.topology
     elements = topology.elements
     root_given = topology.root if topology.root[0] == "boundary" else ("cut", topology.root[1], 0)
-    rows: list[list] = [["root", plan.tip(root_given, negate=True), 12, -1]]  # [label, slot, rows, forces]
-    open_states: dict[int, int] = {}
-    waiting: dict[tuple, int] = {}
+    # Blocks, each [slot, rows, forces, kind] (see Program.ortho_blocks), its slot rewritten when
+    # an orthonormalisation widens it: the rows of Ū_all, the root's known side first; the
+    # open states by element; the cut sides waiting to enter by (cut, side).
+    rows: list[list] = [[plan.tip(root_given, negate=True), 12, -1, ROW_BLOCK]]
+    open_states: dict[int, list] = {}
+    waiting: dict[tuple, list] = {}
 
     def orthonormalise(state: int, emit: bool = True) -> int:
         """Mirror of :meth:`_Orthonormaliser.apply`; returns the state's new slot.
 
         emit : False to record it without an ORTHO operation (a beam's pieces
         after the first run it themselves)."""
-        columns = set(plan.column_sets[state])
-        others = ([("row", i, r[1]) for i, r in enumerate(rows)]
-                  + [("state", key, slot) for key, slot in open_states.items()]
-                  + [("waiting", key, slot) for key, slot in waiting.items()])
-        held = [plan.column_sets[slot] for *_, slot in others]
-        chosen: set[int] = set()
-        while True:
-            more = {i for i, cs in enumerate(held) if i not in chosen and not cs.isdisjoint(columns)}
-            if not more:
-                break
-            chosen |= more
-            for i in more:
-                columns |= held[i]
-        blocks = [others[i] for i in sorted(chosen)] + [("self", None, state)]
-        union = np.array(sorted(columns), dtype=np.int64)
-        block_rows = [rows[key][2] if kind == "row" else 12 for kind, key, _ in blocks]
-        block_forces = [rows[key][3] if kind == "row" else -1 for kind, key, _ in blocks]
-        if sum(block_rows) < union.size:  # fewer rows than columns: never orthonormalised
+        sets = plan.column_sets
+        others = rows + list(open_states.values()) + list(waiting.values())
+        columns = set(sets[state])
+        chosen = [False] * len(others)
+        grown = True
+        while grown:  # every block that shares a column with those gathered so far
+            grown = False
+            for i, block in enumerate(others):
+                if not chosen[i] and not sets[block[0]].isdisjoint(columns):
+                    chosen[i] = grown = True
+                    columns |= sets[block[0]]
+        blocks = [block for block, taken in zip(others, chosen) if taken] + [_state_block(state)]
+        if sum(block[1] for block in blocks) < len(columns):  # fewer rows than columns: never orthonormalised
             return state
+        union_set = frozenset(columns)
+        union = np.array(sorted(union_set), dtype=np.int64)
         first = len(plan.ortho_blocks)
-        new_slots = []
-        for (kind, key, src), count, forces in zip(blocks, block_rows, block_forces):
-            same = len(plan.column_sets[src]) == union.size  # its columns are among the union's
-            dst = src if same else plan.slot(count, union)
-            place = -1 if same else plan.place(plan.columns(src), union)
-            plan.ortho_blocks.append((src, dst, count, ROW_BLOCK if kind == "row" else STATE_BLOCK, place,
-                                      forces))
-            new_slots.append((kind, key, dst))
+        for block in blocks:
+            src, count, forces, kind = block
+            if len(sets[src]) == union.size:  # its columns are the union's: in place
+                dst, place = src, -1
+            else:
+                dst, place = plan.slot(count, union, union_set), plan.place(plan.columns(src), union)
+            plan.ortho_blocks.append((src, dst, count, kind, place, forces))
+            block[0] = dst
         plan.orthos.append((first, len(blocks), len(blocks) - 1, union.size, 0))
         if emit:
             plan.emit(ORTHO, len(plan.orthos) - 1)
-        for kind, key, dst in new_slots:
-            if kind == "row":
-                rows[key][1] = dst
-            elif kind == "state":
-                open_states[key] = dst
-            elif kind == "waiting":
-                waiting[key] = dst
-        return new_slots[-1][2]
+        return dst
 
     def enter_cut_side(link) -> int:
         _, c, side = link
         if (c, side) in waiting:
-            return waiting.pop((c, side))
-        waiting[c, 1 - side] = plan.tip(("cut", c, 1 - side))
+            return waiting.pop((c, side))[0]
+        waiting[c, 1 - side] = _state_block(plan.tip(("cut", c, 1 - side)))
         return plan.tip(link)
 
     for e in topology.order:
@@ -367,7 +286,7 @@ def _planned(deduction: Deduction) -> _Layout:
         for p in element.inputs:
             link = element.ports[p].link
             if link[0] == "element":
-                inputs.append(open_states.pop(link[1]))
+                inputs.append(open_states.pop(link[1])[0])
             elif link[0] == "cut" and not topology.cuts[link[1]].closing:
                 inputs.append(enter_cut_side(link))
             else:
@@ -383,58 +302,81 @@ def _planned(deduction: Deduction) -> _Layout:
             plan.emit(BEAM, state, index, 0, records if len(plan.orthos) > records else -1)
             terms = [(state, -1)]
         else:
-            inertial = deduction._polynomial_parts(e)[1]
-            carried = plan.slot(12, plan.columns(inputs[0]))
-            plan.emit(CARRY, carried, inputs[0], plan.valued(("kinematic", e)),
-                      -1 if inertial is None else plan.valued(("inertial", e)))
+            carried = plan.slot_like(12, inputs[0])
+            kinematic = plan.valued()
+            inertial = plan.valued() if element.kind == "rigid" else -1  # U2 = 0: none
+            plan.constants.carry(e, element.kind, kinematic, inertial)
+            plan.emit(CARRY, carried, inputs[0], kinematic, inertial)
             terms = [(carried, -1)]
             if e in deduction.jump_columns:
                 terms.append((_joint(plan, deduction, e, inputs[0], rows), -1))
-        for k, ((label, _, _), other) in enumerate(zip(deduction._other_inputs(e), inputs[1:])):
-            terms.append((other, plan.valued(("forces", e, k))))
+        for k, other in enumerate(inputs[1:]):
+            forces, incidence = plan.valued(), plan.valued()
+            plan.constants.other_input.append((e, k, forces, incidence))
+            terms.append((other, forces))
             first = inputs[0]
-            union = np.unique(np.concatenate([plan.columns(first), plan.columns(other)]))
-            row = plan.slot(6, union)
-            plan.emit(GEOMETRIC, row, first, other, plan.valued(("incidence", e, k)),
-                      len(plan.places))
+            union, union_set = plan.union([first, other])
+            row = plan.slot(6, union, union_set)
+            plan.emit(GEOMETRIC, row, first, other, incidence, len(plan.places))
             plan.place(plan.columns(first), union)
             plan.place(plan.columns(other), union)
-            rows.append([label, row, 6, -1])
+            rows.append([row, 6, -1, ROW_BLOCK])
         state = terms[0][0] if len(terms) == 1 else plan.combined(terms)
-        open_states[e] = orthonormalise(state)
-    root = open_states[topology.order[-1]]
+        open_states[e] = _state_block(orthonormalise(state))
+    root = open_states[topology.order[-1]][0]
     if topology.root[0] == "boundary":
         _leave_final_orthos_to_the_lu(plan)
+    return rows, root
 
+
+def _assembled(plan: _Planner, rows: list, root: int) -> Program:
+    """The program ``plan`` recorded, as arrays (``rows`` and ``root`` as :func:`_walked` gives them)."""
+    deduction = plan.deduction
     sizes = np.array([r * len(c) for r, c in plan.slots], dtype=np.int64)
     starts = np.cumsum([0] + [len(c) for _, c in plan.slots])
     places_start = np.cumsum([0] + [p.size for p in plan.places])
     order = deduction.full_order
-    program = Program(
+    return Program(
         slot_offset=np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64),
         slot_rows=np.array([r for r, _ in plan.slots], dtype=np.int64),
         slot_width=np.array([len(c) for _, c in plan.slots], dtype=np.int64),
         slot_columns=np.concatenate([c for _, c in plan.slots]).astype(np.int64),
         slot_columns_start=starts.astype(np.int64),
         workspace=int(sizes.sum()),
-        operations=np.array(plan.operations, dtype=np.int64).reshape(-1, 6),
-        terms=np.array(plan.terms, dtype=np.int64).reshape(-1, 3),
+        operations=_table(plan.operations, 6),
+        terms=_table(plan.terms, 3),
         places=np.concatenate(plan.places).astype(np.int64) if plan.places else np.zeros(0, np.int64),
         places_start=places_start.astype(np.int64),
-        matrices=np.array(plan.matrices).reshape(-1, 12, 12),
-        orthos=np.array(plan.orthos, dtype=np.int64).reshape(-1, 5),
-        ortho_blocks=np.array(plan.ortho_blocks, dtype=np.int64).reshape(-1, 6),
+        matrices=plan.all_matrices(),
+        orthos=_table(plan.orthos, 5),
+        ortho_blocks=_table(plan.ortho_blocks, 6),
         beams=_beam_parameters(deduction, plan.beams),
         beam_rotation=_beam_rotations(deduction, plan.beams),
         root=root,
-        root_row=rows[0][1],
-        geometric_rows=np.array([r[1] for r in rows[1:]], dtype=np.int64),
+        root_row=rows[0][0],
+        geometric_rows=np.array([r[0] for r in rows[1:]], dtype=np.int64),
         order=order,
-        kept_rows=np.setdiff1d(np.arange(order), deduction.released_rows).astype(np.int64),
-        kept_columns=np.setdiff1d(np.arange(order), deduction.released_columns).astype(np.int64),
-        row_kinds=np.concatenate([_row_kinds(count, forces) for _, _, count, forces in rows]).astype(np.int64),
+        kept_rows=_kept(order, deduction.released_rows),
+        kept_columns=_kept(order, deduction.released_columns),
+        row_kinds=np.concatenate([_row_kinds(count, forces) for _, count, forces, _ in rows]),
     )
-    return _Layout(program, tuple(plan.recipes), tuple(plan.beams))
+
+
+def _state_block(slot: int) -> list:
+    """A state's block, as the walk holds it: [slot, rows, forces, kind] (:func:`_walked`)."""
+    return [slot, 12, -1, STATE_BLOCK]
+
+
+def _table(records: list[tuple], width: int) -> np.ndarray:
+    """(len(records), width) int64 of ``records``, each ``width`` integers."""
+    return np.fromiter(chain.from_iterable(records), dtype=np.int64, count=width * len(records)).reshape(-1, width)
+
+
+def _kept(order: int, released: np.ndarray) -> np.ndarray:
+    """(order - released,) int64: 0..order-1, less the indices ``released``, ascending."""
+    kept = np.ones(order, dtype=bool)
+    kept[released] = False
+    return np.flatnonzero(kept).astype(np.int64, copy=False)
 
 
 def _row_kinds(count: int, forces: int) -> np.ndarray:
@@ -443,8 +385,12 @@ def _row_kinds(count: int, forces: int) -> np.ndarray:
     root's state, a geometric equation) three rows per kind (as
     :func:`linmstmm.godunov._row_kinds` weighs them)."""
     if forces >= 0:
-        return np.r_[np.full(forces, 3), np.full(count - forces, 2)]
-    return np.arange(count) // 3
+        return np.repeat(np.array([3, 2], dtype=np.int64), [forces, count - forces])
+    return _THREE_PER_KIND[:count]
+
+
+#: Kinds of the rows of a block of up to 12 rows, three rows per kind (:func:`_row_kinds`).
+_THREE_PER_KIND = np.arange(12, dtype=np.int64) // 3
 
 
 def _joint(plan: _Planner, deduction: Deduction, e: int, state: int, rows: list) -> int:
@@ -452,11 +398,13 @@ def _joint(plan: _Planner, deduction: Deduction, e: int, state: int, rows: list)
     ``state``) as :meth:`Deduction._carry` does, and return the slot of its jumps' state
     (a constant, ``E Δ``) to add to its output."""
     record = deduction.topology.elements[e].record
-    row = plan.slot(record.released.size, plan.columns(state))
-    plan.emit(JOINT, row, state, plan.valued(("joint", e)))
-    rows.append([f"{record.name} released", row, record.released.size, int(np.sum(record.released < 3))])
-    slot = plan.slot(12, deduction.jump_state(e, 1).columns)
-    plan.emit(TIP, slot, plan.valued(("jump", e)))
+    row = plan.slot_like(record.released.size, state)
+    force, jump = plan.valued(), plan.valued()
+    plan.constants.joint.append((e, force, jump))
+    plan.emit(JOINT, row, state, force)
+    rows.append([row, record.released.size, int(np.sum(record.released < 3)), ROW_BLOCK])
+    slot = plan.slot(12, deduction.jump_selection(e)[0])
+    plan.emit(TIP, slot, jump)
     return slot
 
 

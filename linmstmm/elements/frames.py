@@ -24,9 +24,26 @@ SYMPLECTIC_FORM[FORCE_INDEX, np.arange(6)] = -1.0
 
 
 def skew(r) -> np.ndarray:
-    """(3, 3) cross-product matrix: ``skew(r) @ v == np.cross(r, v)``."""
-    x, y, z = np.asarray(r)  # float, or mpmath numbers (then an object array)
-    return np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]], dtype=number_type(r))
+    """(..., 3, 3) cross-product matrices of (..., 3) vectors: ``skew(r) @ v == np.cross(r, v)``.
+
+    r : float, or mpmath numbers (then an object array, its zeros the float 0.0).
+    """
+    r = np.asarray(r)
+    x, y, z = r[..., 0], r[..., 1], r[..., 2]
+    out = np.zeros(r.shape[:-1] + (3, 3)).astype(number_type(r), copy=False)
+    out[..., 0, 1], out[..., 0, 2] = -z, y
+    out[..., 1, 0], out[..., 1, 2] = z, -x
+    out[..., 2, 0], out[..., 2, 1] = -y, x
+    return out
+
+
+def identities(shape: tuple, rows: int, columns: int | None = None, dtype=np.float64) -> np.ndarray:
+    """(*shape, rows, columns) matrices of ``dtype`` (columns = rows if None, rows ≤ columns),
+    each :func:`numpy.eye` (ones on the diagonal, zeros elsewhere); writable."""
+    columns = rows if columns is None else columns
+    out = np.zeros(shape + (rows, columns), dtype=dtype)
+    out.reshape(shape + (rows * columns,))[..., ::columns + 1] = 1  # the diagonal of each
+    return out
 
 
 def state_rotation(axes) -> np.ndarray:

@@ -17,29 +17,33 @@ from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.elements.frames import M, Q, R, U, skew
+from linmstmm.elements.frames import M, Q, R, U, identities, skew
 from linmstmm.numeric import frequencies, number_type
 
 
 def rigid_transfer_parts(mass, com, inertia, inp, out) -> tuple[np.ndarray, np.ndarray]:
-    """(kinematic, inertial), each (12, 12): ``U(ω) = kinematic + ω² inertial``;
-    only the block inertial[6:, :6] (forces and moments from displacements and
+    """(kinematic, inertial), each (..., 12, 12): ``U(ω) = kinematic + ω² inertial``;
+    only the block inertial[..., 6:, :6] (forces and moments from displacements and
     rotations) is non-zero.
 
-    mass : kg. com, inp, out : (3,) positions, m. inertia : (3, 3) about the
-    mass centre, kg m². Floats, or mpmath numbers (:func:`~linmstmm.numeric.numbers`):
-    then both matrices are object arrays.
+    mass : (...) kg. com, inp, out : (..., 3) positions, m. inertia : (..., 3, 3)
+    about the mass centre, kg m². One body, or a stack of bodies along the leading
+    axes (each the same numbers as alone). Floats, or mpmath numbers
+    (:func:`~linmstmm.numeric.numbers`): then both matrices are object arrays.
     """
-    inp, out, com = (np.asarray(p) for p in (inp, out, com))
+    mass, inp, out, com, inertia = (np.asarray(p) for p in (mass, inp, out, com, inertia))
     dtype = number_type(mass, com, inertia, inp, out)
-    kinematic = np.eye(12, dtype=dtype)
-    kinematic[U, R] = -skew(out - inp)
-    kinematic[M, Q] = skew(inp - out)
-    inertial = np.zeros((12, 12), dtype=dtype)
-    com_from_input = np.hstack([np.eye(3), -skew(com - inp)])  # u_c = this @ (u_I, θ_I)
-    inertial[Q, 0:6] = mass * com_from_input
-    inertial[M, 0:6] = -skew(out - com) @ (mass * com_from_input)
-    inertial[M, R] += np.asarray(inertia)
+    kinematic = identities(mass.shape, 12, dtype=dtype)
+    kinematic[..., U, R] = -skew(out - inp)
+    kinematic[..., M, Q] = skew(inp - out)
+    weighted = np.zeros(mass.shape + (3, 6)).astype(dtype, copy=False)  # u_c = this @ (u_I, θ_I), times m
+    weighted[..., :3] = np.eye(3)
+    weighted[..., 3:] = -skew(com - inp)
+    weighted *= mass[..., None, None]
+    inertial = np.zeros(mass.shape + (12, 12), dtype=dtype)
+    inertial[..., Q, 0:6] = weighted
+    inertial[..., M, 0:6] = -skew(out - com) @ weighted
+    inertial[..., M, R] += inertia
     return kinematic, inertial
 
 
@@ -54,18 +58,21 @@ def rigid_transfer(mass, com, inertia, inp, out, omega) -> np.ndarray:
 
 
 def force_extraction(inp_k, out) -> np.ndarray:
-    """(12, 12) U_{j,Ik}: carries the force and moment of input k to the output
-    (positions float or mpmath numbers, as in :func:`rigid_transfer_parts`)."""
-    extraction = np.zeros((12, 12), dtype=number_type(inp_k, out))
-    extraction[M, M] = np.eye(3)
-    extraction[Q, Q] = np.eye(3)
-    extraction[M, Q] = skew(np.asarray(inp_k) - np.asarray(out))
+    """(..., 12, 12) U_{j,Ik}: carries the force and moment of input k to the output
+    (positions (..., 3), float or mpmath numbers, as in :func:`rigid_transfer_parts`)."""
+    arm = np.asarray(inp_k) - np.asarray(out)
+    extraction = np.zeros(arm.shape[:-1] + (12, 12), dtype=number_type(inp_k, out))
+    extraction[..., M, M] = np.eye(3)
+    extraction[..., Q, Q] = np.eye(3)
+    extraction[..., M, Q] = skew(arm)
     return extraction
 
 
 def position_incidence(inp_1, inp_k) -> np.ndarray:
-    """(6, 12) H_{j,Ik} with ``H_j Z_I1 = H_{j,Ik} Z_Ik`` (rigid kinematics; H_j takes
-    rows 0:6, the displacement and rotation, as the deduction does directly)."""
-    incidence = np.eye(6, 12, dtype=number_type(inp_1, inp_k))
-    incidence[U, R] = skew(np.asarray(inp_k) - np.asarray(inp_1))
+    """(..., 6, 12) H_{j,Ik} with ``H_j Z_I1 = H_{j,Ik} Z_Ik`` (rigid kinematics; H_j takes
+    rows 0:6, the displacement and rotation, as the deduction does directly);
+    positions (..., 3) as in :func:`force_extraction`."""
+    arm = np.asarray(inp_k) - np.asarray(inp_1)
+    incidence = identities(arm.shape[:-1], 6, 12, dtype=number_type(inp_1, inp_k))
+    incidence[..., U, R] = skew(arm)
     return incidence

@@ -18,40 +18,52 @@ from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.elements.frames import FORCE_INDEX, M, Q, R, U
+from linmstmm.elements.frames import FORCE_INDEX, M, Q, R, U, identities
 from linmstmm.numeric import number_type
 
 
 def spring_compliance(k, axes, release=None) -> tuple[np.ndarray, np.ndarray]:
     """Translational and rotational compliance in the inertial frame.
 
-    k : (6,) N/m and N m/rad, ``inf`` allowed; floats, or mpmath numbers
+    k : (..., 6) N/m and N m/rad, ``inf`` allowed; floats, or mpmath numbers
     (:func:`~linmstmm.numeric.numbers`: the compliances are then formed at the
-    working precision). axes : (3, 3) rows = local axes. release : (6,) bool or
-    None: released directions get zero compliance (their jump is an unknown of
-    its own, :func:`joint_jump`).
-    Returns (C_t, C_r), each (3, 3), m/N and rad/(N m).
+    working precision). axes : (..., 3, 3) rows = local axes. release : (..., 6)
+    bool or None: released directions get zero compliance (their jump is an
+    unknown of its own, :func:`joint_jump`). One spring, or a stack of springs
+    along the leading axes (each the same numbers as alone).
+    Returns (C_t, C_r), each (..., 3, 3), m/N and rad/(N m).
     """
     k = np.asarray(k, dtype=number_type(k))
     axes = np.asarray(axes, dtype=float)
-    free = np.zeros(6, bool) if release is None else np.asarray(release, bool)
-    compliance = np.array([0 * value if loose else 1 / value for value, loose in zip(k, free)],
-                          dtype=k.dtype)  # inf -> 0: rigid direction
-    C_t = axes.T @ np.diag(compliance[:3]) @ axes
-    C_r = axes.T @ np.diag(compliance[3:]) @ axes
-    return C_t, C_r
+    if release is None:
+        compliance = 1 / k  # inf -> 0: rigid direction
+    else:
+        free = np.broadcast_to(np.asarray(release, bool), k.shape)
+        compliance = 1 / np.where(free, 1, k)
+        compliance[free] = 0 * k[free]
+    diagonal = np.zeros(k.shape[:-1] + (2, 9), dtype=k.dtype)  # translational, rotational: diag of each
+    diagonal[..., ::4] = compliance.reshape(k.shape[:-1] + (2, 3))
+    axes = axes[..., None, :, :]
+    both = np.swapaxes(axes, -1, -2) @ diagonal.reshape(k.shape[:-1] + (2, 3, 3)) @ axes
+    return both[..., 0, :, :], both[..., 1, :, :]
+
+
+def spring_constant_transfer(k, axes, release=None) -> np.ndarray:
+    """(..., 12, 12) transfer matrix of a spring (it does not depend on ω), or of a
+    stack of springs; k, axes, release as :func:`spring_compliance`."""
+    C_t, C_r = spring_compliance(k, axes, release)
+    single = identities(C_t.shape[:-2], 12, dtype=C_t.dtype)
+    single[..., U, Q] = -C_t
+    single[..., R, M] = -C_r
+    return single
 
 
 def spring_transfer(k, axes, omega, release=None) -> np.ndarray:
     """Transfer matrix stack (n, 12, 12) of a spring; constant in omega.
 
-    k, axes, release : as :func:`spring_compliance`. omega : (n,) rad/s.
+    k, axes, release : as :func:`spring_compliance`, one spring. omega : (n,) rad/s.
     """
-    C_t, C_r = spring_compliance(k, axes, release)
-    U_single = np.eye(12, dtype=C_t.dtype)
-    U_single[U, Q] = -C_t
-    U_single[R, M] = -C_r
-    return np.broadcast_to(U_single, (np.size(omega), 12, 12)).copy()
+    return np.broadcast_to(spring_constant_transfer(k, axes, release), (np.size(omega), 12, 12)).copy()
 
 
 def damped_spring_transfer(k, c, axes, rate, release=None) -> np.ndarray:

@@ -191,27 +191,28 @@ def misplaced(finder, known: list[float], lo: float | None, hi: float) -> int | 
     reported as certified before)."""
     start, wrong = 0.0 if lo is None else lo, 0
     roots = sorted({r for r in known if start < r < hi})
-    first, held = _counted_widths(finder, known, roots)
+    ordered = np.sort(np.asarray(known, dtype=float))
+    first, held = _counted_widths(finder, ordered, roots)
     for root in roots:
         if root not in first:
             return None
         if root not in held:
-            wrong += abs(first[root][0] - _known_within(known, root, first[root][1]))
+            wrong += abs(first[root][0] - _known_within(ordered, root, first[root][1]))
         elif held[root] > first[root][1]:  # a narrower count disagreed: float64 placed it that far off
             finder.last_step[root] = max(finder.last_step.get(root, 0.0), held[root])
     return wrong
 
 
-def _counted_widths(finder, known: list[float], roots: list[float]) -> tuple[dict, dict]:
+def _counted_widths(finder, ordered: np.ndarray, roots: list[float]) -> tuple[dict, dict]:
     """({root: (count, width)} at the narrowest width where the count across it decides,
-    {root: width} at the narrowest where it holds the ``known`` roots there), over
+    {root: width} at the narrowest where it holds the known roots ``ordered`` (rad/s,
+    ascending, with repeats) there), over
     each root's :func:`_widths`, narrowest first, until one holds: what
     :func:`_counts_near` gives root by root, counted here width by width so that
     each width's counts for all the roots are made together
     (:meth:`~linmstmm.wittrick_williams.ModeCounter.prefetch`, shared among the cores)."""
     pending = {root: _widths(finder, root) for root in roots}
     first, held, level = {}, {}, 0
-    ordered = np.sort(np.asarray(known, dtype=float))
     prefetch = getattr(finder.counter, "prefetch", None)
     while pending:
         pending = {root: widths for root, widths in pending.items() if level < len(widths)}
@@ -223,7 +224,7 @@ def _counted_widths(finder, known: list[float], roots: list[float]) -> tuple[dic
             if below is None or above is None or _on_an_end(ordered, root, width):
                 continue
             first.setdefault(root, (above - below, width))
-            if above - below == _known_within(known, root, width):
+            if above - below == _known_within(ordered, root, width):
                 held[root] = width
                 del pending[root]
         level += 1
@@ -241,10 +242,12 @@ def _on_an_end(ordered: np.ndarray, root: float, width: float) -> bool:
     return bool(np.any(np.searchsorted(ordered, ends + band) > np.searchsorted(ordered, ends - band)))
 
 
-def _known_within(known: list[float], root: float, width: float) -> int:
-    """How many of ``known`` (with repeats) lie within ±``width`` (relative) of ``root``:
-    its own multiplicity, and a close neighbour's that the same count sees."""
-    return sum(abs(r - root) < width * root for r in known)
+def _known_within(ordered: np.ndarray, root: float, width: float) -> int:
+    """How many of the known roots ``ordered`` (rad/s, ascending, with repeats) lie
+    within ±``width`` (relative) of ``root``, ends excluded: its own multiplicity, and
+    a close neighbour's that the same count sees."""
+    return int(np.searchsorted(ordered, root * (1 + width), side="left")
+               - np.searchsorted(ordered, root * (1 - width), side="right"))
 
 
 def stiffness_count(finder, known: list[float], lo: float | None, hi: float) -> int | None:
@@ -281,7 +284,7 @@ def counted_multiplicities(finder, roots: list[float], lo: float | None, hi: flo
             near = _count_near(finder, root, ordered)
             if near is not None:
                 # the count sees close neighbours too: this root holds what they leave
-                counted_here = near[0] - (_known_within(roots, root, near[1]) - have)
+                counted_here = near[0] - (_known_within(ordered, root, near[1]) - have)
                 if counted_here > have and near[1] > finder.rtol:
                     finder.last_step[root] = max(finder.last_step.get(root, 0.0), near[1])
                 have = max(counted_here, 0)

@@ -46,6 +46,7 @@ from linmstmm.fe.products import (
 )
 from linmstmm.fe.sparse import compressed_rows
 from linmstmm.model import Model
+from linmstmm.ordered_ldlt import elimination_plan
 from linmstmm.spread import spread
 
 #: Largest order of D(ω) counted: its dense factorisation grows as n³ (72 unknowns:
@@ -64,6 +65,13 @@ MAX_ORDER = 150
 #: counts 1e-9 to 1e-5 from them) 1e-11, 1e-12 and 1e-13 all gave no wrong count,
 #: leaving 2,333, 1,639 and 1,189 undecided.
 SINGULAR_PIVOT = 1e-12
+
+#: The compiled count's sparse LDLᵀ without pivoting leaves D(ω) to the dense
+#: Bunch–Kaufman factorisation where an entry of diag(|L| |D| |L|ᵀ) is above this
+#: times the largest equilibrated term: its rounding, order (entries a row) ·
+#: eps · growth, stays well below SINGULAR_PIVOT then, and a count it decides is
+#: the inertia the dense factorisation finds.
+MOST_GROWTH = 1e2
 
 #: Frequencies whose D(ω) the numpy engine forms at once (:meth:`ModeCounter.prefetch`):
 #: one at a time, forming D(ω) took 176 of the 308 µs of a count on the launcher.
@@ -114,6 +122,7 @@ class ModeCounter:
         self._answers: dict[float, int | None] = {}
         self._table = None  # the beams as the compiled kernels take them, on their first call
         self._scratch = None  # this counter's own buffers for the compiled kernel, on its first call
+        self._plan = None  # D(ω)'s sparse factorisation as the compiled kernel takes it, on its first call
 
     def fresh(self) -> ModeCounter:
         """This counter with no answers remembered: the same model's matrices (not
@@ -173,6 +182,7 @@ class ModeCounter:
             return
         counts = np.empty(len(wanted), dtype=np.int64)
         self._beam_table()  # made here, not by two pieces at once
+        self._sparse_plan()
 
         def count_piece(start: int, stop: int) -> None:
             scratch = self._new_scratch()
@@ -191,11 +201,13 @@ class ModeCounter:
 
     def _new_scratch(self) -> tuple:
         """Buffers the compiled kernel writes into: D(ω) and |D|(ω) ((n_dof + 1)², a row
-        for padding) and dsytrf's workspace."""
+        for padding) and dsytrf's workspace for the dense count, and the sparse
+        count's own (:func:`linmstmm._stiffness_kernels.ordered_count`)."""
         from linmstmm import _stiffness_kernels as kernels
 
-        size = self.n_dof + 1
-        return np.empty((size, size)), np.empty((size, size)), np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN)
+        size, slots = self.n_dof + 1, self._sparse_plan()[1].shape[1]
+        return (np.empty((size, size)), np.empty((size, size)), np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN),
+                (np.empty(slots), np.empty(2 * slots), np.empty(slots), np.empty(self.n_dof)))
 
     def _beam_table(self) -> np.ndarray:
         """The beams as the compiled kernel takes them (:func:`linmstmm._stiffness_kernels.beam_columns`),
@@ -206,13 +218,22 @@ class ModeCounter:
             self._table = kernels.beam_columns(self._beams)
         return self._table
 
+    def _sparse_plan(self) -> tuple:
+        """(plan, terms) of :func:`linmstmm._stiffness_kernels.ordered_count`
+        (:func:`sparse_plan`), made on the first call."""
+        if self._plan is None:
+            self._plan = sparse_plan(self._static, self._mass, self._maps, self._columns)
+        return self._plan
+
     def _kernel_count(self, omega: float, scratch: tuple) -> int:
-        """J(ω) by :func:`linmstmm._stiffness_kernels.count` in ``scratch``; −1 where undecided."""
+        """J(ω) by :func:`linmstmm._stiffness_kernels.ordered_count` in ``scratch``; −1
+        where undecided."""
         from linmstmm import _stiffness_kernels as kernels
 
-        matrix, magnitude, work = scratch
-        return kernels.count(omega, self._beam_table(), self._maps, self._columns, self._static, self._mass,
-                             SINGULAR_PIVOT, matrix, magnitude, work)
+        matrix, magnitude, work, buffers = scratch
+        plan, terms = self._sparse_plan()
+        return kernels.ordered_count(omega, self._beam_table(), self._maps, self._columns, self._static, self._mass,
+                                     SINGULAR_PIVOT, matrix, magnitude, work, plan, terms, MOST_GROWTH, buffers)
 
     def matrices(self, omegas) -> tuple[np.ndarray, np.ndarray]:
         """(D(ω), |D|(ω)) at each of the m ``omegas`` (rad/s): the reduced exact dynamic
@@ -230,6 +251,48 @@ class ModeCounter:
         n, squared = self.n_dof, (omegas ** 2)[:, None, None]
         matrix = beams[:, :n, :n] + self._static - squared * self._mass
         return matrix, magnitude[:, :n, :n] + np.abs(self._static) + squared * np.abs(self._mass)
+
+
+def sparse_plan(static: np.ndarray, mass: np.ndarray, maps: np.ndarray, columns: np.ndarray) -> tuple[tuple, np.ndarray]:
+    """The sparse factorisation of D(ω) as :func:`linmstmm._stiffness_kernels.ordered_count`
+    takes it.
+
+    Parameters
+    ----------
+    static, mass : (n, n) float64
+        The springs' stiffness (N/m, N·m/rad) and the bodies' mass (kg, kg·m²), reduced.
+    maps, columns : (n_beams, 12, k) float64, (n_beams, k) int
+        Each beam's map from the reduced DOFs it touches to its local ones, and those
+        DOFs (n for padding), as :func:`_beam_maps`.
+
+    Returns
+    -------
+    plan : tuple of int64 arrays
+        (order, starts, rows, high, low, updates, targets) of the
+        :class:`~linmstmm.ordered_ldlt.EliminationPlan` of D(ω)'s pattern, and
+        (n_beams, k, k) beam_slots: where each entry of a beam's map goes (its slot
+        in the lower triangle, slots + its slot in the upper one, −1 for padding).
+    terms : (4, slots) float64
+        ``static`` and ``mass`` at the slots in the lower triangle, then in the upper.
+    """
+    from linmstmm import _stiffness_kernels as kernels
+
+    n = static.shape[0]
+    pattern = (static != 0) | (mass != 0)
+    i, j = np.broadcast_arrays(columns[:, :, None], columns[:, None, :])
+    # where a beam's map.T @ local @ map may be nonzero: any other entry is a sum of zeros
+    reach = np.abs(maps) > 0
+    present = (np.swapaxes(reach, 1, 2).astype(float) @ kernels.LOCAL_PATTERN @ reach > 0) & (i < n) & (j < n)
+    pattern[i[present], j[present]] = True
+    pattern |= pattern.T
+    plan = elimination_plan(pattern)
+    slots = plan.high.size
+    placed = np.where(present, plan.slot_of(np.minimum(i, n - 1), np.minimum(j, n - 1)), -1)
+    beam_slots = np.where(present & (i < j), placed + slots, placed)
+    terms = np.stack([static[plan.high, plan.low], mass[plan.high, plan.low],
+                      np.where(plan.high > plan.low, static[plan.low, plan.high], 0.0),
+                      np.where(plan.high > plan.low, mass[plan.low, plan.high], 0.0)])
+    return (plan.order, plan.starts, plan.rows, plan.high, plan.low, plan.updates, plan.targets, beam_slots), terms
 
 
 def _beam_maps(parts) -> tuple[np.ndarray, np.ndarray]:

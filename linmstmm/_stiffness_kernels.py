@@ -12,7 +12,13 @@ the test oracle (tests/test_wittrick_williams.py compares them):
   whole count J(ω) in one call (J₀, D(ω), its equilibration, and LDLᵀ
   factorisations by LAPACK's ``dsytrf`` of it shifted up and down), compiled
   ``nogil``, so that counts at several frequencies can run on threads side by
-  side.
+  side;
+* :func:`ordered_count` — the same count on the sparse D(ω) (assembled by
+  :func:`_assembled_slots`, factorised by :func:`ordered_inertia`, LDLᵀ without
+  pivoting in the order of a :class:`~linmstmm.ordered_ldlt.EliminationPlan`),
+  the same answer wherever it gives one and REFUSED where :func:`count` is to
+  decide (a small pivot or growth); tests/test_sparse_count.py compares it with
+  :func:`count` and its factorisation with a dense numpy LDLᵀ.
 """
 from __future__ import annotations
 
@@ -35,6 +41,8 @@ LOCAL_PATTERN = np.zeros((12, 12))
 for _dofs in ([0, 6], [3, 9], _X_Y, _X_Z):
     LOCAL_PATTERN[np.ix_(_dofs, _dofs)] = 1.0
 _DSYTRF = lapack_routine("dsytrf", 8)
+#: What :func:`ordered_count` answers where the dense :func:`count` is to decide.
+REFUSED = -2
 #: Workspace LAPACK's dsytrf is given per unknown: its block size (64), with which
 #: it factorises blocked, as scipy's wrapper lets it.
 WORK_PER_UNKNOWN = 64
@@ -352,18 +360,18 @@ def ordered_inertia(values, starts, rows, updates, targets, singular, most_growt
 
 
 @njit(cache=True, nogil=True)
-def ordered_count(omega, beams, maps, columns, static, mass, singular_pivot, matrix, magnitude, work,
-                  plan, terms, most_growth, buffers):
-    """:func:`count` (the same arguments first, the same answer wherever that one
-    decides) by LDLᵀ without pivoting on the sparse D(ω) in a fill-reducing order.
+def ordered_count(omega, beams, maps, singular_pivot, most_growth, plan, terms, buffers):
+    """:func:`count` by LDLᵀ without pivoting on the sparse D(ω) in a fill-reducing
+    order: the same answer wherever it gives one, and REFUSED where the dense
+    :func:`count` is to decide.
 
     D(ω) and |D|(ω) are assembled on the slots of the plan only, equilibrated and
     shifted by ± the rounding level as in :func:`count` (the same numbers), and
-    each shifted matrix factorised by :func:`ordered_inertia`. Where that refuses
-    (a small pivot, growth above ``most_growth`` times the largest equilibrated
-    term), where the two counts differ, or where a term is not finite, the count
-    is :func:`count`'s own.
+    each shifted matrix factorised by :func:`ordered_inertia`. REFUSED where that
+    refuses (a small pivot, or growth above ``most_growth`` times the largest
+    equilibrated term), where the two counts differ, or where a term is not finite.
 
+    beams, maps : as for :func:`assembled`. singular_pivot : as for :func:`count`.
     plan : (order, starts, rows, high, low, updates, targets, beam_slots) int64
     arrays of :class:`~linmstmm.ordered_ldlt.EliminationPlan` (beam_slots as in
     :func:`_assembled_slots`). terms : (4, slots) as there. buffers : float64
@@ -376,7 +384,7 @@ def ordered_count(omega, beams, maps, columns, static, mass, singular_pivot, mat
         return -1
     for s in range(magnitudes.size):
         if not math.isfinite(magnitudes[s]):  # so too where an entry of D(ω) is not
-            return count(omega, beams, maps, columns, static, mass, singular_pivot, matrix, magnitude, work)
+            return REFUSED
     n = order.size
     if n == 0:
         return clamped
@@ -388,16 +396,17 @@ def ordered_count(omega, beams, maps, columns, static, mass, singular_pivot, mat
     slots, largest = values.size, 0.0
     for s in range(slots):
         values[s] = values[s] * weights[high[s]] * weights[low[s]]
-        largest = max(largest, magnitudes[s] * weights[high[s]] * weights[low[s]],
-                      magnitudes[slots + s] * weights[low[s]] * weights[high[s]])
+        largest = max(largest, magnitudes[s] * weights[high[s]] * weights[low[s]])
+        largest = max(largest, magnitudes[slots + s] * weights[low[s]] * weights[high[s]])
     singular = singular_pivot * largest
     negatives = -1
     for sign in (1.0, -1.0):
-        shifted[:] = values
+        for s in range(slots):
+            shifted[s] = values[s]
         for k in range(n):
             shifted[starts[k]] += sign * singular
         found = ordered_inertia(shifted, starts, rows, updates, targets, singular, most_growth * largest, growth)
         if found < 0 or (sign < 0 and found != negatives):
-            return count(omega, beams, maps, columns, static, mass, singular_pivot, matrix, magnitude, work)
+            return REFUSED
         negatives = found
     return clamped + negatives

@@ -143,11 +143,26 @@ def assembled(omega, beams, maps, columns, static, mass, matrix, magnitude):
     static, mass : (n, n) springs' stiffness and bodies' mass, reduced.
     """
     n = static.shape[0]
-    clamped = 0
     for i in range(n):
         for j in range(n):
             matrix[i, j] = static[i, j] - omega * omega * mass[i, j]
             magnitude[i, j] = abs(static[i, j]) + omega * omega * abs(mass[i, j])
+    size, width = matrix.shape[1], columns.shape[1]
+    places = np.empty((beams.shape[0], width, width), dtype=np.int64)  # in matrix.ravel()
+    for b in range(beams.shape[0]):
+        for i in range(width):
+            for j in range(width):
+                places[b, i, j] = columns[b, i] * size + columns[b, j]
+    return _added_beams(omega, beams, maps, places, matrix.reshape(matrix.size), magnitude.reshape(magnitude.size))
+
+
+@njit(cache=True)
+def _added_beams(omega, beams, maps, places, values, magnitudes):
+    """J₀(ω) of the beams (−1 where undecided), each beam's ``map.T @ local @ map``
+    added in order: its entry (i, j) at ``places[b, i, j]`` of ``values`` and its
+    absolute value there in ``magnitudes``; in ``magnitudes`` alone where that place
+    is values.size or more, nowhere where it is negative."""
+    clamped = 0
     local = np.zeros((12, 12))
     combos = np.empty(7)
     for b in range(beams.shape[0]):
@@ -156,11 +171,14 @@ def assembled(omega, beams, maps, columns, static, mass, matrix, magnitude):
             return -1
         clamped += count
         mapped = _mapped(local, maps[b])
-        for i in range(columns.shape[1]):
-            for j in range(columns.shape[1]):
-                value = _entry(maps[b], mapped, i, j)
-                matrix[columns[b, i], columns[b, j]] += value
-                magnitude[columns[b, i], columns[b, j]] += abs(value)
+        for i in range(places.shape[1]):
+            for j in range(places.shape[2]):
+                place = places[b, i, j]
+                if place >= 0:
+                    value = _entry(maps[b], mapped, i, j)
+                    if place < values.size:
+                        values[place] += value
+                    magnitudes[place] += abs(value)
     return clamped
 
 
@@ -300,7 +318,7 @@ def _assembled_slots(omega, beams, maps, beam_slots, terms, values, magnitudes):
 
     beam_slots : (n_beams, k, k) int64, where entry (i, j) of a beam's map goes:
     its slot in the lower triangle, slots + its slot in the upper one (|D| only),
-    or −1 (padding). terms : (4, slots) the springs' stiffness and the bodies'
+    or −1 (padding, or an entry that no term of the beam's local stiffness reaches). terms : (4, slots) the springs' stiffness and the bodies'
     mass in the lower triangle, then the same in the upper one.
     """
     slots = values.size
@@ -309,24 +327,7 @@ def _assembled_slots(omega, beams, maps, beam_slots, terms, values, magnitudes):
         values[s] = terms[0, s] - squared * terms[1, s]
         magnitudes[s] = abs(terms[0, s]) + squared * abs(terms[1, s])
         magnitudes[slots + s] = abs(terms[2, s]) + squared * abs(terms[3, s])
-    clamped = 0
-    local = np.zeros((12, 12))
-    combos = np.empty(7)
-    for b in range(beams.shape[0]):
-        count = _beam_local(beams[b], omega, local, combos)
-        if count < 0:
-            return -1
-        clamped += count
-        mapped = _mapped(local, maps[b])
-        for i in range(beam_slots.shape[1]):
-            for j in range(beam_slots.shape[2]):
-                slot = beam_slots[b, i, j]
-                if slot >= 0:
-                    value = _entry(maps[b], mapped, i, j)
-                    if slot < slots:
-                        values[slot] += value
-                    magnitudes[slot] += abs(value)
-    return clamped
+    return _added_beams(omega, beams, maps, beam_slots, values, magnitudes)
 
 
 @njit(cache=True)

@@ -272,7 +272,8 @@ def sparse_plan(static: np.ndarray, mass: np.ndarray, maps: np.ndarray, columns:
         (order, starts, rows, high, low, updates, targets) of the
         :class:`~linmstmm.ordered_ldlt.EliminationPlan` of D(ω)'s pattern, and
         (n_beams, k, k) beam_slots: where each entry of a beam's map goes (its slot
-        in the lower triangle, slots + its slot in the upper one, −1 for padding).
+        in the lower triangle, slots + its slot in the upper one, −1 for padding
+        and for entries that no term of the beam's local stiffness reaches).
     terms : (4, slots) float64
         ``static`` and ``mass`` at the slots in the lower triangle, then in the upper.
     """

@@ -56,7 +56,9 @@ from linmstmm.spread import spread
 #: Largest order of D(ω) counted: its dense factorisation grows as n³ (72 unknowns:
 #: 75 µs, 120: 160 µs compiled), and a count is made twice per root; a longer model
 #: (a chain of 1,000 bodies: 3,000 unknowns, 12.8 s instead of 0.13 s) is counted by
-#: the argument principle, whose evaluations the periodic carry keeps cheap.
+#: the argument principle, whose evaluations the periodic carry keeps cheap. (The
+#: compiled count is sparse, but leaves the frequencies where its pivots are not
+#: safe to the dense factorisation.)
 MAX_ORDER = 150
 
 #: A pivot of the equilibrated D(ω) below this, relative to the largest term that
@@ -72,9 +74,11 @@ SINGULAR_PIVOT = 1e-12
 
 #: The compiled count's sparse LDLᵀ without pivoting leaves D(ω) to the dense
 #: Bunch–Kaufman factorisation where an entry of diag(|L| |D| |L|ᵀ) is above this
-#: times the largest equilibrated term: its rounding, order (entries a row) ·
-#: eps · growth, stays well below SINGULAR_PIVOT then, and a count it decides is
-#: the inertia the dense factorisation finds.
+#: times the largest equilibrated term. Below it the factorisation's rounding, of
+#: order (entries of a column of L, at most 10 on the launchers) · 1.1e-16 · growth,
+#: about 1e-13 at the bound, stays well below SINGULAR_PIVOT, and a count it
+#: decides is the inertia the dense factorisation finds. Without the bound a 4 × 4 matrix whose first pivot is
+#: 1.2e-11 counts 2 negative eigenvalues where there is 1 (tests/test_sparse_count.py).
 MOST_GROWTH = 1e2
 
 #: Frequencies whose D(ω) the numpy engine forms at once (:meth:`ModeCounter.prefetch`):

@@ -12,7 +12,13 @@ the test oracle (tests/test_wittrick_williams.py compares them):
   whole count J(ω) in one call (J₀, D(ω), its equilibration, and LDLᵀ
   factorisations by LAPACK's ``dsytrf`` of it shifted up and down), compiled
   ``nogil``, so that counts at several frequencies can run on threads side by
-  side.
+  side;
+* :func:`ordered_count` — the same count on the sparse D(ω) (assembled by
+  :func:`_assembled_slots`, factorised by :func:`ordered_inertia`, LDLᵀ without
+  pivoting in the order of a :class:`~linmstmm.ordered_ldlt.EliminationPlan`),
+  the same answer wherever it gives one and REFUSED where :func:`count` is to
+  decide (a small pivot or growth); tests/test_sparse_count.py compares it with
+  :func:`count` and its factorisation with a dense numpy LDLᵀ.
 """
 from __future__ import annotations
 
@@ -29,7 +35,14 @@ EA, GJ, EIY, EIZ, RHO_A, RHO_IP, LENGTH, AXIAL, TORSION = range(9)
 _X_Y = np.array([1, 5, 7, 11])
 _X_Z = np.array([2, 4, 8, 10])
 _FLIP = np.array([1.0, -1.0, 1.0, -1.0])
+#: (12, 12) 1.0 where a beam's local dynamic stiffness may be nonzero: the rods
+#: (axial, torsion) and the two bending planes, each coupling its own DOFs only.
+LOCAL_PATTERN = np.zeros((12, 12))
+for _dofs in ([0, 6], [3, 9], _X_Y, _X_Z):
+    LOCAL_PATTERN[np.ix_(_dofs, _dofs)] = 1.0
 _DSYTRF = lapack_routine("dsytrf", 8)
+#: What :func:`ordered_count` answers where the dense :func:`count` is to decide.
+REFUSED = -2
 #: Workspace LAPACK's dsytrf is given per unknown: its block size (64), with which
 #: it factorises blocked, as scipy's wrapper lets it.
 WORK_PER_UNKNOWN = 64
@@ -130,32 +143,63 @@ def assembled(omega, beams, maps, columns, static, mass, matrix, magnitude):
     static, mass : (n, n) springs' stiffness and bodies' mass, reduced.
     """
     n = static.shape[0]
-    clamped = 0
     for i in range(n):
         for j in range(n):
             matrix[i, j] = static[i, j] - omega * omega * mass[i, j]
             magnitude[i, j] = abs(static[i, j]) + omega * omega * abs(mass[i, j])
+    size, width = matrix.shape[1], columns.shape[1]
+    places = np.empty((beams.shape[0], width, width), dtype=np.int64)  # in matrix.ravel()
+    for b in range(beams.shape[0]):
+        for i in range(width):
+            for j in range(width):
+                places[b, i, j] = columns[b, i] * size + columns[b, j]
+    return _added_beams(omega, beams, maps, places, matrix.reshape(matrix.size), magnitude.reshape(magnitude.size))
+
+
+@njit(cache=True)
+def _added_beams(omega, beams, maps, places, values, magnitudes):
+    """J₀(ω) of the beams (−1 where undecided), each beam's ``map.T @ local @ map``
+    added in order: its entry (i, j) at ``places[b, i, j]`` of ``values`` and its
+    absolute value there in ``magnitudes``; in ``magnitudes`` alone where that place
+    is values.size or more, nowhere where it is negative."""
+    clamped = 0
     local = np.zeros((12, 12))
     combos = np.empty(7)
     for b in range(beams.shape[0]):
-        beam = beams[b]
-        count = _clamped(beam, omega)
+        count = _beam_local(beams[b], omega, local, combos)
         if count < 0:
             return -1
         clamped += count
-        local[:] = 0.0
-        _rod(beam[EA], beam[RHO_A], beam[LENGTH], omega, beam[AXIAL] > 0, local, 0, 6)
-        _rod(beam[GJ], beam[RHO_IP], beam[LENGTH], omega, beam[TORSION] > 0, local, 3, 9)
-        _bending(beam[EIZ], beam[RHO_A], beam[LENGTH], omega, local, _X_Y, np.ones(4), combos)
-        _bending(beam[EIY], beam[RHO_A], beam[LENGTH], omega, local, _X_Z, _FLIP, combos)
-        _add_mapped(local, maps[b], columns[b], matrix, magnitude)
+        mapped = _mapped(local, maps[b])
+        for i in range(places.shape[1]):
+            for j in range(places.shape[2]):
+                place = places[b, i, j]
+                if place >= 0:
+                    value = _entry(maps[b], mapped, i, j)
+                    if place < values.size:
+                        values[place] += value
+                    magnitudes[place] += abs(value)
     return clamped
 
 
 @njit(cache=True)
-def _add_mapped(local, map_, columns, matrix, magnitude):
-    """Add ``map_.T @ local @ map_`` at ``columns`` of ``matrix`` (and its absolute
-    value to ``magnitude``)."""
+def _beam_local(beam, omega, local, combos):
+    """J₀ of one beam (:func:`_clamped`, −1 where undecided), with its (12, 12) exact
+    dynamic stiffness written into ``local`` (unless undecided)."""
+    count = _clamped(beam, omega)
+    if count < 0:
+        return -1
+    local[:] = 0.0
+    _rod(beam[EA], beam[RHO_A], beam[LENGTH], omega, beam[AXIAL] > 0, local, 0, 6)
+    _rod(beam[GJ], beam[RHO_IP], beam[LENGTH], omega, beam[TORSION] > 0, local, 3, 9)
+    _bending(beam[EIZ], beam[RHO_A], beam[LENGTH], omega, local, _X_Y, np.ones(4), combos)
+    _bending(beam[EIY], beam[RHO_A], beam[LENGTH], omega, local, _X_Z, _FLIP, combos)
+    return count
+
+
+@njit(cache=True)
+def _mapped(local, map_):
+    """``local @ map_`` (12, k), skipping the zeros of ``local``."""
     rows, width = map_.shape
     mapped = np.zeros((rows, width))
     for p in range(rows):
@@ -163,13 +207,16 @@ def _add_mapped(local, map_, columns, matrix, magnitude):
             if local[p, q] != 0.0:
                 for j in range(width):
                     mapped[p, j] += local[p, q] * map_[q, j]
-    for i in range(width):
-        for j in range(width):
-            value = 0.0
-            for p in range(rows):
-                value += map_[p, i] * mapped[p, j]
-            matrix[columns[i], columns[j]] += value
-            magnitude[columns[i], columns[j]] += abs(value)
+    return mapped
+
+
+@njit(cache=True)
+def _entry(map_, mapped, i, j):
+    """Entry (i, j) of ``map_.T @ local @ map_`` from ``mapped`` (:func:`_mapped`)."""
+    value = 0.0
+    for p in range(map_.shape[0]):
+        value += map_[p, i] * mapped[p, j]
+    return value
 
 
 @njit(cache=True)
@@ -259,4 +306,108 @@ def count(omega, beams, maps, columns, static, mass, singular_pivot, matrix, mag
     negatives = _ldlt_inertia(first, singular, pivots, work, integers)
     if negatives < 0 or negatives != _ldlt_inertia(second, singular, pivots, work, integers):
         return -1  # an eigenvalue within rounding of zero (a small one need not show as a small pivot)
+    return clamped + negatives
+
+
+@njit(cache=True)
+def _assembled_slots(omega, beams, maps, beam_slots, terms, values, magnitudes):
+    """:func:`assembled` on the slots of an :class:`~linmstmm.ordered_ldlt.EliminationPlan`:
+    J₀(ω) (−1 where undecided), D(ω)'s lower triangle into ``values`` (slots,) and
+    |D|(ω) into ``magnitudes`` (2 · slots,: the lower triangle, then the upper one),
+    each entry the same number as there, summed in the same order.
+
+    beam_slots : (n_beams, k, k) int64, where entry (i, j) of a beam's map goes:
+    its slot in the lower triangle, slots + its slot in the upper one (|D| only),
+    or −1 (padding, or an entry that no term of the beam's local stiffness reaches). terms : (4, slots) the springs' stiffness and the bodies'
+    mass in the lower triangle, then the same in the upper one.
+    """
+    slots = values.size
+    squared = omega * omega
+    for s in range(slots):
+        values[s] = terms[0, s] - squared * terms[1, s]
+        magnitudes[s] = abs(terms[0, s]) + squared * abs(terms[1, s])
+        magnitudes[slots + s] = abs(terms[2, s]) + squared * abs(terms[3, s])
+    return _added_beams(omega, beams, maps, beam_slots, values, magnitudes)
+
+
+@njit(cache=True)
+def ordered_inertia(values, starts, rows, updates, targets, singular, most_growth, growth):
+    """Negative eigenvalues of a symmetric matrix by LDLᵀ without pivoting in the
+    order of an :class:`~linmstmm.ordered_ldlt.EliminationPlan` (its ``starts``,
+    ``rows``, ``updates``, ``targets``); −1 where a pivot is below ``singular`` or
+    an entry of diag(|L| |D| |L|ᵀ), which bounds every entry of it, is above
+    ``most_growth`` (the factorisation's rounding is not known to be small then).
+
+    values : (slots,) the matrix's lower triangle, overwritten; growth : (n,) scratch.
+    """
+    n = starts.size - 1
+    growth[:] = 0.0
+    negatives = 0
+    for k in range(n):
+        pivot = values[starts[k]]
+        growth[k] += abs(pivot)
+        if abs(pivot) < singular or growth[k] > most_growth:
+            return -1
+        if pivot < 0:
+            negatives += 1
+        t = updates[k]
+        for a in range(starts[k] + 1, starts[k + 1]):
+            multiplier = values[a] / pivot
+            growth[rows[a]] += abs(values[a] * multiplier)
+            for b in range(starts[k] + 1, a + 1):
+                values[targets[t]] -= multiplier * values[b]
+                t += 1
+    return negatives
+
+
+@njit(cache=True, nogil=True)
+def ordered_count(omega, beams, maps, singular_pivot, most_growth, plan, terms, buffers):
+    """:func:`count` by LDLᵀ without pivoting on the sparse D(ω) in a fill-reducing
+    order: the same answer wherever it gives one, and REFUSED where the dense
+    :func:`count` is to decide.
+
+    D(ω) and |D|(ω) are assembled on the slots of the plan only, equilibrated and
+    shifted by ± the rounding level as in :func:`count` (the same numbers), and
+    each shifted matrix factorised by :func:`ordered_inertia`. REFUSED where that
+    refuses (a small pivot, or growth above ``most_growth`` times the largest
+    equilibrated term), where the two counts differ, or where a term is not finite.
+
+    beams, maps : as for :func:`assembled`. singular_pivot : as for :func:`count`.
+    plan : (order, starts, rows, high, low, updates, targets, beam_slots) int64
+    arrays of :class:`~linmstmm.ordered_ldlt.EliminationPlan` (beam_slots as in
+    :func:`_assembled_slots`). terms : (4, slots) as there. buffers : float64
+    scratch (values (slots,), magnitudes (2 · slots,), shifted (slots,), growth (n,)).
+    """
+    order, starts, rows, high, low, updates, targets, beam_slots = plan
+    values, magnitudes, shifted, growth = buffers
+    clamped = _assembled_slots(omega, beams, maps, beam_slots, terms, values, magnitudes)
+    if clamped < 0:
+        return -1
+    for s in range(magnitudes.size):
+        if not math.isfinite(magnitudes[s]):  # so too where an entry of D(ω) is not
+            return REFUSED
+    n = order.size
+    if n == 0:
+        return clamped
+    weights = np.empty(n)
+    for k in range(n):
+        if not magnitudes[starts[k]] > 0:
+            return -1  # a DOF with neither stiffness nor mass
+        weights[order[k]] = 1.0 / math.sqrt(magnitudes[starts[k]])
+    slots, largest = values.size, 0.0
+    for s in range(slots):
+        values[s] = values[s] * weights[high[s]] * weights[low[s]]
+        largest = max(largest, magnitudes[s] * weights[high[s]] * weights[low[s]])
+        largest = max(largest, magnitudes[slots + s] * weights[low[s]] * weights[high[s]])
+    singular = singular_pivot * largest
+    negatives = -1
+    for sign in (1.0, -1.0):
+        for s in range(slots):
+            shifted[s] = values[s]
+        for k in range(n):
+            shifted[starts[k]] += sign * singular
+        found = ordered_inertia(shifted, starts, rows, updates, targets, singular, most_growth * largest, growth)
+        if found < 0 or (sign < 0 and found != negatives):
+            return REFUSED
+        negatives = found
     return clamped + negatives

@@ -22,6 +22,11 @@ rotated to the inertial frame, plus the springs' stiffness, minus ω² times the
 rigid bodies' mass. No mesh: the count is exact for the same Euler–Bernoulli
 model that det Ū_all describes, and independent of the transfer matrices.
 
+The compiled count factorises D(ω) on its sparsity pattern, the same at every
+ω, in a minimum-degree order (:mod:`linmstmm.ordered_ldlt`), and leaves to the
+dense factorisation the frequencies where its pivots are not safe
+(:func:`linmstmm._stiffness_kernels.ordered_count`).
+
 Where float64 cannot decide it (ω within rounding of a natural frequency or of
 an element's clamped one, a degree of freedom with neither stiffness nor mass)
 the count answers None, and callers count another way.
@@ -51,7 +56,9 @@ from linmstmm.spread import spread
 #: Largest order of D(ω) counted: its dense factorisation grows as n³ (72 unknowns:
 #: 75 µs, 120: 160 µs compiled), and a count is made twice per root; a longer model
 #: (a chain of 1,000 bodies: 3,000 unknowns, 12.8 s instead of 0.13 s) is counted by
-#: the argument principle, whose evaluations the periodic carry keeps cheap.
+#: the argument principle, whose evaluations the periodic carry keeps cheap. (The
+#: compiled count is sparse, but leaves the frequencies where its pivots are not
+#: safe to the dense factorisation.)
 MAX_ORDER = 150
 
 #: A pivot of the equilibrated D(ω) below this, relative to the largest term that
@@ -64,6 +71,15 @@ MAX_ORDER = 150
 #: counts 1e-9 to 1e-5 from them) 1e-11, 1e-12 and 1e-13 all gave no wrong count,
 #: leaving 2,333, 1,639 and 1,189 undecided.
 SINGULAR_PIVOT = 1e-12
+
+#: The compiled count's sparse LDLᵀ without pivoting leaves D(ω) to the dense
+#: Bunch–Kaufman factorisation where an entry of diag(|L| |D| |L|ᵀ) is above this
+#: times the largest equilibrated term. Below it the factorisation's rounding, of
+#: order (entries of a column of L, at most 10 on the launchers) · 1.1e-16 · growth,
+#: about 1e-13 at the bound, stays well below SINGULAR_PIVOT, and a count it
+#: decides is the inertia the dense factorisation finds. Without the bound a 4 × 4 matrix whose first pivot is
+#: 1.2e-11 counts 2 negative eigenvalues where there is 1 (tests/test_sparse_count.py).
+MOST_GROWTH = 1e2
 
 #: Frequencies whose D(ω) the numpy engine forms at once (:meth:`ModeCounter.prefetch`):
 #: one at a time, forming D(ω) took 176 of the 308 µs of a count on the launcher.
@@ -114,6 +130,8 @@ class ModeCounter:
         self._answers: dict[float, int | None] = {}
         self._table = None  # the beams as the compiled kernels take them, on their first call
         self._scratch = None  # this counter's own buffers for the compiled kernel, on its first call
+        # D(ω)'s sparse factorisation as the compiled kernel takes it, shared with the twins (0.2 ms)
+        self._plan = sparse_plan(self._static, self._mass, self._maps, self._columns) if self.engine == "compiled" else None
 
     def fresh(self) -> ModeCounter:
         """This counter with no answers remembered: the same model's matrices (not
@@ -191,11 +209,13 @@ class ModeCounter:
 
     def _new_scratch(self) -> tuple:
         """Buffers the compiled kernel writes into: D(ω) and |D|(ω) ((n_dof + 1)², a row
-        for padding) and dsytrf's workspace."""
+        for padding) and dsytrf's workspace for the dense count, and the sparse
+        count's own (:func:`linmstmm._stiffness_kernels.ordered_count`)."""
         from linmstmm import _stiffness_kernels as kernels
 
-        size = self.n_dof + 1
-        return np.empty((size, size)), np.empty((size, size)), np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN)
+        size, slots = self.n_dof + 1, self._plan[1].shape[1]
+        return (np.empty((size, size)), np.empty((size, size)), np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN),
+                (np.empty(slots), np.empty(2 * slots), np.empty(slots), np.empty(self.n_dof)))
 
     def _beam_table(self) -> np.ndarray:
         """The beams as the compiled kernel takes them (:func:`linmstmm._stiffness_kernels.beam_columns`),
@@ -207,12 +227,18 @@ class ModeCounter:
         return self._table
 
     def _kernel_count(self, omega: float, scratch: tuple) -> int:
-        """J(ω) by :func:`linmstmm._stiffness_kernels.count` in ``scratch``; −1 where undecided."""
+        """J(ω) by :func:`linmstmm._stiffness_kernels.ordered_count` in ``scratch``, or
+        by the dense :func:`~linmstmm._stiffness_kernels.count` where that one
+        refuses; −1 where undecided."""
         from linmstmm import _stiffness_kernels as kernels
 
-        matrix, magnitude, work = scratch
-        return kernels.count(omega, self._beam_table(), self._maps, self._columns, self._static, self._mass,
-                             SINGULAR_PIVOT, matrix, magnitude, work)
+        matrix, magnitude, work, buffers = scratch
+        found = kernels.ordered_count(omega, self._beam_table(), self._maps, SINGULAR_PIVOT, MOST_GROWTH, *self._plan,
+                                      buffers)
+        if found == kernels.REFUSED:
+            found = kernels.count(omega, self._beam_table(), self._maps, self._columns, self._static, self._mass,
+                                  SINGULAR_PIVOT, matrix, magnitude, work)
+        return found
 
     def matrices(self, omegas) -> tuple[np.ndarray, np.ndarray]:
         """(D(ω), |D|(ω)) at each of the m ``omegas`` (rad/s): the reduced exact dynamic
@@ -230,6 +256,50 @@ class ModeCounter:
         n, squared = self.n_dof, (omegas ** 2)[:, None, None]
         matrix = beams[:, :n, :n] + self._static - squared * self._mass
         return matrix, magnitude[:, :n, :n] + np.abs(self._static) + squared * np.abs(self._mass)
+
+
+def sparse_plan(static: np.ndarray, mass: np.ndarray, maps: np.ndarray, columns: np.ndarray) -> tuple[tuple, np.ndarray]:
+    """The sparse factorisation of D(ω) as :func:`linmstmm._stiffness_kernels.ordered_count`
+    takes it.
+
+    Parameters
+    ----------
+    static, mass : (n, n) float64
+        The springs' stiffness (N/m, N·m/rad) and the bodies' mass (kg, kg·m²), reduced.
+    maps, columns : (n_beams, 12, k) float64, (n_beams, k) int
+        Each beam's map from the reduced DOFs it touches to its local ones, and those
+        DOFs (n for padding), as :func:`_beam_maps`.
+
+    Returns
+    -------
+    plan : tuple of int64 arrays
+        (order, starts, rows, high, low, updates, targets) of the
+        :class:`~linmstmm.ordered_ldlt.EliminationPlan` of D(ω)'s pattern, and
+        (n_beams, k, k) beam_slots: where each entry of a beam's map goes (its slot
+        in the lower triangle, slots + its slot in the upper one, −1 for padding
+        and for entries that no term of the beam's local stiffness reaches).
+    terms : (4, slots) float64
+        ``static`` and ``mass`` at the slots in the lower triangle, then in the upper.
+    """
+    from linmstmm import _stiffness_kernels as kernels  # numba: imported where a count is compiled
+    from linmstmm.ordered_ldlt import elimination_plan
+
+    n = static.shape[0]
+    pattern = (static != 0) | (mass != 0)
+    i, j = np.broadcast_arrays(columns[:, :, None], columns[:, None, :])
+    # where a beam's map.T @ local @ map may be nonzero: any other entry is a sum of zeros
+    reach = np.abs(maps) > 0
+    present = (np.swapaxes(reach, 1, 2).astype(float) @ kernels.LOCAL_PATTERN @ reach > 0) & (i < n) & (j < n)
+    pattern[i[present], j[present]] = True
+    pattern |= pattern.T
+    plan = elimination_plan(pattern)
+    slots = plan.high.size
+    placed = np.where(present, plan.slot_of(np.minimum(i, n - 1), np.minimum(j, n - 1)), -1)
+    beam_slots = np.where(present & (i < j), placed + slots, placed)
+    terms = np.stack([static[plan.high, plan.low], mass[plan.high, plan.low],
+                      np.where(plan.high > plan.low, static[plan.low, plan.high], 0.0),
+                      np.where(plan.high > plan.low, mass[plan.low, plan.high], 0.0)])
+    return (plan.order, plan.starts, plan.rows, plan.high, plan.low, plan.updates, plan.targets, beam_slots), terms
 
 
 def _beam_maps(parts) -> tuple[np.ndarray, np.ndarray]:

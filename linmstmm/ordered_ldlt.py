@@ -18,7 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from linmstmm._stiffness_kernels import minimum_degree
 
 
 @dataclass(frozen=True)
@@ -66,58 +66,9 @@ class EliminationPlan:
         return lookup[np.maximum(i, j), np.minimum(i, j)]
 
 
-@njit(cache=True)
-def minimum_degree(pattern):
-    """Minimum-degree elimination: at each step the unknown joined to the fewest
-    others left (the lowest index among equals) is eliminated, and the others it
-    is joined to are joined to each other (the fill).
-
-    Parameters
-    ----------
-    pattern : (n, n) int64
-        1 where the symmetric matrix may be nonzero, else 0.
-
-    Returns
-    -------
-    order : (n,) int64
-        The unknowns in the order eliminated.
-    joined : (n, n) int64
-        Row k: 1 at the unknowns k was joined to when it was eliminated (the
-        pattern of its column of L below the diagonal).
-    """
-    n = pattern.shape[0]
-    live = pattern.copy()
-    joined = np.zeros((n, n), dtype=np.int64)
-    degree = np.zeros(n, dtype=np.int64)
-    for i in range(n):
-        live[i, i] = 0
-        for j in range(n):
-            degree[i] += live[i, j]
-    order = np.empty(n, dtype=np.int64)
-    for step in range(n):
-        k = 0
-        for i in range(n):
-            if degree[i] < degree[k]:
-                k = i
-        order[step] = k
-        degree[k] = n + 1  # eliminated: above any degree
-        for i in range(n):
-            joined[k, i] = live[k, i]
-        for i in range(n):
-            if joined[k, i]:
-                live[i, k] = 0
-                for j in range(n):
-                    if joined[k, j] and j != i:
-                        live[i, j] = 1
-                degree[i] = 0
-                for j in range(n):
-                    degree[i] += live[i, j]
-    return order, joined
-
-
 def elimination_plan(pattern: np.ndarray) -> EliminationPlan:
     """The :class:`EliminationPlan` of the symmetric boolean (n, n) ``pattern`` in
-    its :func:`minimum_degree` order.
+    its :func:`~linmstmm._stiffness_kernels.minimum_degree` order.
 
     Parameters
     ----------

@@ -31,7 +31,7 @@ from linmstmm.program import forget_layouts
 from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.roots.settings import FLOOR_RATIO
 from linmstmm.topology import build_topology
-from linmstmm.wittrick_williams import ModeCounter, mode_counter
+from linmstmm.wittrick_williams import ModeCounter, forget_plans, mode_counter
 
 #: Model objects whose compiled systems are kept (least recently used dropped first).
 MODELS_KEPT = 8
@@ -117,9 +117,10 @@ def _compiled_now(model: Model, root: str | None, cut_at: tuple, engine: str) ->
 
 
 def forget_compiled_models() -> None:
-    """Drop every compiled system, program walk (:func:`linmstmm.program.compile_program`)
-    and coarse FE pencil kept so far: the next solve of any model compiles it anew, as
-    in a new process (the benchmarks time first solves so)."""
+    """Drop every compiled system, program walk (:func:`linmstmm.program.compile_program`),
+    coarse FE pencil and count's elimination plan kept so far: the next solve of any
+    model compiles it anew, as in a new process (the benchmarks time first solves so)."""
     _compiled.cache_clear()
     coarse_pencil.cache_clear()
     forget_layouts()
+    forget_plans()

@@ -192,3 +192,27 @@ def test_sparse_count_is_the_dense_count_wherever_that_decides(source):
         elif sparse is not None:
             assert sparse == eigenvalue_count(counter, omega), omega
     assert same > 0
+
+
+@pytest.mark.parametrize("source", LAUNCHERS)
+def test_a_plan_kept_for_a_pattern_is_the_plan_made_anew(source):
+    """A parameter study's counters share the elimination plan of their pattern
+    (wittrick_williams._planned): the counter of an edited launcher (its first
+    body 30 % heavier, the same pattern) takes the plan and the terms a fresh
+    plan gives, array for array; a counter whose pattern differs gets a plan of its own."""
+    from linmstmm.parameters import parse_key, with_values
+    from linmstmm.wittrick_williams import _plans, forget_plans, sparse_plan
+
+    model = load_model(source)
+    first = ModeCounter(model, "compiled")
+    rigid = model.rigids[0].name
+    edited = with_values(model, {parse_key(model, f"rigid.{rigid}.mass"): model.rigids[0].mass * 1.3})
+    kept = ModeCounter(edited, "compiled")
+    assert len(_plans) >= 1 and kept._plan[0][0] is first._plan[0][0]  # the same plan object
+    forget_plans()
+    fresh = sparse_plan(kept._static, kept._mass, kept._maps, kept._columns)
+    for a, b in zip(kept._plan[0], fresh[0]):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(kept._plan[1], fresh[1])
+    other = ModeCounter(random_model(KINDS[0], 3), "compiled")
+    assert other._plan[0][0] is not kept._plan[0][0]

@@ -306,8 +306,8 @@ def with_numbers(model: Model, points: dict, records: dict, damping) -> Model:
     frames = []
     for attribute, (kind, _) in _RECORD_KINDS.items():
         for index, record in enumerate(edited[attribute]):
-            on_moved = kind != "rigid" and (resized or not moved.isdisjoint(record.ends))
-            if record.name in records or on_moved:
+            on_moved = kind != "rigid" and not moved.isdisjoint(record.ends)
+            if record.name in records or on_moved or (resized and _tolerance_matters(kind, record, points, tol)):
                 table = _element_table(file, kind, index, _plain(_record_table(record, file)))
                 fields = ELEMENT_CHECKS[kind](table, points, tol)
                 if kind == "beam":
@@ -324,6 +324,18 @@ def with_numbers(model: Model, points: dict, records: dict, damping) -> Model:
         object.__setattr__(new, name, value)
     _freeze(new)
     return new
+
+
+def _tolerance_matters(kind: str, record, points: dict, tol: float) -> bool:
+    """Whether an element whose record and points did not change must be checked again
+    under the length tolerance ``tol`` (m) of a model whose size changed: a beam
+    always (its length and frame are compared within it), a spring where its ends
+    are now ``tol`` apart (the one check of a spring that reads it, made as
+    :func:`~linmstmm.model_file._check_spring` makes it), a rigid body never."""
+    if kind == "spring":
+        a, b = record.ends
+        return not np.linalg.norm(points[b] - points[a]) <= tol
+    return kind == "beam"
 
 
 def _document(model, file):

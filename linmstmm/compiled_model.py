@@ -26,6 +26,7 @@ from linmstmm.counting import count_in_disc
 from linmstmm.deduction import Deduction
 from linmstmm.determinant import determinant, kernels_loaded, resolved_engine
 from linmstmm.model import Model
+from linmstmm.model_structure import forget_structures
 from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
 from linmstmm.program import forget_layouts
 from linmstmm.rigid_motion import rigid_body_mode_count
@@ -117,9 +118,11 @@ def _compiled_now(model: Model, root: str | None, cut_at: tuple, engine: str) ->
 
 
 def forget_compiled_models() -> None:
-    """Drop every compiled system, program walk (:func:`linmstmm.program.compile_program`)
-    and coarse FE pencil kept so far: the next solve of any model compiles it anew, as
+    """Drop every compiled system, program walk (:func:`linmstmm.program.compile_program`),
+    coarse FE pencil and whatever is kept by a model's structure
+    (:mod:`linmstmm.model_structure`) so far: the next solve of any model compiles it anew, as
     in a new process (the benchmarks time first solves so)."""
     _compiled.cache_clear()
     coarse_pencil.cache_clear()
     forget_layouts()
+    forget_structures()

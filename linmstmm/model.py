@@ -320,9 +320,12 @@ def with_numbers(model: Model, points: dict, records: dict, damping) -> Model:
     new = object.__new__(Model)  # checked above: the constructor would check it all again
     for name in model.__dataclass_fields__:
         object.__setattr__(new, name, getattr(model, name))
-    for name, value in dict(edited, points=points, damping=damping).items():
+    for name, value in dict(edited, damping=damping).items():
         object.__setattr__(new, name, value)
-    _freeze(new)
+    # the records and boundary not edited are the model's own, frozen already
+    object.__setattr__(new, "points", _frozen_table(points))
+    for record in records.values():
+        _freeze_record(record)
     return new
 
 
@@ -472,13 +475,22 @@ def _freeze(model) -> None:
     for name in ("rigids", "beams", "springs"):
         object.__setattr__(model, name, tuple(getattr(model, name)))
     for name in ("points", "boundary"):
-        table = getattr(model, name)
-        object.__setattr__(model, name, FrozenDict({key: _read_only(value) for key, value in table.items()}))
+        object.__setattr__(model, name, _frozen_table(getattr(model, name)))
     for record in model.elements:
-        for name in record.__dataclass_fields__:
-            value = getattr(record, name)
-            if isinstance(value, np.ndarray) and value.flags.writeable:
-                object.__setattr__(record, name, _frozen(value))
+        _freeze_record(record)
+
+
+def _frozen_table(table: dict) -> FrozenDict:
+    """``table`` (name -> array) as a :class:`FrozenDict` of read-only arrays."""
+    return FrozenDict({key: _read_only(value) for key, value in table.items()})
+
+
+def _freeze_record(record) -> None:
+    """Make every array of an element record read-only (a copy where it was writeable)."""
+    for name in record.__dataclass_fields__:
+        value = getattr(record, name)
+        if isinstance(value, np.ndarray) and value.flags.writeable:
+            object.__setattr__(record, name, _frozen(value))
 
 
 def _build(cls, fields):

@@ -108,11 +108,12 @@ def _compiled_now(model: Model, root: str | None, cut_at: tuple, engine: str) ->
     """The :class:`CompiledSystem` of ``model``, built."""
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
     evaluator = determinant(deduction, engine)  # compiled first: its plain Ū_all screens the probes
-    released = release_indeterminate(deduction, screen=evaluator.plain_matrix)
+    scales = characteristic_frequencies(deduction.topology)  # of the elements alone: a release keeps them
+    released = release_indeterminate(deduction, screen=evaluator.plain_matrix, scales=scales)
     if released:  # the program carries the unknowns it was compiled for
         evaluator = determinant(deduction, engine)
     rigid = rigid_body_mode_count(model)
-    scale = min(characteristic_frequencies(deduction.topology))
+    scale = min(scales)
     confirmed = bool(rigid) and count_in_disc(evaluator.log_det, FLOOR_RATIO * scale) == 2 * rigid
     return CompiledSystem(deduction, evaluator, released, rigid, confirmed, scale, mode_counter(model, engine))
 

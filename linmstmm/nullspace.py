@@ -39,9 +39,13 @@ def equilibration(matrix: np.ndarray, sweeps: int = 4, start=None):
     weighted = rows[..., :, None] * size  # the rows' part of the scaled |a|, formed once per change of rows
     scaled = np.empty_like(weighted)
     for _ in range(sweeps):
-        rows *= power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-1))
+        row_factors = power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-1))
+        rows *= row_factors
         weighted = rows[..., :, None] * size
-        cols *= power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-2))
+        column_factors = power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-2))
+        cols *= column_factors
+        if np.all(row_factors == 1.0) and np.all(column_factors == 1.0):
+            break  # a sweep that changed nothing: so would every one after it (Ū_all of a launcher's probe: the second)
     return rows, cols
 
 
@@ -180,7 +184,7 @@ SCREEN_MARGIN = 1e5
 
 
 def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINATE_TOLERANCE,
-                          screen=None) -> int:
+                          screen=None, scales=None) -> int:
     """Find and release statically indeterminate unknowns of ``deduction``.
 
     probe : rad/s, the generic frequencies to look at (default :data:`PROBES`
@@ -203,10 +207,12 @@ def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINAT
     tolerance, nothing is released without the numpy carry; anything else is
     decided on ``deduction.matrix`` as without it, so that the unknowns released
     (chosen among equal weights by rounding) are the same.
+    scales : the :func:`characteristic_frequencies` of ``deduction.topology`` (rad/s)
+    where the caller has them already; found here otherwise.
     """
     if probe is None and _statically_determinate(deduction.topology):
         return 0
-    scales = characteristic_frequencies(deduction.topology)
+    scales = characteristic_frequencies(deduction.topology) if scales is None else scales
     start = own_units_start(deduction, min(scales))   # the same for every probe: made once
     if probe is not None:
         return _released_at(deduction, np.asarray(probe, dtype=float), tolerance, screen, start)

@@ -165,3 +165,10 @@ def test_equilibration_is_the_plain_sweeps():
         start = (rng.uniform(1e-5, 1e5, shape[:-1]), rng.uniform(1e-5, 1e5, shape[:-2] + shape[-1:]))
         for ours, theirs in zip(equilibration(matrix, start=start), plain(matrix, 4, start)):
             assert np.array_equal(ours, theirs)
+    # balanced from the start (|a| within 0.75 and 1.4 of 1): the sweeps stop after the
+    # first changes nothing, with the scales of all four
+    for trial in range(100):
+        matrix = rng.uniform(0.75, 1.4, (5, 7)) * rng.choice([-1.0, 1.0], (5, 7))
+        start = (2.0 ** rng.integers(-3, 3, 5), 2.0 ** -rng.integers(-3, 3, 7)) if trial % 2 else (np.ones(5), np.ones(7))
+        for ours, theirs in zip(equilibration(matrix, start=start), plain(matrix, 4, start)):
+            assert np.array_equal(ours, theirs)

@@ -255,9 +255,32 @@ def _released_at(deduction, probe: np.ndarray, tolerance: float, screen, start) 
 def _clearly_regular(samples: np.ndarray, threshold: float, start) -> bool:
     """True where every one of ``samples`` (n, N, N) is finite and the first, balanced
     from ``start`` (:func:`equilibration`), has no singular value below ``threshold``
-    times its largest (:func:`nullity`)."""
-    return bool(np.all(np.isfinite(samples))) and nullity(
-        samples[0], threshold, equilibration(samples[0], start=start)) == 0
+    times its largest (:func:`nullity`; decided by :func:`_well_above` where that can)."""
+    if not np.all(np.isfinite(samples)):
+        return False
+    scales = equilibration(samples[0], start=start)
+    return _well_above(scales[0][:, None] * samples[0] * scales[1], threshold) or nullity(
+        samples[0], threshold, scales) == 0
+
+
+#: :func:`_well_above` answers True only where its bound clears the threshold this many
+#: times over: the computed inverse is off by at most κ n eps (κ ≤ 1 / threshold, under
+#: 1e-8 relative for the probes' 1e-6 and order 60), and the singular values an SVD
+#: computes by n eps of the largest, both far inside a factor 2.
+BOUND_MARGIN = 2.0
+
+
+def _well_above(matrix: np.ndarray, threshold: float) -> bool:
+    """True where the square ``matrix``'s smallest singular value is surely at least
+    ``threshold`` times its largest, by bounds of both from one inverse (a third of an
+    SVD's cost): σ_max ≤ √(‖A‖₁ ‖A‖∞) and 1 / σ_min = ‖A⁻¹‖₂ ≤ √(‖A⁻¹‖₁ ‖A⁻¹‖∞).
+    False says nothing (a matrix that is nearly singular, or whose bounds are loose)."""
+    try:
+        inverse = np.linalg.inv(matrix)
+    except np.linalg.LinAlgError:
+        return False
+    norms = [np.abs(m).sum(axis=axis).max() for m in (matrix, inverse) for axis in (0, 1)]
+    return bool(1.0 >= BOUND_MARGIN * threshold * np.sqrt(norms[0] * norms[1] * norms[2] * norms[3]))
 
 
 def _common_nullity(samples: np.ndarray, tolerance: float) -> int:

@@ -21,7 +21,7 @@ T entry for entry, or none is kept. On the launcher: 0.16 ms a scene against
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -51,6 +51,20 @@ class _Elimination:
     unit: int
     masters: np.ndarray
     shape: tuple
+    _springs: list = field(default_factory=lambda: [None, None])  # [records, (strains, stiffness)] made last
+
+    def springs(self, model: Model, layout) -> tuple:
+        """(strain triplets, stiffnesses) of ``model``'s springs on ``layout``, as
+        :func:`~linmstmm.fe.node_constraints.node_constraints` makes them; those of the
+        last model whose spring records were the same objects (a study's steps that edit
+        no spring share them) are taken as they are."""
+        records = model.springs
+        if self._springs[0] is None or len(records) != len(self._springs[0]) or any(
+                a is not b for a, b in zip(records, self._springs[0])):
+            strains, stiffness = _Triplets(), []
+            _add_springs(model, layout, strains, stiffness, _Triplets())  # no inf direction: no constraint row
+            self._springs[:] = records, (strains, stiffness)
+        return self._springs[1]
 
     def T(self, positions: np.ndarray):
         """(n_full, n_dof) scipy CSR elimination of a model whose nodes sit at ``positions``
@@ -92,11 +106,11 @@ def counter_parts(model: Model) -> ConstrainedParts:
     if fresh or elimination is None:
         return fresh[0] if fresh else constrained_parts(model, 1, kept_node_constraints(model))
     layout = _layout(model, 1)
-    strains, stiffness, mass = _Triplets(), [], _Triplets(repeats=True)
-    _add_springs(model, layout, strains, stiffness, _Triplets())  # no inf direction: no constraint row
+    mass = _Triplets(repeats=True)
     _add_rigid_masses(model, layout, mass)
     return ConstrainedParts(layout, elimination.T(layout.positions), elimination.masters, elimination.shape[0],
-                            strains, stiffness, mass, element_maps(layout.beam_table, _beam_axes(model.beams)))
+                            *elimination.springs(model, layout), mass,
+                            element_maps(layout.beam_table, _beam_axes(model.beams)))
 
 
 def _kept_elimination(model: Model, parts: ConstrainedParts) -> _Elimination | None:

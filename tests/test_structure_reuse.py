@@ -31,8 +31,10 @@ def _edits(model, count: int = 6, seed: int = 7):
 
 def _kept_and_fresh(model, edited, build):
     """(``build(edited)`` after ``model`` left its structure's parts behind, the same built
-    with nothing kept), and whether the first took kept parts."""
+    with nothing kept), and whether the first took kept parts. ``model`` is built twice:
+    the second build takes the kept parts too, and leaves behind what they keep of it."""
     forget_compiled_models()
+    build(model)
     build(model)
     reused = model_structure.structure_of(edited) == model_structure.structure_of(model)
     kept = build(edited)

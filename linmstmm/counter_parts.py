@@ -40,8 +40,8 @@ class _Elimination:
     ports, centres : (p,) node of each rigid body's port and of its mass centre, bodies
     and ports in model order. rows, cols : (u + 36 p,) the positions of T's possible
     entries: first the u DOFs kept as they are (value 1), then each port's six DOFs
-    against its body's six centre DOFs (the lever-arm block). masters : (n_dof,) full
-    DOFs kept. shape : (n_full, n_dof).
+    against its body's six centre DOFs (the lever-arm block). unit : u. masters :
+    (n_dof,) full DOFs kept. shape : (n_full, n_dof).
     """
 
     ports: np.ndarray

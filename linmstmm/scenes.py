@@ -265,7 +265,20 @@ class SceneMaker:
         self._bodies = [rigid for rigid in model.rigids if rigid.name in bundle.tube]
 
     def cradle(self, tube: int, fired: frozenset) -> MassProps:
-        """The cradle of scene ``tube`` with the rockets of the slots ``fired`` gone (kg, m, kg m²)."""
+        """The cradle of scene ``tube``: frame + every other tube, rocket-less where fired.
+
+        Parameters
+        ----------
+        tube : int
+            The firing tube's slot (left out of the sum).
+        fired : frozenset of int
+            Slots whose rockets are gone.
+
+        Returns
+        -------
+        MassProps
+            kg, m, kg m²: the sum slot by slot from the frame (:func:`cradle_props`).
+        """
         added, total = (), self._sums[()]
         for slot in self.bundle.slots:
             if slot != tube:
@@ -276,7 +289,25 @@ class SceneMaker:
         return total
 
     def values(self, tube: int, rockets_fired=frozenset()) -> dict[str, float]:
-        """:func:`scene_values` of scene ``tube``."""
+        """The scene where tube ``tube`` fires, as edits of the model.
+
+        Parameters
+        ----------
+        tube : int
+            The firing tube's slot, 1 … rows · columns.
+        rockets_fired : iterable of int
+            Slots whose rockets are gone (not ``tube`` itself).
+
+        Returns
+        -------
+        dict of str to float
+            As :func:`scene_values` gives them.
+
+        Raises
+        ------
+        ValueError
+            For a slot that is not in the bundle, or a firing tube listed as fired.
+        """
         bundle, fired = self.bundle, frozenset(rockets_fired)
         if tube in fired:
             raise ValueError(f"tube {tube} fires in this scene, so its rocket cannot be already fired")

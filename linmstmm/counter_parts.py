@@ -28,7 +28,7 @@ import numpy as np
 from linmstmm.fe.assembly import ConstrainedParts, constrained_parts
 from linmstmm.fe.layout import _beam_axes, _layout, _Triplets, element_maps
 from linmstmm.fe.node_constraints import _add_rigid_masses, _add_springs, _port_kinematics, kept_node_constraints
-from linmstmm.fe.sparse import compressed_of_distinct, scipy_csr
+from linmstmm.fe.sparse import _sorted_rows, scipy_csr
 from linmstmm.model import Model
 from linmstmm.model_structure import KeptByStructure
 
@@ -38,15 +38,17 @@ class _Elimination:
     """Where each entry of T comes from, for every model of one structure.
 
     ports, centres : (p,) node of each rigid body's port and of its mass centre, bodies
-    and ports in model order. rows, cols : (u + 36 p,) the positions of T's possible
-    entries: first the u DOFs kept as they are (value 1), then each port's six DOFs
-    against its body's six centre DOFs (the lever-arm block). unit : u. masters :
-    (n_dof,) full DOFs kept. shape : (n_full, n_dof).
+    and ports in model order. T's possible entries are first the u DOFs kept as they
+    are (value 1), then each port's six DOFs against its body's six centre DOFs (the
+    lever-arm block); order : (u + 36 p,) them by ascending position, position and
+    cols : (u + 36 p,) row × n_dof + column and column of each, in that order.
+    unit : u. masters : (n_dof,) full DOFs kept. shape : (n_full, n_dof).
     """
 
     ports: np.ndarray
     centres: np.ndarray
-    rows: np.ndarray
+    order: np.ndarray
+    position: np.ndarray
     cols: np.ndarray
     unit: int
     masters: np.ndarray
@@ -70,9 +72,9 @@ class _Elimination:
         """(n_full, n_dof) scipy CSR elimination of a model whose nodes sit at ``positions``
         ((n_nodes, 3) m): the entries scipy's product T0 T1 stores (exact zeros left out)."""
         values = np.concatenate([np.ones(self.unit),
-                                 _port_kinematics(positions[self.ports], positions[self.centres]).ravel()])
+                                 _port_kinematics(positions[self.ports], positions[self.centres]).ravel()])[self.order]
         stored = values != 0
-        return scipy_csr(compressed_of_distinct(self.rows[stored], self.cols[stored], values[stored], self.shape))
+        return scipy_csr(_sorted_rows(self.position[stored], self.cols[stored], values[stored], self.shape))
 
 
 #: The kept elimination of each structure seen last (None: one of another kind).
@@ -135,9 +137,14 @@ def _kept_elimination(model: Model, parts: ConstrainedParts) -> _Elimination | N
     centre_dofs = np.tile(6 * centres[:, None] + np.arange(6), 6)                         # (p, 36): columns c
     if np.any(column[centre_dofs] < 0):  # a mass centre's DOF eliminated: not the kind kept
         return None
-    elimination = _Elimination(ports, centres, np.concatenate([unit, port_dofs.ravel()]),
-                               np.concatenate([column[unit], column[centre_dofs].ravel()]), unit.size,
-                               parts.masters, (n_full, n_dof))
+    rows = np.concatenate([unit, port_dofs.ravel()])
+    cols = np.concatenate([column[unit], column[centre_dofs].ravel()])
+    position = rows * n_dof + cols
+    order = np.argsort(position)
+    if np.any(np.diff(position[order]) == 0):  # two entries in one place: not the kind kept
+        return None
+    elimination = _Elimination(ports, centres, order, position[order], cols[order], unit.size, parts.masters,
+                               (n_full, n_dof))
     kept, full = elimination.T(parts.layout.positions), parts.T.sorted_indices()
     same = all(np.array_equal(getattr(kept, name), getattr(full, name)) for name in ("indptr", "indices", "data"))
     return elimination if same else None

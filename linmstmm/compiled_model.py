@@ -26,6 +26,7 @@ from linmstmm.counting import count_in_disc
 from linmstmm.deduction import Deduction
 from linmstmm.determinant import determinant, kernels_loaded, resolved_engine
 from linmstmm.model import Model
+from linmstmm.model_structure import forget_structures
 from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
 from linmstmm.program import forget_layouts
 from linmstmm.rigid_motion import rigid_body_mode_count
@@ -107,20 +108,23 @@ def _compiled_now(model: Model, root: str | None, cut_at: tuple, engine: str) ->
     """The :class:`CompiledSystem` of ``model``, built."""
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
     evaluator = determinant(deduction, engine)  # compiled first: its plain Ū_all screens the probes
-    released = release_indeterminate(deduction, screen=evaluator.plain_matrix)
+    scales = characteristic_frequencies(deduction.topology)  # of the elements alone: a release keeps them
+    released = release_indeterminate(deduction, screen=evaluator.plain_matrix, scales=scales)
     if released:  # the program carries the unknowns it was compiled for
         evaluator = determinant(deduction, engine)
     rigid = rigid_body_mode_count(model)
-    scale = min(characteristic_frequencies(deduction.topology))
+    scale = min(scales)
     confirmed = bool(rigid) and count_in_disc(evaluator.log_det, FLOOR_RATIO * scale) == 2 * rigid
     return CompiledSystem(deduction, evaluator, released, rigid, confirmed, scale, mode_counter(model, engine))
 
 
 def forget_compiled_models() -> None:
     """Drop every compiled system, program walk (:func:`linmstmm.program.compile_program`),
-    coarse FE pencil and count's elimination plan kept so far: the next solve of any
-    model compiles it anew, as in a new process (the benchmarks time first solves so)."""
+    coarse FE pencil, count's elimination plan and whatever is kept by a model's
+    structure (:mod:`linmstmm.model_structure`) so far: the next solve of any model
+    compiles it anew, as in a new process (the benchmarks time first solves so)."""
     _compiled.cache_clear()
     coarse_pencil.cache_clear()
     forget_layouts()
     forget_plans()
+    forget_structures()

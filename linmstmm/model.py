@@ -306,8 +306,8 @@ def with_numbers(model: Model, points: dict, records: dict, damping) -> Model:
     frames = []
     for attribute, (kind, _) in _RECORD_KINDS.items():
         for index, record in enumerate(edited[attribute]):
-            on_moved = kind != "rigid" and (resized or not moved.isdisjoint(record.ends))
-            if record.name in records or on_moved:
+            on_moved = kind != "rigid" and not moved.isdisjoint(record.ends)
+            if record.name in records or on_moved or (resized and _tolerance_matters(kind, record, points, tol)):
                 table = _element_table(file, kind, index, _plain(_record_table(record, file)))
                 fields = ELEMENT_CHECKS[kind](table, points, tol)
                 if kind == "beam":
@@ -320,10 +320,25 @@ def with_numbers(model: Model, points: dict, records: dict, damping) -> Model:
     new = object.__new__(Model)  # checked above: the constructor would check it all again
     for name in model.__dataclass_fields__:
         object.__setattr__(new, name, getattr(model, name))
-    for name, value in dict(edited, points=points, damping=damping).items():
+    for name, value in dict(edited, damping=damping).items():
         object.__setattr__(new, name, value)
-    _freeze(new)
+    # the records and boundary not edited are the model's own, frozen already
+    object.__setattr__(new, "points", _frozen_table(points))
+    for record in records.values():
+        _freeze_record(record)
     return new
+
+
+def _tolerance_matters(kind: str, record, points: dict, tol: float) -> bool:
+    """Whether an element whose record and points did not change must be checked again
+    under the length tolerance ``tol`` (m) of a model whose size changed: a beam
+    always (its length and frame are compared within it), a spring where its ends
+    are now ``tol`` apart (the one check of a spring that reads it, made as
+    :func:`~linmstmm.model_file._check_spring` makes it), a rigid body never."""
+    if kind == "spring":
+        a, b = record.ends
+        return not np.linalg.norm(points[b] - points[a]) <= tol
+    return kind == "beam"
 
 
 def _document(model, file):
@@ -460,13 +475,22 @@ def _freeze(model) -> None:
     for name in ("rigids", "beams", "springs"):
         object.__setattr__(model, name, tuple(getattr(model, name)))
     for name in ("points", "boundary"):
-        table = getattr(model, name)
-        object.__setattr__(model, name, FrozenDict({key: _read_only(value) for key, value in table.items()}))
+        object.__setattr__(model, name, _frozen_table(getattr(model, name)))
     for record in model.elements:
-        for name in record.__dataclass_fields__:
-            value = getattr(record, name)
-            if isinstance(value, np.ndarray) and value.flags.writeable:
-                object.__setattr__(record, name, _frozen(value))
+        _freeze_record(record)
+
+
+def _frozen_table(table: dict) -> FrozenDict:
+    """``table`` (name -> array) as a :class:`FrozenDict` of read-only arrays."""
+    return FrozenDict({key: _read_only(value) for key, value in table.items()})
+
+
+def _freeze_record(record) -> None:
+    """Make every array of an element record read-only (a copy where it was writeable)."""
+    for name in record.__dataclass_fields__:
+        value = getattr(record, name)
+        if isinstance(value, np.ndarray) and value.flags.writeable:
+            object.__setattr__(record, name, _frozen(value))
 
 
 def _build(cls, fields):

@@ -39,9 +39,13 @@ def equilibration(matrix: np.ndarray, sweeps: int = 4, start=None):
     weighted = rows[..., :, None] * size  # the rows' part of the scaled |a|, formed once per change of rows
     scaled = np.empty_like(weighted)
     for _ in range(sweeps):
-        rows *= power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-1))
+        row_factors = power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-1))
+        rows *= row_factors
         weighted = rows[..., :, None] * size
-        cols *= power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-2))
+        column_factors = power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-2))
+        cols *= column_factors
+        if np.all(row_factors == 1.0) and np.all(column_factors == 1.0):
+            break  # a sweep that changed nothing: so would every one after it (Ū_all of a launcher's probe: the second)
     return rows, cols
 
 
@@ -180,7 +184,7 @@ SCREEN_MARGIN = 1e5
 
 
 def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINATE_TOLERANCE,
-                          screen=None) -> int:
+                          screen=None, scales=None) -> int:
     """Find and release statically indeterminate unknowns of ``deduction``.
 
     probe : rad/s, the generic frequencies to look at (default :data:`PROBES`
@@ -203,10 +207,12 @@ def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINAT
     tolerance, nothing is released without the numpy carry; anything else is
     decided on ``deduction.matrix`` as without it, so that the unknowns released
     (chosen among equal weights by rounding) are the same.
+    scales : the :func:`characteristic_frequencies` of ``deduction.topology`` (rad/s)
+    where the caller has them already; found here otherwise.
     """
     if probe is None and _statically_determinate(deduction.topology):
         return 0
-    scales = characteristic_frequencies(deduction.topology)
+    scales = characteristic_frequencies(deduction.topology) if scales is None else scales
     start = own_units_start(deduction, min(scales))   # the same for every probe: made once
     if probe is not None:
         return _released_at(deduction, np.asarray(probe, dtype=float), tolerance, screen, start)
@@ -249,9 +255,32 @@ def _released_at(deduction, probe: np.ndarray, tolerance: float, screen, start) 
 def _clearly_regular(samples: np.ndarray, threshold: float, start) -> bool:
     """True where every one of ``samples`` (n, N, N) is finite and the first, balanced
     from ``start`` (:func:`equilibration`), has no singular value below ``threshold``
-    times its largest (:func:`nullity`)."""
-    return bool(np.all(np.isfinite(samples))) and nullity(
-        samples[0], threshold, equilibration(samples[0], start=start)) == 0
+    times its largest (:func:`nullity`; decided by :func:`_well_above` where that can)."""
+    if not np.all(np.isfinite(samples)):
+        return False
+    scales = equilibration(samples[0], start=start)
+    return _well_above(scales[0][:, None] * samples[0] * scales[1], threshold) or nullity(
+        samples[0], threshold, scales) == 0
+
+
+#: :func:`_well_above` answers True only where its bound clears the threshold this many
+#: times over: the computed inverse is off by at most κ n eps (κ ≤ 1 / threshold, under
+#: 1e-8 relative for the probes' 1e-6 and order 60), and the singular values an SVD
+#: computes by n eps of the largest, both far inside a factor 2.
+BOUND_MARGIN = 2.0
+
+
+def _well_above(matrix: np.ndarray, threshold: float) -> bool:
+    """True where the square ``matrix``'s smallest singular value is surely at least
+    ``threshold`` times its largest, by bounds of both from one inverse (a third of an
+    SVD's cost): σ_max ≤ √(‖A‖₁ ‖A‖∞) and 1 / σ_min = ‖A⁻¹‖₂ ≤ √(‖A⁻¹‖₁ ‖A⁻¹‖∞).
+    False says nothing (a matrix that is nearly singular, or whose bounds are loose)."""
+    try:
+        inverse = np.linalg.inv(matrix)
+    except np.linalg.LinAlgError:
+        return False
+    norms = [np.abs(m).sum(axis=axis).max() for m in (matrix, inverse) for axis in (0, 1)]
+    return bool(1.0 >= BOUND_MARGIN * threshold * np.sqrt(norms[0] * norms[1] * norms[2] * norms[3]))
 
 
 def _common_nullity(samples: np.ndarray, tolerance: float) -> int:

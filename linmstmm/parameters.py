@@ -215,17 +215,24 @@ def _edited_numbers(model: Model, edits: dict[Key, float]) -> tuple[dict, dict, 
     original = {record.name: record for record in model.elements}
     records = dict(original)
     damping = model.damping
+    arrays, fields = {}, {}  # (point) or (element, field) -> [(index, value)]; element -> {field: value}
     for key, value in edits.items():
         value = float(value)
         if key.section == "points":
-            points[key.name] = _replaced(points[key.name], key.index, value)
+            arrays.setdefault((key.name,), []).append((key.index, value))
         elif key.section == "damping":
             damping = tuple(value if f == key.field else v for f, v in zip(("alpha", "beta"), damping))
+        elif key.index:
+            arrays.setdefault((key.name, key.field), []).append((_symmetric(key), value))
         else:
-            record = records[key.name]
-            old = getattr(record, key.field)
-            new = _replaced(old, _symmetric(key), value) if key.index else value
-            records[key.name] = dataclasses.replace(record, **{key.field: new})
+            fields.setdefault(key.name, {})[key.field] = value
+    for place, changes in arrays.items():  # each array copied once, its edits in their order
+        if len(place) == 1:
+            points[place[0]] = _replaced(points[place[0]], changes)
+        else:
+            fields.setdefault(place[0], {})[place[1]] = _replaced(getattr(records[place[0]], place[1]), changes)
+    for name, changed in fields.items():  # each record replaced once
+        records[name] = dataclasses.replace(records[name], **changed)
     moved = {name for name in points if points[name] is not model.points[name]}
     for record in model.beams:
         if moved & set(record.ends):
@@ -271,10 +278,12 @@ def _symmetric(key: Key):
     return key.index
 
 
-def _replaced(array, index, value) -> np.ndarray:
-    """A read-only float copy of ``array`` with ``array[index] = value``."""
+def _replaced(array, changes) -> np.ndarray:
+    """A read-only float copy of ``array`` with ``array[index] = value`` for each
+    (index, value) of ``changes``, in their order."""
     array = np.array(array, dtype=float)
-    array[index] = value
+    for index, value in changes:
+        array[index] = value
     array.flags.writeable = False
     return array
 

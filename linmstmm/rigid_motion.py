@@ -28,6 +28,7 @@ import numpy as np
 import scipy.linalg as la
 
 from linmstmm.model import Model
+from linmstmm.model_structure import KeptByStructure
 
 #: A boundary row of the geometry matrix is independent of the others above
 #: this fraction of the largest singular value (entries are direction cosines
@@ -165,12 +166,8 @@ def _motions(model: Model) -> np.ndarray:
     """(points, 6, r): :func:`rigid_body_motions` of every point, in ``model.points`` order."""
     columns = []
     names = list(model.points)
-    parts, segments = _point_labels(model)
-    fixed = np.array([name in model.boundary and bool(np.all(model.boundary[name])) for name in names],
-                     dtype=bool)  # points held in all six directions
-    for members in _members(parts):
-        if fixed[members].any() and np.all(segments[members] == segments[members[0]]):
-            continue  # one segment held in all six directions: no motion (most grounded models)
+    segments, free = _free_parts.get(model, _parts_that_may_move)
+    for members in free:
         part = [names[i] for i in members]
         segment_of = dict(zip(part, segments[members].tolist()))
         motion = _part_motions(model, part, segment_of)
@@ -178,6 +175,22 @@ def _motions(model: Model) -> np.ndarray:
             columns.append(np.zeros((len(names), 6, motion.shape[2])))
             columns[-1][members] = motion
     return np.concatenate(columns, axis=2) if columns else np.zeros((len(names), 6, 0))
+
+
+def _parts_that_may_move(model: Model) -> tuple[np.ndarray, list[np.ndarray]]:
+    """((points,) segment of every point (:func:`_point_labels`), the points of each
+    connected part that is not one segment held in all six directions, which has no
+    motion (most grounded models)): the model's structure alone decides them."""
+    parts, segments = _point_labels(model)
+    segments.setflags(write=False)  # kept for every model of the structure
+    fixed = np.array([name in model.boundary and bool(np.all(model.boundary[name])) for name in model.points],
+                     dtype=bool)  # points held in all six directions
+    return segments, [members for members in _members(parts)
+                      if not (fixed[members].any() and np.all(segments[members] == segments[members[0]]))]
+
+
+#: :func:`_parts_that_may_move` of the last structures seen (a parameter study's models share one).
+_free_parts = KeptByStructure(8)
 
 
 def _part_motions(model: Model, part: list, segment_of: dict) -> np.ndarray | None:

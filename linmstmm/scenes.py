@@ -44,8 +44,7 @@ class MassProps:
 
     def origin_tensor(self) -> np.ndarray:
         """Inertia tensor about the inertial origin (parallel-axis theorem)."""
-        c = self.com
-        return self.inertia + self.mass * (c @ c * np.eye(3) - np.outer(c, c))
+        return self.inertia + self.mass * _arm_tensor(self.com)
 
     def __add__(self, other: MassProps) -> MassProps:
         return _from_origin(self.mass + other.mass, self.mass * self.com + other.mass * other.com,
@@ -67,8 +66,17 @@ class MassProps:
 def _from_origin(mass, first_moment, origin_tensor) -> MassProps:
     """MassProps from the mass, the first moment Σ m c and the inertia tensor about the origin."""
     com = first_moment / mass
-    inertia = origin_tensor - mass * (com @ com * np.eye(3) - np.outer(com, com))
+    inertia = origin_tensor - mass * _arm_tensor(com)
     return MassProps(mass, com, (inertia + inertia.T) / 2)
+
+
+_IDENTITY = np.eye(3)
+
+
+def _arm_tensor(c: np.ndarray) -> np.ndarray:
+    """(3, 3) |c|² I − c cᵀ of a (3,) offset c (m²): the parallel-axis term per unit mass
+    (the same numbers as ``c @ c * np.eye(3) - np.outer(c, c)``, without their call costs)."""
+    return c @ c * _IDENTITY - c[:, None] * c
 
 
 def rigid_props(rigid) -> MassProps:
@@ -189,14 +197,7 @@ def loaded_tube(model: Model, bundle: Bundle) -> tuple[MassProps, MassProps]:
 def cradle_props(model: Model, bundle: Bundle, tube: int,
                  rockets_fired=frozenset()) -> MassProps:
     """The cradle of scene ``tube``: frame + every other tube, rocket-less where fired."""
-    axes = tube_axes(model, bundle)
-    loaded, rocket = loaded_tube(model, bundle)
-    total = bundle.frame(axes)
-    for slot in bundle.slots:
-        if slot != tube:
-            lumped = loaded - rocket if slot in rockets_fired else loaded
-            total = total + lumped.shifted(bundle.offset(slot, axes))
-    return total
+    return SceneMaker(model, bundle).cradle(tube, frozenset(rockets_fired))
 
 
 def scene_values(model: Model, tube: int, rockets_fired=frozenset(),
@@ -228,28 +229,103 @@ def scene_values(model: Model, tube: int, rockets_fired=frozenset(),
     ValueError
         For a slot that is not in the bundle, or a firing tube listed as fired.
     """
-    bundle = bundle or bundle_beside(model)
-    fired = frozenset(rockets_fired)
-    if tube in fired:
-        raise ValueError(f"tube {tube} fires in this scene, so its rocket cannot be already fired")
-    unknown = sorted(fired - set(bundle.slots))
-    if unknown:
-        raise ValueError(f"rockets_fired: {unknown} are not slots of the bundle (1 … {len(bundle.slots)})")
-    offset = bundle.offset(tube, tube_axes(model, bundle))
-    moving = set()
-    for element in map(model.element, bundle.tube):
-        moving.update(element.ports if element.kind == "rigid" else element.ends)
-    values = {}
-    for name in (p for p in model.points if p in moving):
-        values.update(_vector(f"points.{name}", model.points[name] + offset))
-    cradle = cradle_props(model, bundle, tube, fired)
-    values[f"rigid.{bundle.cradle}.mass"] = float(cradle.mass)
-    values.update(_vector(f"rigid.{bundle.cradle}.com", cradle.com))
-    values.update({f"rigid.{bundle.cradle}.inertia[{i}][{j}]": float(cradle.inertia[i, j])
-                   for i in range(3) for j in range(i, 3)})
-    for rigid in (r for r in model.rigids if r.name in bundle.tube):
-        values.update(_vector(f"rigid.{rigid.name}.com", rigid.com + offset))
-    return values
+    return SceneMaker(model, bundle or bundle_beside(model)).values(tube, rockets_fired)
+
+
+class SceneMaker:
+    """The scenes of one launcher model and bundle: what every scene shares (the tube
+    frame, the loaded and the emptied tube lumped in each slot, the keys) made
+    once, and the cradle's running sums over the slots kept, so that scenes whose
+    slots agree up to some slot add those up once (scene l and scene l + 1 share
+    the sum over slots 1 … l − 1). Every number is formed by the same operations
+    in the same order as for one scene alone: the same bits.
+
+    Parameters
+    ----------
+    model : Model
+        The launcher model (its flexible tube in the bundle's base slot).
+    bundle : Bundle
+        Its tube bundle.
+    """
+
+    def __init__(self, model: Model, bundle: Bundle):
+        self.model, self.bundle = model, bundle
+        self.axes = tube_axes(model, bundle)
+        loaded, rocket = loaded_tube(model, bundle)
+        emptied = loaded - rocket
+        offsets = {slot: bundle.offset(slot, self.axes) for slot in bundle.slots}
+        #: (slot, fired) -> that tube lumped in its slot
+        self._lumped = {(slot, fired): (emptied if fired else loaded).shifted(offsets[slot])
+                        for slot in bundle.slots for fired in (False, True)}
+        self._sums = {(): bundle.frame(self.axes)}  # slots added so far -> frame + those tubes
+        moving = set()
+        for element in map(model.element, bundle.tube):
+            moving.update(element.ports if element.kind == "rigid" else element.ends)
+        self._points = [name for name in model.points if name in moving]
+        self._bodies = [rigid for rigid in model.rigids if rigid.name in bundle.tube]
+
+    def cradle(self, tube: int, fired: frozenset) -> MassProps:
+        """The cradle of scene ``tube``: frame + every other tube, rocket-less where fired.
+
+        Parameters
+        ----------
+        tube : int
+            The firing tube's slot (left out of the sum).
+        fired : frozenset of int
+            Slots whose rockets are gone.
+
+        Returns
+        -------
+        MassProps
+            kg, m, kg m²: the sum slot by slot from the frame (:func:`cradle_props`).
+        """
+        added, total = (), self._sums[()]
+        for slot in self.bundle.slots:
+            if slot != tube:
+                added += ((slot, slot in fired),)
+                if added not in self._sums:
+                    self._sums[added] = total + self._lumped[added[-1]]
+                total = self._sums[added]
+        return total
+
+    def values(self, tube: int, rockets_fired=frozenset()) -> dict[str, float]:
+        """The scene where tube ``tube`` fires, as edits of the model.
+
+        Parameters
+        ----------
+        tube : int
+            The firing tube's slot, 1 … rows · columns.
+        rockets_fired : iterable of int
+            Slots whose rockets are gone (not ``tube`` itself).
+
+        Returns
+        -------
+        dict of str to float
+            As :func:`scene_values` gives them.
+
+        Raises
+        ------
+        ValueError
+            For a slot that is not in the bundle, or a firing tube listed as fired.
+        """
+        bundle, fired = self.bundle, frozenset(rockets_fired)
+        if tube in fired:
+            raise ValueError(f"tube {tube} fires in this scene, so its rocket cannot be already fired")
+        unknown = sorted(fired - set(bundle.slots))
+        if unknown:
+            raise ValueError(f"rockets_fired: {unknown} are not slots of the bundle (1 … {len(bundle.slots)})")
+        offset = bundle.offset(tube, self.axes)
+        values = {}
+        for name in self._points:
+            values.update(_vector(f"points.{name}", self.model.points[name] + offset))
+        cradle = self.cradle(tube, fired)
+        values[f"rigid.{bundle.cradle}.mass"] = float(cradle.mass)
+        values.update(_vector(f"rigid.{bundle.cradle}.com", cradle.com))
+        values.update({f"rigid.{bundle.cradle}.inertia[{i}][{j}]": float(cradle.inertia[i, j])
+                       for i in range(3) for j in range(i, 3)})
+        for rigid in self._bodies:
+            values.update(_vector(f"rigid.{rigid.name}.com", rigid.com + offset))
+        return values
 
 
 def scene_model(base, tube: int, rockets_fired=frozenset(), bundle: Bundle | None = None) -> Model:
@@ -323,7 +399,8 @@ def scene_study(base, count: int = 6, tubes=range(1, 19), fired=None, bundle: Bu
     """
     model = base if isinstance(base, Model) else load_model(base)
     bundle = bundle or bundle_beside(model)
-    steps = [scene_values(model, tube, fired(tube) if fired else frozenset(), bundle) for tube in tubes]
+    scenes = SceneMaker(model, bundle)
+    steps = [scenes.values(tube, fired(tube) if fired else frozenset()) for tube in tubes]
     return sweep(model, steps, count=count, warm_start=warm_start, engine=engine, **options)
 
 

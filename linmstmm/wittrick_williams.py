@@ -38,10 +38,9 @@ import copy
 import numpy as np
 import scipy.linalg.lapack as lapack
 
+from linmstmm.counter_parts import counter_parts
 from linmstmm.determinant import resolved_engine
 from linmstmm.dynamic_stiffness import BeamTable, clamped_counts_at, dynamic_stiffnesses
-from linmstmm.fe.assembly import constrained_parts
-from linmstmm.fe.node_constraints import kept_node_constraints
 from linmstmm.fe.products import (
     congruence,
     dense_product,
@@ -117,7 +116,7 @@ class ModeCounter:
 
     def __init__(self, model: Model, engine: str = "auto"):
         self.engine = resolved_engine(engine)
-        parts = constrained_parts(model, 1, kept_node_constraints(model))  # shared with the coarse predictions
+        parts = counter_parts(model)  # its elimination kept by the model's structure where it can be
         T, n = parts.T, parts.T.shape[1]
         # dense, each entry summed as scipy.sparse sums it (linmstmm.fe.products)
         springs = compressed_rows(dense_product(parts.spring_strains.compressed(parts.n_full), T))

@@ -165,3 +165,33 @@ def test_equilibration_is_the_plain_sweeps():
         start = (rng.uniform(1e-5, 1e5, shape[:-1]), rng.uniform(1e-5, 1e5, shape[:-2] + shape[-1:]))
         for ours, theirs in zip(equilibration(matrix, start=start), plain(matrix, 4, start)):
             assert np.array_equal(ours, theirs)
+    # balanced from the start (|a| within 0.75 and 1.4 of 1): the sweeps stop after the
+    # first changes nothing, with the scales of all four
+    for trial in range(100):
+        matrix = rng.uniform(0.75, 1.4, (5, 7)) * rng.choice([-1.0, 1.0], (5, 7))
+        start = (2.0 ** rng.integers(-3, 3, 5), 2.0 ** -rng.integers(-3, 3, 7)) if trial % 2 else (np.ones(5), np.ones(7))
+        for ours, theirs in zip(equilibration(matrix, start=start), plain(matrix, 4, start)):
+            assert np.array_equal(ours, theirs)
+
+
+def test_the_bound_from_an_inverse_never_clears_what_the_svd_would_not():
+    """nullspace._well_above says a matrix's smallest singular value is at least the
+    threshold times its largest only where the SVD finds none below it: on matrices of
+    singular values spread over 1 to 1e-9 (about the threshold and far from it), and it
+    does say so for well conditioned ones (or the screen's shortcut would never serve)."""
+    from linmstmm.nullspace import _well_above, nullity
+
+    rng = np.random.default_rng(11)
+    cleared = 0
+    for trial in range(600):
+        n = int(rng.integers(2, 70))
+        u, _ = np.linalg.qr(rng.standard_normal((n, n)))
+        v, _ = np.linalg.qr(rng.standard_normal((n, n)))
+        sigma = np.sort(10.0 ** rng.uniform(-rng.uniform(0, 9), 0, n))[::-1]
+        matrix = (u * sigma) @ v.T * 10.0 ** rng.integers(-20, 20)
+        threshold = 10.0 ** rng.uniform(-9, -3)
+        if _well_above(matrix, threshold):
+            cleared += 1
+            assert nullity(matrix, threshold, (np.ones(n), np.ones(n))) == 0
+    assert cleared > 100
+    assert not _well_above(np.zeros((4, 4)), 1e-6) and not _well_above(np.diag([1.0, 1e-7]), 1e-6)

@@ -15,8 +15,8 @@ import pytest
 
 from linmstmm.deduction import Deduction
 from linmstmm.model import load_model
-from linmstmm.scenes import (beam_props, bundle_beside, cradle_props, rigid_props, salvo,
-                             scene_model, scene_sweep)
+from linmstmm.scenes import (SceneMaker, beam_props, bundle_beside, cradle_props, loaded_tube, rigid_props,
+                             salvo, scene_model, scene_sweep, scene_values, tube_axes)
 from linmstmm.solve import natural_frequencies
 from linmstmm.topology import build_topology
 
@@ -64,6 +64,40 @@ def test_file_cradle_is_frame_plus_lumped_tubes(model, bundle):
     assert built.mass == pytest.approx(cradle.mass, rel=1e-6)
     np.testing.assert_allclose(built.com, cradle.com, atol=1e-6)
     np.testing.assert_allclose(built.inertia, cradle.inertia, atol=1e-6 * np.abs(cradle.inertia).max())
+
+
+def _cradle_by_slots(model, bundle, tube, fired):
+    """The cradle of scene ``tube`` summed slot by slot from the frame, with nothing shared."""
+    axes = tube_axes(model, bundle)
+    loaded, rocket = loaded_tube(model, bundle)
+    total = bundle.frame(axes)
+    for slot in bundle.slots:
+        if slot != tube:
+            lumped = loaded - rocket if slot in fired else loaded
+            total = total + lumped.shifted(bundle.offset(slot, axes))
+    return total
+
+
+def test_scenes_sharing_their_sums_are_the_scenes_made_alone(model, bundle):
+    """A SceneMaker kept over many scenes (in any order, any rockets fired) shares the
+    cradle's sums over the slots: every value must be the one of the scene made alone,
+    and its cradle the slot-by-slot sum, bit for bit."""
+    rng = np.random.default_rng(3)
+    maker = SceneMaker(model, bundle)
+    shared = 0
+    for _ in range(60):
+        tube = int(rng.integers(1, 19))
+        fired = frozenset(int(s) for s in rng.choice(np.arange(1, 19), int(rng.integers(0, 18)), replace=False)) - {tube}
+        if rng.random() < 0.3:
+            fired = salvo(tube)
+        before = len(maker._sums)
+        values = maker.values(tube, fired)
+        shared += len(maker._sums) - before < len(bundle.slots) - 1
+        assert values == scene_values(model, tube, fired, bundle)
+        cradle, alone = maker.cradle(tube, fired), _cradle_by_slots(model, bundle, tube, fired)
+        assert cradle.mass == alone.mass
+        assert np.array_equal(cradle.com, alone.com) and np.array_equal(cradle.inertia, alone.inertia)
+    assert shared  # some scenes took sums made for others
 
 
 def test_smeared_rocket_leaves_steel(model, bundle):

@@ -1,0 +1,103 @@
+"""What a parameter study's next model takes from a model of the same structure
+(linmstmm.model_structure) must be, array for array, what a fresh build of it gives:
+the rigid-body motions, the Wittrick–Williams counter's matrices and the unknowns a
+solve releases, on edited launchers, random models and jointed ones."""
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from linmstmm import counter_parts, model_structure, rigid_motion
+from linmstmm.compiled_model import forget_compiled_models
+from linmstmm.wittrick_williams import ModeCounter
+from linmstmm.model import ModelError, load_model
+from test_program_reuse import _edited, _models
+
+MODELS = Path(__file__).resolve().parents[1] / "models"
+
+
+def _edits(model, count: int = 6, seed: int = 7):
+    """Up to ``count`` edited copies of ``model`` (its numbers moved, its structure kept)."""
+    rng = np.random.default_rng(seed)
+    for _ in range(count):
+        try:
+            yield _edited(model, rng)
+        except ModelError:  # an edit that breaks the model: nothing to compare
+            continue
+
+
+def _kept_and_fresh(model, edited, build):
+    """(``build(edited)`` after ``model`` left its structure's parts behind, the same built
+    with nothing kept), and whether the first took kept parts. ``model`` is built twice:
+    the second build takes the kept parts too, and leaves behind what they keep of it."""
+    forget_compiled_models()
+    build(model)
+    build(model)
+    reused = model_structure.structure_of(edited) == model_structure.structure_of(model)
+    kept = build(edited)
+    forget_compiled_models()
+    return kept, build(edited), reused
+
+
+@pytest.mark.parametrize("model", list(_models()), ids=lambda m: m.name)
+def test_rigid_body_motions_of_a_kept_structure_are_those_found_afresh(model):
+    reused = 0
+    for edited in _edits(model):
+        kept, fresh, same = _kept_and_fresh(model, edited, rigid_motion._motions)
+        assert np.array_equal(kept, fresh)
+        reused += same
+    assert reused  # the kept structure served at least one edited model
+
+
+def _counter_arrays(model) -> list:
+    """Every array a Wittrick–Williams counter of ``model`` counts with."""
+    counter = ModeCounter(model, "numpy")
+    return [np.array(counter.n_dof), counter._static, counter._mass, counter._maps, counter._columns,
+            *dataclasses.astuple(counter._beams)]
+
+
+@pytest.mark.parametrize("model", list(_models()), ids=lambda m: m.name)
+def test_a_counter_on_a_kept_elimination_is_the_counter_built_afresh(model):
+    """The counter of an edited model, built on the elimination its structure's first
+    model left behind (linmstmm.counter_parts), against the full build."""
+    reused = 0
+    for edited in _edits(model):
+        kept, fresh, same = _kept_and_fresh(model, edited, _counter_arrays)
+        assert len(kept) == len(fresh)
+        for ours, theirs in zip(kept, fresh):
+            assert ours.shape == theirs.shape and np.array_equal(ours, theirs)
+        reused += same and counter_parts._eliminations.get(edited, lambda m: None) is not None
+    if model.name.startswith("MLRS"):
+        assert reused  # the launcher's structure is of the kind kept, and served
+
+
+def test_only_an_elimination_fixed_by_the_structure_is_kept():
+    """A port on a boundary point, a point two bodies share or an inf spring direction
+    puts numbers into the constraints: such a structure keeps no elimination."""
+    model = load_model(MODELS / "mlrs/mlrs.toml")
+    forget_compiled_models()
+    ModeCounter(model)
+    assert counter_parts._eliminations.get(model, lambda m: None) is not None
+    body = model.rigids[0]
+    for changed in (dataclasses.replace(model, boundary={**model.boundary, body.ports[0]: np.ones(6, bool)}),
+                    dataclasses.replace(model, springs=tuple(dataclasses.replace(s, k=np.where(
+                        np.arange(6) == 0, np.inf, s.k)) for s in model.springs))):
+        ModeCounter(changed)
+        assert counter_parts._eliminations.get(changed, lambda m: 0) is None
+
+
+def test_a_structure_differs_where_a_release_or_a_boundary_does():
+    model = load_model(MODELS / "mlrs/mlrs.toml")
+    held = dataclasses.replace(model, boundary={})
+    assert model_structure.structure_of(held) != model_structure.structure_of(model)
+    assert rigid_motion.rigid_body_mode_count(held) == 6 != rigid_motion.rigid_body_mode_count(model)
+
+
+def test_forgetting_compiled_models_forgets_the_structures():
+    model = load_model(MODELS / "cantilever_tip_mass.toml")
+    rigid_motion.rigid_body_mode_count(model)
+    forget_compiled_models()
+    assert not rigid_motion._free_parts._kept and model_structure.structure_of.cache_info().currsize == 0

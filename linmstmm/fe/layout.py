@@ -139,10 +139,15 @@ class _Triplets:
         self.repeats = repeats
 
     def add(self, rows, cols, values):
-        rows, cols, values = np.broadcast_arrays(rows, cols, values)
-        self.rows.append(rows.ravel())
-        self.cols.append(cols.ravel())
-        self.values.append(values.ravel().astype(float))
+        shape = np.broadcast(rows, cols, values).shape
+        rows, cols, values = (_flat(part, shape) for part in (rows, cols, values))
+        self._append(rows, cols, values.astype(float, copy=False))
+
+    def _append(self, rows, cols, values):
+        """Append flat entries as they are."""
+        self.rows.append(rows)
+        self.cols.append(cols)
+        self.values.append(values)
 
     def new_rows(self, count):
         """Indices of ``count`` fresh rows."""
@@ -160,7 +165,7 @@ class _Triplets:
     def extend(self, other: "_Triplets"):
         """Append the rows of ``other`` after these (renumbered)."""
         for rows, cols, values in zip(other.rows, other.cols, other.values):
-            self.add(rows + self.n_rows, cols, values)
+            self._append(rows + self.n_rows, cols, values)
         self.n_rows += other.n_rows
 
     def matrix(self, n_cols, n_rows=None) -> sp.csr_matrix:
@@ -178,6 +183,12 @@ class _Triplets:
             return compressed_of_summed(rows, cols, values, (n_rows, n_cols))
         nonzero = values != 0
         return compressed_of_distinct(rows[nonzero], cols[nonzero], values[nonzero], (n_rows, n_cols))
+
+
+def _flat(part, shape: tuple) -> np.ndarray:
+    """``part`` broadcast to ``shape`` and flattened (its own flat view where it has that shape)."""
+    part = np.asarray(part)
+    return part.ravel() if part.shape == shape else np.broadcast_to(part, shape).ravel()
 
 
 def _spring_directions(spring, index: DofIndex, kept_only: bool):

@@ -11,7 +11,6 @@ import scipy.sparse as sp
 from linmstmm.fe.elements import frame_elements
 from linmstmm.fe.layout import (
     DofIndex,
-    _beam_axes,
     _layout,
     _Triplets,
     element_maps,
@@ -121,7 +120,7 @@ def constrained_parts(model: Model, elements_per_beam: int, nodes: NodeConstrain
     """
     nodes = node_constraints(model) if nodes is None else nodes
     layout = _layout(model, elements_per_beam, nodes.layout)
-    maps = element_maps(layout.beam_table, _beam_axes(model.beams))
+    maps = element_maps(layout.beam_table, layout.beam_axes)
     beam_rows = _Triplets()
     _add_beam_constraints(model.beams, maps, elements_per_beam, beam_rows)
     n_full = 6 * layout.n_nodes

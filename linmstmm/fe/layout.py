@@ -60,12 +60,14 @@ class _Layout:
 
     beam_table : (n_beams, n+1) the nodes of each beam (``model.beams`` order), end a
         to end b, as in ``index.beam_nodes``.
+    beam_axes : (n_beams, 3, 3) rows = each beam's local axes in the inertial frame.
     """
 
     index: DofIndex
     positions: np.ndarray   # (n_nodes, 3)
     frames: np.ndarray      # (n_nodes, 3, 3) rows = the node's DOF axes
     beam_table: np.ndarray
+    beam_axes: np.ndarray
 
     @property
     def n_nodes(self):
@@ -82,18 +84,19 @@ def _layout(model: Model, elements_per_beam: int, nodes: _Layout | None = None) 
         rigids = {body.name: len(points) + i for i, body in enumerate(model.rigids)}
         placed = np.array([*model.points.values(), *(body.com for body in model.rigids)], float).reshape(-1, 3)
         ends = np.array([[points[end] for end in beam.ends] for beam in model.beams], int).reshape(-1, 2)
+        axes = _beam_axes(model.beams)
     else:
-        points, rigids, placed, ends = nodes.index.points, nodes.index.rigids, nodes.positions, nodes.beam_table
+        points, rigids, placed, ends, axes = (nodes.index.points, nodes.index.rigids, nodes.positions,
+                                              nodes.beam_table, nodes.beam_axes)
         if n == 1:
             return nodes
     interior = len(placed) + np.arange(len(ends) * (n - 1)).reshape(len(ends), n - 1)
     table = np.concatenate([ends[:, :1], interior, ends[:, 1:]], axis=1)
     xa, xb = placed[ends[:, 0]], placed[ends[:, 1]]
     inside = xa[:, None] + (xb - xa)[:, None] * (np.arange(1, n) / n)[None, :, None]
-    axes = _beam_axes(model.beams)
     frames = np.concatenate([np.broadcast_to(np.eye(3), (len(placed), 3, 3)), np.repeat(axes, n - 1, axis=0)])
     return _Layout(DofIndex(points, rigids, {beam.name: nodes for beam, nodes in zip(model.beams, table)}),
-                   np.concatenate([placed, inside.reshape(-1, 3)]), frames, table)
+                   np.concatenate([placed, inside.reshape(-1, 3)]), frames, table, axes)
 
 
 def _beam_axes(beams) -> np.ndarray:

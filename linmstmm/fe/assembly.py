@@ -19,7 +19,7 @@ from linmstmm.fe.masses import _negligible_mass_removed
 from linmstmm.fe.node_constraints import NodeConstraints, node_constraints
 from linmstmm.fe.products import congruence, dense_product, small, transposed
 from linmstmm.fe.rigid_motions import rigid_modes
-from linmstmm.fe.sparse import Compressed, compressed_rows, scipy_csr, symmetric_part
+from linmstmm.fe.sparse import scipy_csr, symmetric_part
 from linmstmm.model import Model
 
 
@@ -196,26 +196,16 @@ class Assembly:
     M, K : (n_dof, n_dof) symmetric bit for bit: mass (kg, kg m²) and stiffness
         (N/m, N m/rad); dense numpy arrays where formed densely, scipy CSR otherwise
         (:func:`~linmstmm.fe.sparse.scipy_csr` makes either CSR).
-    strains : (n_strain, n_full) CSR rows (:class:`~linmstmm.fe.sparse.Compressed`) of
-        the element strains on the full DOFs: the beams' rows, then the springs'.
-    D : (n_strain,) their stiffnesses; the natural factor is ``K = G.T @ diag(D) @ G``.
-    formed_G : :attr:`G` where K was formed sparse from it, else None.
+    G, D : natural factor ``K = G.T @ diag(D) @ G``: G (n_strain, n_dof) scipy CSR,
+        D (n_strain,).
     """
 
     model: Model
     parts: ConstrainedParts
     M: np.ndarray | sp.csr_matrix
     K: np.ndarray | sp.csr_matrix
-    strains: Compressed
+    G: sp.csr_matrix
     D: np.ndarray
-    formed_G: sp.csr_matrix | None = None
-
-    @property
-    def G(self) -> sp.csr_matrix:
-        """(n_strain, n_dof) scipy CSR ``strains @ T`` as scipy.sparse stores it: the one
-        K was formed with where formed sparse (``formed_G``), else formed here (the
-        coarse predictions never ask for it)."""
-        return _strain_product(self.strains, self.parts.T) if self.formed_G is None else self.formed_G
 
 
 def assembled(model: Model, elements_per_beam: int, constraints_of=node_constraints) -> Assembly:
@@ -237,25 +227,16 @@ def assembled(model: Model, elements_per_beam: int, constraints_of=node_constrai
     strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
     stiffness += parts.spring_stiffness
 
-    strains = strains.compressed(n_full)
+    G = (strains.matrix(n_full) @ T).tocsr()
     D = np.concatenate(stiffness) if stiffness else np.zeros(0)
     mass = mass.compressed(n_full, n_full)
-    if small(T.shape[1], n_full):
-        # G's rows as compressed_rows stores them, not as scipy's product does: each
-        # entry of K is summed over the strains in ascending order either way
-        G = compressed_rows(dense_product(strains, T))
-        M, K = (_symmetric_of_dense(product) for product in (congruence(T, mass), dense_product(transposed(G, D), G)))
-        return Assembly(model, parts, M, K, strains, D)
-    G = _strain_product(strains, T)
     weighted = transposed(G, D)                 # Gᵀ diag(D), G's own arrays
-    M = symmetric_part(T.T @ scipy_csr(mass) @ T)
-    K = symmetric_part(sp.csc_matrix((weighted.data, weighted.indices, weighted.indptr), shape=weighted.shape) @ G)
-    return Assembly(model, parts, M, K, strains, D, G)
-
-
-def _strain_product(strains: Compressed, T: sp.csr_matrix) -> sp.csr_matrix:
-    """(n_strain, n_dof) ``strains @ T`` by scipy.sparse, its rows as scipy stores them."""
-    return (scipy_csr(strains) @ T).tocsr()
+    if small(T.shape[1], n_full):
+        M, K = (_symmetric_of_dense(product) for product in (congruence(T, mass), dense_product(weighted, G)))
+    else:
+        M = symmetric_part(T.T @ scipy_csr(mass) @ T)
+        K = symmetric_part(sp.csc_matrix((weighted.data, weighted.indices, weighted.indptr), shape=weighted.shape) @ G)
+    return Assembly(model, parts, M, K, G, D)
 
 
 def assemble(model: Model, elements_per_beam: int = 8) -> FEModel:

@@ -104,14 +104,14 @@ def _substitute(terms, owner, slave, solved, users):
         users.setdefault(master, set()).add(owner)
 
 
-def reduced_constraints(constraints: Compressed, t0) -> Compressed:
+def reduced_constraints(constraints: Compressed, t0: sp.csr_matrix) -> Compressed:
     """``constraints @ t0`` (canonical CSR rows), less the entries below NEGLIGIBLE_ENTRY of
     their row's largest: densely where small (:mod:`linmstmm.fe.products`), the same
-    entries as scipy.sparse's product. t0 : scipy CSR or canonical :class:`Compressed` CSR."""
+    entries as scipy.sparse's product."""
     shape = (constraints.shape[0], t0.shape[1])
     if small(*shape):
         return _debris_dropped(compressed_rows(dense_product(constraints, t0)))
-    product = sp.csr_matrix(scipy_csr(constraints) @ scipy_csr(t0))
+    product = sp.csr_matrix(scipy_csr(constraints) @ t0)
     product.sum_duplicates()                           # indices ascending
     return _debris_dropped(Compressed("csr", product.indptr, product.indices, product.data, shape))
 

@@ -23,8 +23,7 @@ import scipy.sparse as sp
 
 from linmstmm.fe.constraints import _eliminate, reduced_constraints
 from linmstmm.fe.layout import _layout, _Triplets, spring_rows
-from linmstmm.fe.products import stored_product
-from linmstmm.fe.sparse import Compressed
+from linmstmm.fe.sparse import Compressed, scipy_csr
 from linmstmm.model import Model
 
 #: Model objects whose node constraints are kept (:func:`kept_node_constraints`),
@@ -95,9 +94,9 @@ class NodeConstraints:
             if not interior.size:       # the nodes themselves (one element per beam)
                 return T, masters
             return _with_identity(T, len(interior)), np.concatenate([masters, interior])
-        t0 = _with_identity(self.port_map, len(interior))
+        t0 = scipy_csr(_with_identity(self.port_map, len(interior)))
         t1, masters = _eliminate(reduced_constraints(_stacked(beam_rows.compressed(n_full), self.rows), t0))
-        return stored_product(t0, t1), np.concatenate([self.kept, interior])[masters]
+        return (t0 @ scipy_csr(t1)).tocsr(), np.concatenate([self.kept, interior])[masters]
 
 
 def node_constraints(model: Model) -> NodeConstraints:
@@ -123,8 +122,9 @@ def node_constraints(model: Model) -> NodeConstraints:
     rows = constraints.compressed(n_full)
     elimination = None
     if all(beam.axial and beam.torsion for beam in model.beams):
-        t1, masters = _eliminate(reduced_constraints(rows, t0))
-        elimination = (stored_product(t0, t1), kept[masters])
+        t0_csr = scipy_csr(t0)
+        t1, masters = _eliminate(reduced_constraints(rows, t0_csr))
+        elimination = ((t0_csr @ scipy_csr(t1)).tocsr(), kept[masters])
     return NodeConstraints(layout, n_full, t0, kept, rows, strains, stiffness, mass, elimination)
 
 

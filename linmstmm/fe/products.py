@@ -12,9 +12,8 @@ adds them with :func:`numpy.bincount`, which adds in the order given.
 from __future__ import annotations
 
 import numpy as np
-import scipy.sparse as sp
 
-from linmstmm.fe.sparse import Compressed, scipy_csr, stored_entries
+from linmstmm.fe.sparse import Compressed, stored_entries
 
 #: Largest dense intermediate (rows × columns) for the callers that choose between
 #: :func:`dense_product` and scipy.sparse: clearing and scanning a dense result costs
@@ -56,35 +55,6 @@ def dense_product(a, b) -> np.ndarray:
     position = rows[entry] * n_cols + b.indices[taken]
     summed = np.bincount(position, values[entry] * b.data[taken], minlength=n_rows * n_cols)
     return summed.reshape(n_rows, n_cols)
-
-
-def stored_product(a, b) -> sp.csr_matrix:
-    """``(a @ b).tocsr()`` of CSR ``a`` and ``b``, stored as scipy.sparse stores it: each
-    row's entries in the reverse of the order their first terms are met (scipy
-    links each new column in at the head of the row's list), exact zeros dropped.
-    Formed in numpy where the product is small (:func:`small`), by scipy otherwise.
-
-    Parameters
-    ----------
-    a : (n, m) scipy CSR matrix or canonical :class:`Compressed` CSR.
-    b : (m, p) the same kinds.
-
-    Returns
-    -------
-    scipy.sparse.csr_matrix, (n, p), int32 indices.
-    """
-    n_rows, n_cols = a.shape[0], b.shape[1]
-    if not small(n_rows, n_cols):
-        return (scipy_csr(a) @ scipy_csr(b)).tocsr()
-    major = np.repeat(np.arange(n_rows), np.diff(a.indptr))
-    entry, taken = stored_entries(b.indptr, a.indices)     # the terms in the order scipy meets them
-    position = major[entry] * n_cols + b.indices[taken]
-    summed = np.bincount(position, a.data[entry] * b.data[taken], minlength=n_rows * n_cols)
-    met, first = np.unique(position, return_index=True)
-    position = met[np.lexsort((-first, met // n_cols))]     # rows ascending, latest met first
-    position = position[summed[position] != 0]
-    indptr = np.searchsorted(position, np.arange(n_rows + 1) * n_cols).astype(np.int32)
-    return sp.csr_matrix((summed[position], (position % n_cols).astype(np.int32), indptr), shape=(n_rows, n_cols))
 
 
 def rows_scaled(matrix, factors: np.ndarray) -> Compressed:

@@ -57,9 +57,8 @@ def _add_beams(elements: _BeamElements, strains, stiffness, mass):
     dofs, to_local, rows, d, strain, m = elements
     n = dofs.shape[1]
     kept = np.broadcast_to(strain[:, None], rows.shape[:3])
-    numbers = np.zeros(kept.shape, int)
-    numbers[kept] = strains.new_rows(np.count_nonzero(kept))
-    strains.add(numbers[kept][:, None], np.broadcast_to(dofs[:, :, None], kept.shape + (12,))[kept], rows[kept])
+    strains.add(strains.new_rows(np.count_nonzero(kept))[:, None],
+                np.broadcast_to(dofs[:, :, None], kept.shape + (12,))[kept], rows[kept])
     stiffness.append(np.repeat(d, n, axis=0)[np.repeat(strain, n, axis=0)])
     mass.add(dofs[..., :, None], dofs[..., None, :], np.swapaxes(to_local, 2, 3) @ m[:, None] @ to_local)
 

@@ -12,10 +12,15 @@ through scipy.sparse, bit for bit.
   body the one-call screen passes over is returned unchanged by the full
   per-body check, on tensors whose least principal inertia lies on either side
   of the threshold.
+* A model with a negligible mass is assembled on its own node constraints (the
+  counter's, kept) given the masses left, the same arrays as the model with that
+  mass removed from the start.
 * A dense left factor is multiplied as the canonical CSR of its nonzero entries,
   the same sums as scipy's product.
 """
 from __future__ import annotations
+
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -27,9 +32,11 @@ from varied_models import varied_model
 import linmstmm.fe.products as products
 from linmstmm.coarse_prediction import coarse_pencil
 from linmstmm.fe.assembly import assemble, assembled
-from linmstmm.fe.masses import _body_mass_kept, _maybe_negligible
+from linmstmm.fe.masses import _body_mass_kept, _maybe_negligible, _negligible_mass_removed
+from linmstmm.fe.node_constraints import kept_node_constraints
 from linmstmm.fe.products import dense_product
 from linmstmm.model import load_model
+from linmstmm.wittrick_williams import ModeCounter
 
 MODELS = {path.stem: (lambda path=path: load_model(path)) for path in BUNDLED_MODELS}
 MODELS |= {f"{kind} {seed}": (lambda kind=kind, seed=seed: random_model(kind, seed))
@@ -91,3 +98,29 @@ def test_dense_left_factor_is_multiplied_as_its_canonical_csr():
         a.data *= 10.0 ** rng.integers(-6, 7, a.nnz)
         b = sp.random(m, p, density=rng.uniform(0.05, 0.6), format="csr", random_state=rng)
         assert np.array_equal(dense_product(a.toarray(), b), (a @ b).toarray())
+
+
+def test_negligible_masses_keep_the_model_s_own_node_constraints():
+    """A body of 1e-16 of the others' mass is rounding, removed before assembly: the
+    assembly asks for the node constraints of the model itself (so the coarse pencil
+    shares the counter's) and gives them the masses left, the same arrays as
+    assembling the model with that body's mass removed from the start."""
+    model = random_model("tree", 1)
+    heavy = model.rigids[0]
+    tiny = replace(heavy, mass=1e-16 * heavy.mass, inertia=1e-16 * heavy.inertia)
+    model = replace(model, rigids=(tiny,) + model.rigids[1:])
+    light = _negligible_mass_removed(model)
+    assert light is not model and light.rigids[0].mass == 0.0
+    for n in (1, 2, 3):
+        given, made = assembled(model, n), assembled(light, n)
+        assert given.model is not model
+        for a, b in zip((given.parts.T, given.M, given.K, given.G), (made.parts.T, made.M, made.K, made.G)):
+            a, b = (m if isinstance(m, np.ndarray) else m.toarray() for m in (a, b))
+            assert np.array_equal(a, b)
+        assert np.array_equal(given.D, made.D)
+    kept_node_constraints.cache_clear()
+    ModeCounter(model, "numpy")
+    coarse_pencil.cache_clear()
+    coarse_pencil(model, 2)
+    assert kept_node_constraints.cache_info().misses == 1     # made for the counter, kept for the pencil
+    coarse_pencil.cache_clear()

@@ -212,14 +212,18 @@ def assembled(model: Model, elements_per_beam: int, constraints_of=node_constrai
     elements per beam; ``constraints_of`` (Model -> NodeConstraints) gives the
     constraints of its nodes (made anew by default, the kept ones of
     :func:`~linmstmm.fe.node_constraints.kept_node_constraints` for the coarse
-    predictions).
+    predictions), asked of ``model`` itself and given the masses that are left of it
+    where some are negligible (:mod:`linmstmm.fe.masses`).
 
     M = Tᵀ M_full T and K = (Gᵀ D) G are formed densely where their dense
     intermediate (n_dof × n_full) is small (:func:`linmstmm.fe.products.small`), by
     scipy.sparse otherwise: the same matrices bit for bit either way.
     """
-    model = _negligible_mass_removed(model)
-    parts = constrained_parts(model, elements_per_beam, constraints_of(model))
+    light = _negligible_mass_removed(model)
+    nodes = constraints_of(model)       # the model's own (kept ones shared with its counter)
+    if light is not model:
+        model, nodes = light, nodes.with_masses_of(light)
+    parts = constrained_parts(model, elements_per_beam, nodes)
     T, n_full = parts.T, parts.n_full
     strains, mass, stiffness = _Triplets(), parts.rigid_mass.copy(), []
     _add_beams(_beam_elements(model.beams, parts.beam_maps, elements_per_beam), strains, stiffness, mass)

@@ -15,8 +15,6 @@ through scipy.sparse, bit for bit.
 * A model with a negligible mass is assembled on its own node constraints (the
   counter's, kept) given the masses left, the same arrays as the model with that
   mass removed from the start.
-* A dense left factor is multiplied as the canonical CSR of its nonzero entries,
-  the same sums as scipy's product.
 """
 from __future__ import annotations
 
@@ -24,7 +22,6 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-import scipy.sparse as sp
 from builders import BUNDLED_MODELS, make_rigid
 from random_models import KINDS, random_model, random_rotation
 from varied_models import varied_model
@@ -34,7 +31,6 @@ from linmstmm.coarse_prediction import coarse_pencil
 from linmstmm.fe.assembly import assemble, assembled
 from linmstmm.fe.masses import _body_mass_kept, _maybe_negligible, _negligible_mass_removed
 from linmstmm.fe.node_constraints import kept_node_constraints
-from linmstmm.fe.products import dense_product
 from linmstmm.model import load_model
 from linmstmm.wittrick_williams import ModeCounter
 
@@ -88,16 +84,6 @@ def test_inertia_screen_passes_over_only_bodies_left_unchanged():
             assert _body_mass_kept(body, least_mass, least_inertia) is body
             passed_over_near += np.linalg.eigvalsh(body.inertia)[0] < 10 * least_inertia
     assert passed_over_near > 0 and looked_at.any()         # the screen acted, and left some to the full check
-
-
-def test_dense_left_factor_is_multiplied_as_its_canonical_csr():
-    rng = np.random.default_rng(5)
-    for _ in range(100):
-        n, m, p = rng.integers(1, 25, 3)
-        a = sp.random(n, m, density=rng.uniform(0.05, 0.6), format="csr", random_state=rng)
-        a.data *= 10.0 ** rng.integers(-6, 7, a.nnz)
-        b = sp.random(m, p, density=rng.uniform(0.05, 0.6), format="csr", random_state=rng)
-        assert np.array_equal(dense_product(a.toarray(), b), (a @ b).toarray())
 
 
 def test_negligible_masses_keep_the_model_s_own_node_constraints():

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.fe.sparse import Compressed, stored_entries
+from linmstmm.fe.sparse import Compressed, compressed_rows, stored_entries
 
 #: Largest dense intermediate (rows × columns) for the callers that choose between
 #: :func:`dense_product` and scipy.sparse: clearing and scanning a dense result costs
@@ -35,8 +35,7 @@ def dense_product(a, b) -> np.ndarray:
     Parameters
     ----------
     a : (n, m) scipy CSR or CSC matrix or :class:`Compressed`; a CSR one's indices
-        in the order scipy would meet them (its stored order). Or a numpy array,
-        taken as the canonical CSR of its nonzero entries (columns ascending).
+        in the order scipy would meet them (its stored order).
     b : (m, p) scipy CSR matrix or :class:`Compressed` CSR.
 
     Returns
@@ -44,16 +43,11 @@ def dense_product(a, b) -> np.ndarray:
     numpy.ndarray, (n, p).
     """
     n_rows, n_cols = a.shape[0], b.shape[1]
-    if isinstance(a, np.ndarray):
-        rows, inner = np.nonzero(a != 0)                    # row after row, columns ascending
-        values = a[rows, inner]
-    else:
-        major = np.repeat(np.arange(len(a.indptr) - 1), np.diff(a.indptr))
-        rows, inner = (major, a.indices) if a.format == "csr" else (a.indices, major)
-        values = a.data
+    major = np.repeat(np.arange(len(a.indptr) - 1), np.diff(a.indptr))
+    rows, inner = (major, a.indices) if a.format == "csr" else (a.indices, major)
     entry, taken = stored_entries(b.indptr, inner)          # each entry of a times b's row of its k
     position = rows[entry] * n_cols + b.indices[taken]
-    summed = np.bincount(position, values[entry] * b.data[taken], minlength=n_rows * n_cols)
+    summed = np.bincount(position, a.data[entry] * b.data[taken], minlength=n_rows * n_cols)
     return summed.reshape(n_rows, n_cols)
 
 
@@ -94,7 +88,7 @@ def congruence(T, matrix) -> np.ndarray:
     indptr = np.zeros(len(used) + 1, int)
     np.cumsum(np.bincount(line, minlength=len(used)), out=indptr[1:])
     rows = Compressed("csr", indptr, T.indices[taken], T.data[taken], (len(used), T.shape[1]))
-    return dense_product(dense_product(transposed(T), narrowed), rows)
+    return dense_product(compressed_rows(dense_product(transposed(T), narrowed)), rows)
 
 
 def _moved(T, matrix, used: np.ndarray) -> np.ndarray | None:

@@ -26,10 +26,14 @@ from builders import BUNDLED_MODELS, make_rigid
 from random_models import KINDS, random_model, random_rotation
 from varied_models import varied_model
 
-import linmstmm.fe.products as products
 from linmstmm.coarse_prediction import coarse_pencil
+from linmstmm.fe import products
 from linmstmm.fe.assembly import assemble, assembled
-from linmstmm.fe.masses import _body_mass_kept, _maybe_negligible, _negligible_mass_removed
+from linmstmm.fe.masses import (
+    _body_mass_kept,
+    _maybe_negligible,
+    _negligible_mass_removed,
+)
 from linmstmm.fe.node_constraints import kept_node_constraints
 from linmstmm.model import load_model
 from linmstmm.wittrick_williams import ModeCounter

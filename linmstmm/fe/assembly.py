@@ -11,7 +11,6 @@ import scipy.sparse as sp
 from linmstmm.fe.elements import frame_elements
 from linmstmm.fe.layout import (
     DofIndex,
-    _beam_axes,
     _layout,
     _Triplets,
     element_maps,
@@ -58,9 +57,8 @@ def _add_beams(elements: _BeamElements, strains, stiffness, mass):
     dofs, to_local, rows, d, strain, m = elements
     n = dofs.shape[1]
     kept = np.broadcast_to(strain[:, None], rows.shape[:3])
-    numbers = np.zeros(kept.shape, int)
-    numbers[kept] = strains.new_rows(np.count_nonzero(kept))
-    strains.add(numbers[kept][:, None], np.broadcast_to(dofs[:, :, None], kept.shape + (12,))[kept], rows[kept])
+    strains.add(strains.new_rows(np.count_nonzero(kept))[:, None],
+                np.broadcast_to(dofs[:, :, None], kept.shape + (12,))[kept], rows[kept])
     stiffness.append(np.repeat(d, n, axis=0)[np.repeat(strain, n, axis=0)])
     mass.add(dofs[..., :, None], dofs[..., None, :], np.swapaxes(to_local, 2, 3) @ m[:, None] @ to_local)
 
@@ -121,7 +119,7 @@ def constrained_parts(model: Model, elements_per_beam: int, nodes: NodeConstrain
     """
     nodes = node_constraints(model) if nodes is None else nodes
     layout = _layout(model, elements_per_beam, nodes.layout)
-    maps = element_maps(layout.beam_table, _beam_axes(model.beams))
+    maps = element_maps(layout.beam_table, layout.beam_axes)
     beam_rows = _Triplets()
     _add_beam_constraints(model.beams, maps, elements_per_beam, beam_rows)
     n_full = 6 * layout.n_nodes
@@ -214,14 +212,18 @@ def assembled(model: Model, elements_per_beam: int, constraints_of=node_constrai
     elements per beam; ``constraints_of`` (Model -> NodeConstraints) gives the
     constraints of its nodes (made anew by default, the kept ones of
     :func:`~linmstmm.fe.node_constraints.kept_node_constraints` for the coarse
-    predictions).
+    predictions), asked of ``model`` itself and given the masses that are left of it
+    where some are negligible (:mod:`linmstmm.fe.masses`).
 
     M = Tᵀ M_full T and K = (Gᵀ D) G are formed densely where their dense
     intermediate (n_dof × n_full) is small (:func:`linmstmm.fe.products.small`), by
     scipy.sparse otherwise: the same matrices bit for bit either way.
     """
-    model = _negligible_mass_removed(model)
-    parts = constrained_parts(model, elements_per_beam, constraints_of(model))
+    light = _negligible_mass_removed(model)
+    nodes = constraints_of(model)       # the model's own (kept ones shared with its counter)
+    if light is not model:
+        model, nodes = light, nodes.with_masses_of(light)
+    parts = constrained_parts(model, elements_per_beam, nodes)
     T, n_full = parts.T, parts.n_full
     strains, mass, stiffness = _Triplets(), parts.rigid_mass.copy(), []
     _add_beams(_beam_elements(model.beams, parts.beam_maps, elements_per_beam), strains, stiffness, mass)

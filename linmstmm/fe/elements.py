@@ -44,13 +44,12 @@ def frame_elements(beams, h: np.ndarray):
     strain : (b, 6) bool, True where a row is a strain, False where the beam declares
         the direction rigid (``axial`` or ``torsion`` False: the row is a constraint).
     """
-    E, G, rho, A, Iy, Iz, J, Ip = (np.array([getattr(beam, key) for beam in beams], float)
-                                    for key in ("E", "G", "rho", "A", "Iy", "Iz", "J", "Ip"))
+    E, G, rho, A, Iy, Iz, J, Ip = np.array([(beam.E, beam.G, beam.rho, beam.A, beam.Iy, beam.Iz, beam.J, beam.Ip)
+                                            for beam in beams], float).reshape(-1, 8).T
     rows = _ROWS + (1 / h)[:, None, None] * _ROWS_PER_LENGTH
     d = np.stack([E * Iz / h, 12 * E * Iz / h, E * Iy / h, 12 * E * Iy / h, E * A / h, G * J / h], axis=1)
     strain = np.ones((len(h), 6), bool)
-    strain[:, 4] = [beam.axial for beam in beams]
-    strain[:, 5] = [beam.torsion for beam in beams]
+    strain[:, 4:] = np.array([(beam.axial, beam.torsion) for beam in beams], bool).reshape(-1, 2)
     return rows, d, _frame_masses(rho * A, rho * Ip, h), strain
 
 

@@ -60,12 +60,14 @@ class _Layout:
 
     beam_table : (n_beams, n+1) the nodes of each beam (``model.beams`` order), end a
         to end b, as in ``index.beam_nodes``.
+    beam_axes : (n_beams, 3, 3) rows = each beam's local axes in the inertial frame.
     """
 
     index: DofIndex
     positions: np.ndarray   # (n_nodes, 3)
     frames: np.ndarray      # (n_nodes, 3, 3) rows = the node's DOF axes
     beam_table: np.ndarray
+    beam_axes: np.ndarray
 
     @property
     def n_nodes(self):
@@ -82,18 +84,19 @@ def _layout(model: Model, elements_per_beam: int, nodes: _Layout | None = None) 
         rigids = {body.name: len(points) + i for i, body in enumerate(model.rigids)}
         placed = np.array([*model.points.values(), *(body.com for body in model.rigids)], float).reshape(-1, 3)
         ends = np.array([[points[end] for end in beam.ends] for beam in model.beams], int).reshape(-1, 2)
+        axes = _beam_axes(model.beams)
     else:
-        points, rigids, placed, ends = nodes.index.points, nodes.index.rigids, nodes.positions, nodes.beam_table
+        points, rigids, placed, ends, axes = (nodes.index.points, nodes.index.rigids, nodes.positions,
+                                              nodes.beam_table, nodes.beam_axes)
         if n == 1:
             return nodes
     interior = len(placed) + np.arange(len(ends) * (n - 1)).reshape(len(ends), n - 1)
     table = np.concatenate([ends[:, :1], interior, ends[:, 1:]], axis=1)
     xa, xb = placed[ends[:, 0]], placed[ends[:, 1]]
     inside = xa[:, None] + (xb - xa)[:, None] * (np.arange(1, n) / n)[None, :, None]
-    axes = _beam_axes(model.beams)
     frames = np.concatenate([np.broadcast_to(np.eye(3), (len(placed), 3, 3)), np.repeat(axes, n - 1, axis=0)])
     return _Layout(DofIndex(points, rigids, {beam.name: nodes for beam, nodes in zip(model.beams, table)}),
-                   np.concatenate([placed, inside.reshape(-1, 3)]), frames, table)
+                   np.concatenate([placed, inside.reshape(-1, 3)]), frames, table, axes)
 
 
 def _beam_axes(beams) -> np.ndarray:
@@ -139,10 +142,15 @@ class _Triplets:
         self.repeats = repeats
 
     def add(self, rows, cols, values):
-        rows, cols, values = np.broadcast_arrays(rows, cols, values)
-        self.rows.append(rows.ravel())
-        self.cols.append(cols.ravel())
-        self.values.append(values.ravel().astype(float))
+        shape = np.broadcast(rows, cols, values).shape
+        rows, cols, values = (_flat(part, shape) for part in (rows, cols, values))
+        self._append(rows, cols, values.astype(float, copy=False))
+
+    def _append(self, rows, cols, values):
+        """Append flat entries as they are."""
+        self.rows.append(rows)
+        self.cols.append(cols)
+        self.values.append(values)
 
     def new_rows(self, count):
         """Indices of ``count`` fresh rows."""
@@ -160,7 +168,7 @@ class _Triplets:
     def extend(self, other: "_Triplets"):
         """Append the rows of ``other`` after these (renumbered)."""
         for rows, cols, values in zip(other.rows, other.cols, other.values):
-            self.add(rows + self.n_rows, cols, values)
+            self._append(rows + self.n_rows, cols, values)
         self.n_rows += other.n_rows
 
     def matrix(self, n_cols, n_rows=None) -> sp.csr_matrix:
@@ -178,6 +186,12 @@ class _Triplets:
             return compressed_of_summed(rows, cols, values, (n_rows, n_cols))
         nonzero = values != 0
         return compressed_of_distinct(rows[nonzero], cols[nonzero], values[nonzero], (n_rows, n_cols))
+
+
+def _flat(part, shape: tuple) -> np.ndarray:
+    """``part`` broadcast to ``shape`` and flattened (its own flat view where it has that shape)."""
+    part = np.asarray(part)
+    return part.ravel() if part.shape == shape else np.broadcast_to(part, shape).ravel()
 
 
 def _spring_directions(spring, index: DofIndex, kept_only: bool):

@@ -13,6 +13,9 @@ from linmstmm.model import Model, Rigid
 #: model's own scale of the same units is rounding, not mass: a body's mass or
 #: principal inertia, a beam, or a rigid motion below it carries none.
 MASSLESS = 1e-13
+#: A least principal inertia above this many times the negligible one is kept
+#: whatever the rounding of the eigensolver that found it (:func:`_maybe_negligible`).
+SURE_INERTIA = 2.0
 
 
 def _negligible_mass_removed(model: Model) -> Model:
@@ -43,11 +46,21 @@ def _negligible_mass_removed(model: Model) -> Model:
 
 def _maybe_negligible(masses: np.ndarray, tensors: np.ndarray, least_mass: float, least_inertia: float) -> np.ndarray:
     """(b,) bool: the bodies (masses (b,) kg, inertia tensors (b, 3, 3) kg m²) that
-    :func:`_body_mass_kept` may change; the others it returns as they are."""
+    :func:`_body_mass_kept` may change; the others it returns as they are.
+
+    Where Gershgorin's bound cannot clear a tensor, its least principal inertia
+    can (all of them in one call, where :func:`_body_mass_kept` takes one LAPACK
+    call per body): above SURE_INERTIA times ``least_inertia`` it is above
+    ``least_inertia`` in any backward-stable solver's rounding too (a few eps of
+    the tensor's norm, at most its trace, itself at most 1e13 ``least_inertia``).
+    """
     diagonal = tensors.diagonal(axis1=1, axis2=2)
     gershgorin = diagonal - (np.abs(tensors).sum(axis=2) - np.abs(diagonal))
     light = (masses != 0) & (masses <= least_mass)
-    return light | (diagonal.any(axis=1) & (gershgorin.min(axis=1, initial=np.inf) <= least_inertia))
+    doubtful = diagonal.any(axis=1) & (gershgorin.min(axis=1, initial=np.inf) <= least_inertia)
+    if doubtful.any():
+        doubtful[doubtful] = np.linalg.eigvalsh(tensors[doubtful])[:, 0] <= SURE_INERTIA * least_inertia
+    return light | doubtful
 
 
 def _body_mass_kept(body: Rigid, least_mass: float, least_inertia: float) -> Rigid:

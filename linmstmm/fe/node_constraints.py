@@ -15,6 +15,7 @@ predicting mesh (two or more) of one model object share one such elimination
 """
 from __future__ import annotations
 
+import dataclasses
 import functools
 from dataclasses import dataclass
 
@@ -69,6 +70,24 @@ class NodeConstraints:
     spring_stiffness: list
     rigid_mass: _Triplets
     elimination: tuple | None
+
+    def with_masses_of(self, model: Model) -> NodeConstraints:
+        """These constraints with the rigid masses of ``model``: the same model but for
+        its masses (:func:`~linmstmm.fe.masses._negligible_mass_removed`), on which
+        nothing else here depends.
+
+        Parameters
+        ----------
+        model : Model
+            The model these were made of, its masses changed.
+
+        Returns
+        -------
+        NodeConstraints
+        """
+        mass = _Triplets(repeats=True)
+        _add_rigid_masses(model, self.layout, mass)
+        return dataclasses.replace(self, rigid_mass=mass)
 
     def eliminated(self, beam_rows: _Triplets, n_full: int) -> tuple[sp.csr_matrix, np.ndarray]:
         """The elimination of a mesh's constraints: the same arrays as eliminating them anew.

@@ -47,10 +47,10 @@ def _components(edges: np.ndarray, n_nodes: int) -> np.ndarray:
     root = np.arange(n_nodes)
     while True:
         a, b = root[edges[:, 0]], root[edges[:, 1]]
-        if np.array_equal(a, b):
+        if (a == b).all():
             return np.unique(root, return_inverse=True)[1]
         np.minimum.at(root, np.maximum(a, b), np.minimum(a, b))
-        while not np.array_equal(root[root], root):
+        while not (root[root] == root).all():
             root = root[root]
 
 
@@ -218,12 +218,12 @@ def _held_everywhere(model, layout) -> bool:
     rows are unit upper triangular on its segment's motions (their least singular
     value above 1/3, far above REDUNDANT_CONSTRAINT of the largest), and further
     rows only add rank."""
-    clamped = [layout.index.points[point] for point, fixed in model.boundary.items() if np.all(fixed)]
+    clamped = [layout.index.points[point] for point, fixed in model.boundary.items() if all(fixed)]
     if not clamped:
         return False
     edges, joints = _edges(model, layout)
     segments = _components(edges[~joints], layout.n_nodes)
-    return np.unique(segments[clamped]).size == segments.max() + 1
+    return bool(np.bincount(segments[clamped], minlength=segments.max() + 1).all())
 
 
 def _kinetic_directions(motions, M, weight):

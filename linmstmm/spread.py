@@ -47,7 +47,7 @@ def cores() -> int:
     return os.cpu_count() or 1  # pragma: no cover - systems without affinity
 
 
-def spread(task, size: int) -> None:
+def spread(task, size: int, min_batch: int = MIN_BATCH) -> None:
     """Call ``task(start, stop)`` over consecutive pieces covering range(size), on this
     thread and on up to ``cores() - 1`` others.
 
@@ -59,13 +59,17 @@ def spread(task, size: int) -> None:
         threads to run side by side (a ``nogil`` kernel).
     size : int
         Number of items.
+    min_batch : int
+        Items below which the batch stays on the calling thread, and per two of
+        which a thread joins in (MIN_BATCH suits items that cost about one
+        evaluation of det Ū_all; cheaper items want more).
 
     Raises
     ------
     Exception
         Whatever a piece raised (the first one met).
     """
-    threads = min(cores(), size // (MIN_BATCH // 2)) if size >= MIN_BATCH else 1
+    threads = min(cores(), size // (min_batch // 2)) if size >= min_batch else 1
     if threads <= 1:
         task(0, size)
         return

@@ -80,6 +80,14 @@ SINGULAR_PIVOT = 1e-12
 #: 1.2e-11 counts 2 negative eigenvalues where there is 1 (tests/test_sparse_count.py).
 MOST_GROWTH = 1e2
 
+#: Counts below which a batch stays on the calling thread (:func:`linmstmm.spread.spread`):
+#: a compiled count costs about a third of an evaluation of det Ū_all, so handing one to
+#: another thread pays three times later. Measured side by side on the launchers (their
+#: 20 to 23 counts) and the 18 firing scenes (14 a scene): spread from 8 counts, a solve
+#: of the ten lowest took 4.3-4.8 and 6.4-7.0 ms and the scenes 125-128 ms; from 24,
+#: 3.8 and 5.9 ms and 110 ms, as on one thread.
+COUNT_BATCH = 24
+
 #: Frequencies whose D(ω) the numpy engine forms at once (:meth:`ModeCounter.prefetch`):
 #: one at a time, forming D(ω) took 176 of the 308 µs of a count on the launcher.
 NUMPY_BATCH = 64
@@ -196,7 +204,7 @@ class ModeCounter:
             for i in range(start, stop):
                 counts[i] = self._kernel_count(wanted[i], scratch)
 
-        spread(count_piece, len(wanted))
+        spread(count_piece, len(wanted), COUNT_BATCH)
         self._answers.update((omega, None if count < 0 else int(count)) for omega, count in zip(wanted, counts))
 
     def _compiled(self, omega: float) -> int | None:

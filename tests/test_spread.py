@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import multiprocessing
 import threading
+import time
 
 import numpy as np
 import pytest
@@ -24,6 +25,21 @@ def test_every_item_once(monkeypatch, cores, size):
 
     spread.spread(task, size)
     assert np.all(seen == 1)
+
+
+@pytest.mark.parametrize("size, min_batch, threaded", [(20, 24, False), (24, 24, True), (7, 8, False), (8, 8, True)])
+def test_a_batch_below_its_minimum_stays_on_the_calling_thread(monkeypatch, size, min_batch, threaded):
+    """Cheap items (the Wittrick–Williams counts) are shared only from a larger batch:
+    below ``min_batch`` every piece runs on the calling thread."""
+    monkeypatch.setattr(spread, "cores", lambda: 2)
+    callers = set()
+
+    def task(start, stop):
+        callers.add(threading.get_ident())
+        time.sleep(0.01)  # long enough for the other thread to claim a piece
+
+    spread.spread(task, size, min_batch)
+    assert (callers != {threading.get_ident()}) == threaded
 
 
 def test_a_piece_that_fails_raises_in_the_caller(monkeypatch):

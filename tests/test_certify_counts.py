@@ -93,3 +93,22 @@ def test_a_certified_last_step_does_not_widen_the_count():
     finder.last_step = {off: 7.3e-10}
     assert certify.stiffness_other_zeros(finder, [10.0, off, 30.0], None, 35.0) == 0
     assert finder.last_step[off] == pytest.approx(1e-8)
+
+
+def test_a_root_float64_could_not_certify_is_placed_by_bisection_on_the_count():
+    """True root 20, float64 put it 5e-9 high and the counts made its last step 1e-8:
+    bisection on J(ω) from ±4e-8 puts it within the rtol of 1e-9 and certifies that
+    as its last step; a root with a neighbour inside the bracket, and a double root,
+    are left for mpmath."""
+    finder = KnownSpectrum([10.0, 20.0, 30.0])
+    off = 20.0 * (1 + 5e-9)
+    finder.last_step = {10.0: 1e-13, off: 1e-8, 30.0: 1e-13}
+    placed = certify.placed_by_counts(finder, [10.0, off, 30.0])
+    assert placed[0] == 10.0 and placed[2] == 30.0
+    assert abs(placed[1] / 20.0 - 1) <= 1e-9 and finder.last_step[placed[1]] <= 1e-9
+    crowded = KnownSpectrum([10.0, 20.0, 20.0 * (1 + 2e-8)])
+    crowded.last_step = {off: 1e-8}
+    assert certify.placed_by_counts(crowded, [10.0, off, 20.0 * (1 + 2e-8)])[1] == off
+    double = KnownSpectrum([10.0, 20.0, 20.0])
+    double.last_step = {off: 1e-8}
+    assert certify.placed_by_counts(double, [10.0, off, off]) == [10.0, off, off]

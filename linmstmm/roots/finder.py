@@ -210,7 +210,7 @@ class RootFinder:
             search's diagnostics, frozen.
         """
         self.note = ""
-        return self._search_result(self._near(guesses, count))
+        return self._search_result(self._placed_by_counts(self._near(guesses, count)))
 
     def _near(self, guesses, count: int) -> list[float]:
         """The roots :meth:`find_near` returns, as a list (rad/s)."""
@@ -244,7 +244,7 @@ class RootFinder:
             search on this finder does not change them.
         """
         self.note = ""
-        return self._search_result(self._found(count, omega_max))
+        return self._search_result(self._placed_by_counts(self._found(count, omega_max)))
 
     def _found(self, count: int | None, omega_max: float | None) -> list[float]:
         """The roots :meth:`find` returns, as a list (rad/s)."""
@@ -328,6 +328,7 @@ class RootFinder:
     stiffness_count = certify.stiffness_count
     stiffness_other_zeros = certify.stiffness_other_zeros
     counted_multiplicities = certify.counted_multiplicities
+    _placed_by_counts = certify.placed_by_counts
 
     # the fast path: scan ahead, polish, close by one count (:mod:`linmstmm.roots.fast_path`)
     _scan_ahead = fast_path.scan_ahead

@@ -28,11 +28,10 @@ from linmstmm.determinant import determinant, kernels_loaded, resolved_engine
 from linmstmm.model import Model
 from linmstmm.model_structure import forget_structures
 from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
-from linmstmm.program import forget_layouts
 from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.roots.settings import FLOOR_RATIO
 from linmstmm.topology import build_topology
-from linmstmm.wittrick_williams import ModeCounter, forget_plans, mode_counter
+from linmstmm.wittrick_williams import ModeCounter, mode_counter
 
 #: Model objects whose compiled systems are kept (least recently used dropped first).
 MODELS_KEPT = 8
@@ -125,6 +124,4 @@ def forget_compiled_models() -> None:
     compiles it anew, as in a new process (the benchmarks time first solves so)."""
     _compiled.cache_clear()
     coarse_pencil.cache_clear()
-    forget_layouts()
-    forget_plans()
-    forget_structures()
+    forget_structures()  # the program walks, count plans and all else kept by structure

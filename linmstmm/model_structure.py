@@ -4,7 +4,7 @@ A parameter study's models (:func:`linmstmm.parameters.with_values`) differ in
 their numbers only: the same points, elements, ends and ports, releases and
 boundary. :func:`structure_of` names that structure (a hashable tuple), and a
 :class:`KeptByStructure` keeps what a computation derived from the structure
-alone, so that the next model of the same structure takes it instead of
+alone (a :class:`KeptByKey`, which keeps by any key, for what depends on more), so that the next model of the same structure takes it instead of
 deriving it again. :func:`forget_structures` drops everything kept
 (:func:`linmstmm.compiled_model.forget_compiled_models` calls it).
 """
@@ -51,7 +51,56 @@ def structure_of(model: Model) -> tuple:
     return tuple(model.points), tuple(elements), boundary
 
 
-class KeptByStructure:
+class KeptByKey:
+    """What a computation derived, kept by a hashable key for the last ``kept`` keys
+    (least recently used dropped first); :func:`forget_structures` forgets it.
+
+    Parameters
+    ----------
+    kept : int
+        Keys kept.
+    """
+
+    def __init__(self, kept: int):
+        self.kept = kept
+        self._kept: dict = {}
+        _everything_kept.append(self)
+
+    def __contains__(self, key) -> bool:
+        return key in self._kept
+
+    def __len__(self) -> int:
+        return len(self._kept)
+
+    def value(self, key, derive):
+        """What ``derive()`` gives, derived on the first call with ``key`` kept.
+
+        Parameters
+        ----------
+        key : hashable
+            What the value depends on alone.
+        derive : callable
+            () -> the value.
+
+        Returns
+        -------
+        object
+            The kept value (the same object for every call with ``key``).
+        """
+        if key in self._kept:
+            self._kept[key] = value = self._kept.pop(key)  # now the most recently used
+            return value
+        value = self._kept[key] = derive()
+        if len(self._kept) > self.kept:
+            del self._kept[next(iter(self._kept))]
+        return value
+
+    def clear(self) -> None:
+        """Forget every key kept."""
+        self._kept.clear()
+
+
+class KeptByStructure(KeptByKey):
     """What one computation derived from a model's structure, kept for the last
     ``kept`` structures (least recently used dropped first).
 
@@ -60,11 +109,6 @@ class KeptByStructure:
     kept : int
         Structures kept.
     """
-
-    def __init__(self, kept: int):
-        self.kept = kept
-        self._kept: dict[tuple, object] = {}
-        _everything_kept.append(self)
 
     def get(self, model: Model, derive):
         """What ``derive(model)`` gives, derived on the first model of this structure.
@@ -81,21 +125,10 @@ class KeptByStructure:
         object
             The kept value (the same object for every model of the structure).
         """
-        key = structure_of(model)
-        if key in self._kept:
-            self._kept[key] = value = self._kept.pop(key)  # now the most recently used
-            return value
-        value = self._kept[key] = derive(model)
-        if len(self._kept) > self.kept:
-            del self._kept[next(iter(self._kept))]
-        return value
-
-    def clear(self) -> None:
-        """Forget every structure kept."""
-        self._kept.clear()
+        return self.value(structure_of(model), lambda: derive(model))
 
 
-_everything_kept: list[KeptByStructure] = []
+_everything_kept: list[KeptByKey] = []
 
 
 def forget_structures() -> None:

@@ -25,6 +25,7 @@ import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import _state_rotation
+from linmstmm.model_structure import KeptByKey
 from linmstmm.program_constants import Constants
 from linmstmm.program_record import (BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, ROW_BLOCK, STATE_BLOCK, TIP,
                                      Program)
@@ -146,14 +147,9 @@ def compile_program(deduction: Deduction) -> Program:
     Program
     """
     structure = _structure(deduction)
-    if structure in _layouts:
-        _layouts[structure] = layout = _layouts.pop(structure)  # now the most recently used
-        return _revalued(layout, deduction)
-    layout = _planned(deduction)
-    _layouts[structure] = layout
-    if len(_layouts) > LAYOUTS_KEPT:
-        del _layouts[next(iter(_layouts))]
-    return layout.program
+    walked = structure not in _layouts
+    layout = _layouts.value(structure, lambda: _planned(deduction))
+    return layout.program if walked else _revalued(layout, deduction)
 
 
 @dataclass(frozen=True)
@@ -171,12 +167,7 @@ class _Layout:
 
 #: Walks kept by structure (:func:`compile_program`), least recently used dropped first.
 LAYOUTS_KEPT = 8
-_layouts: dict[tuple, _Layout] = {}
-
-
-def forget_layouts() -> None:
-    """Drop every walk kept: the next compile of any model walks its carry anew."""
-    _layouts.clear()
+_layouts = KeptByKey(LAYOUTS_KEPT)
 
 
 def _structure(deduction: Deduction) -> tuple:

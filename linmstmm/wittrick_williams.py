@@ -50,6 +50,7 @@ from linmstmm.fe.products import (
 )
 from linmstmm.fe.sparse import compressed_rows
 from linmstmm.model import Model
+from linmstmm.model_structure import KeptByKey
 from linmstmm.spread import spread
 
 #: Largest order of D(ω) counted: its dense factorisation grows as n³ (72 unknowns:
@@ -305,21 +306,24 @@ def sparse_plan(static: np.ndarray, mass: np.ndarray, maps: np.ndarray, columns:
 #: Elimination plans kept by their pattern (:func:`_planned`): a parameter study's models
 #: share one, whose minimum-degree order took 0.25-0.35 ms of a launcher counter's build.
 PLANS_KEPT = 8
-_plans: dict[bytes, tuple] = {}
+_plans = KeptByKey(PLANS_KEPT)
 
 
 def _planned(pattern: np.ndarray, beam_pattern: np.ndarray, columns: np.ndarray) -> tuple:
     """(:class:`~linmstmm.ordered_ldlt.EliminationPlan`, beam_slots) of D(ω)'s pattern:
     ``pattern`` (n, n) bool, the springs' and bodies' entries; ``beam_pattern``
     (n_beams, k, k) bool, the entries of each beam's ``columns`` its stiffness reaches
-    (see :func:`sparse_plan`). Kept for the last PLANS_KEPT patterns (:func:`forget_plans`)."""
-    from linmstmm.ordered_ldlt import elimination_plan
-
+    (see :func:`sparse_plan`). Kept for the last PLANS_KEPT patterns
+    (:func:`linmstmm.model_structure.forget_structures` forgets them)."""
     key = b"".join(np.ascontiguousarray(part).tobytes() for part in (pattern, beam_pattern, columns))
     key += repr((pattern.shape, beam_pattern.shape)).encode()
-    if key in _plans:
-        _plans[key] = _plans.pop(key)  # most recently used last
-        return _plans[key]
+    return _plans.value(key, lambda: _plan_of(pattern, beam_pattern, columns))
+
+
+def _plan_of(pattern: np.ndarray, beam_pattern: np.ndarray, columns: np.ndarray) -> tuple:
+    """:func:`_planned` made anew."""
+    from linmstmm.ordered_ldlt import elimination_plan
+
     n = pattern.shape[0]
     i, j = np.broadcast_arrays(columns[:, :, None], columns[:, None, :])
     present = beam_pattern & (i < n) & (j < n)
@@ -328,15 +332,7 @@ def _planned(pattern: np.ndarray, beam_pattern: np.ndarray, columns: np.ndarray)
     pattern |= pattern.T
     plan = elimination_plan(pattern)
     placed = np.where(present, plan.slot_of(np.minimum(i, n - 1), np.minimum(j, n - 1)), -1)
-    _plans[key] = plan, np.where(present & (i < j), placed + plan.high.size, placed)
-    while len(_plans) > PLANS_KEPT:
-        del _plans[next(iter(_plans))]
-    return _plans[key]
-
-
-def forget_plans() -> None:
-    """Drop every elimination plan kept (:func:`_planned`)."""
-    _plans.clear()
+    return plan, np.where(present & (i < j), placed + plan.high.size, placed)
 
 
 def _beam_maps(parts) -> tuple[np.ndarray, np.ndarray]:

@@ -63,7 +63,7 @@ def test_a_program_with_new_numbers_is_the_program_a_fresh_walk_writes(model):
         reused = program._structure(deduction) in program._layouts
         assert reused == (program._structure(deduction) == program._structure(_deduced(model)))
         kept = program.compile_program(deduction)
-        program.forget_layouts()
+        program._layouts.clear()
         fresh = program.compile_program(_deduced(edited))
         program.compile_program(_deduced(model))
         for field in dataclasses.fields(fresh):

@@ -142,10 +142,14 @@ def coarse_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
 @functools.lru_cache(maxsize=PENCILS_KEPT)
 def _pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
     """:func:`coarse_pencil` made anew."""
+    from linmstmm.determinant import kernels_loaded
     from linmstmm.fe.assembly import assembled
     from linmstmm.fe.rigid_motions import rigid_mode_count
 
-    fe = assembled(model, elements_per_beam, kept_node_constraints)
+    forms = None
+    if kernels_loaded():  # compiled products where numba is loaded already: the same K and M
+        from linmstmm._product_kernels import pencil_forms as forms
+    fe = assembled(model, elements_per_beam, kept_node_constraints, forms)
     K, M = (matrix if isinstance(matrix, np.ndarray) else matrix.toarray() for matrix in (fe.K, fe.M))
     size = np.where(np.diag(M) > 0, np.diag(M), np.abs(np.diag(K)))
     scale = 1 / np.sqrt(np.where(size > 0, size, 1.0))

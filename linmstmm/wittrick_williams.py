@@ -126,13 +126,8 @@ class ModeCounter:
     def __init__(self, model: Model, engine: str = "auto"):
         self.engine = resolved_engine(engine)
         parts = counter_parts(model)  # its elimination kept by the model's structure where it can be
-        T, n = parts.T, parts.T.shape[1]
-        # dense, each entry summed as scipy.sparse sums it (linmstmm.fe.products)
-        springs = compressed_rows(dense_product(parts.spring_strains.compressed(parts.n_full), T))
-        stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
-        self.n_dof = n
-        self._static = dense_product(transposed(springs), rows_scaled(springs, stiffness))
-        self._mass = congruence(T, parts.rigid_mass.compressed(parts.n_full, parts.n_full))
+        self.n_dof = parts.T.shape[1]
+        self._static, self._mass = _reduced_terms(parts, self.engine)
         self._beams = BeamTable.of(model.beams)
         self._maps, self._columns = _beam_maps(parts)
         self._answers: dict[float, int | None] = {}
@@ -333,6 +328,26 @@ def _plan_of(pattern: np.ndarray, beam_pattern: np.ndarray, columns: np.ndarray)
     plan = elimination_plan(pattern)
     placed = np.where(present, plan.slot_of(np.minimum(i, n - 1), np.minimum(j, n - 1)), -1)
     return plan, np.where(present & (i < j), placed + plan.high.size, placed)
+
+
+def _reduced_terms(parts, engine: str) -> tuple[np.ndarray, np.ndarray]:
+    """(n, n) springs' stiffness (N/m, N m/rad) and bodies' mass (kg, kg m²) on the
+    reduced DOFs of ``parts`` (:class:`~linmstmm.fe.assembly.ConstrainedParts`), dense,
+    each entry summed as scipy.sparse sums it: by :mod:`linmstmm.fe.products`, or by
+    the compiled :mod:`linmstmm._product_kernels` for the compiled ``engine`` (the
+    same numbers in one call each)."""
+    T, n = parts.T, parts.T.shape[1]
+    strains = parts.spring_strains.compressed(parts.n_full)
+    stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
+    mass = parts.rigid_mass.compressed(parts.n_full, parts.n_full)
+    if engine == "compiled":
+        from linmstmm import _product_kernels as kernels  # numba: imported where a count is compiled
+
+        return (kernels.ordered_gram(strains.indptr, strains.indices, strains.data, T.indptr, T.indices, T.data,
+                                     stiffness, n, False),
+                kernels.ordered_congruence(T.indptr, T.indices, T.data, mass.indptr, mass.indices, mass.data, n))
+    springs = compressed_rows(dense_product(strains, T))
+    return dense_product(transposed(springs), rows_scaled(springs, stiffness)), congruence(T, mass)
 
 
 def _beam_maps(parts) -> tuple[np.ndarray, np.ndarray]:

@@ -7,6 +7,11 @@ through scipy.sparse, bit for bit.
   made from the assembly formed entirely by scipy.sparse (every product forced
   sparse), and its rigid-body count equals the number of rigid-body modes the FE
   route forms (:func:`~linmstmm.fe.assembly.assemble`).
+* The same models with the products formed by the compiled kernels
+  (:mod:`linmstmm._product_kernels`): the assembly's K and M at one, two and three
+  elements per beam, and the Wittrick–Williams counter's springs' stiffness and
+  bodies' mass, equal the numpy route's (:mod:`linmstmm.fe.products`, itself
+  checked against scipy.sparse) bit for bit.
 * A body whose inertia Gershgorin's bound cannot clear is looked at only where
   its least principal inertia is not clearly above the negligible one: every
   body the one-call screen passes over is returned unchanged by the full
@@ -26,6 +31,7 @@ from builders import BUNDLED_MODELS, make_rigid
 from random_models import KINDS, random_model, random_rotation
 from varied_models import varied_model
 
+from linmstmm._product_kernels import pencil_forms
 from linmstmm.coarse_prediction import coarse_pencil
 from linmstmm.fe import products
 from linmstmm.fe.assembly import assemble, assembled
@@ -35,8 +41,11 @@ from linmstmm.fe.masses import (
     _negligible_mass_removed,
 )
 from linmstmm.fe.node_constraints import kept_node_constraints
+from linmstmm.fe.products import small
+from linmstmm.fe.sparse import scipy_csr
 from linmstmm.model import load_model
-from linmstmm.wittrick_williams import ModeCounter
+from linmstmm.counter_parts import counter_parts
+from linmstmm.wittrick_williams import ModeCounter, _reduced_terms
 
 MODELS = {path.stem: (lambda path=path: load_model(path)) for path in BUNDLED_MODELS}
 MODELS |= {f"{kind} {seed}": (lambda kind=kind, seed=seed: random_model(kind, seed))
@@ -68,6 +77,21 @@ def test_pencil_is_the_sparse_assemblys(name, monkeypatch):
         assert np.array_equal(pencil.K, K) and np.array_equal(pencil.M, M) and np.array_equal(pencil.scale, scale)
         assert pencil.rigid_body_modes == assemble(model, n).rigid_modes.shape[1]
     coarse_pencil.cache_clear()
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_compiled_products_are_the_numpy_route_s(name):
+    model = MODELS[name]()
+    for n in (1, 2, 3):
+        compiled, reference = assembled(model, n, forms=pencil_forms), assembled(model, n)
+        formed = small(compiled.parts.T.shape[1], compiled.parts.n_full)     # by the kernels, else by scipy
+        assert (compiled.G is None) == formed and (formed or n > 1)
+        K, M = (matrix if isinstance(matrix, np.ndarray) else matrix.toarray() for matrix in (reference.K, reference.M))
+        assert np.array_equal(scipy_csr(compiled.K).toarray(), K) and np.array_equal(scipy_csr(compiled.M).toarray(), M)
+        assert np.array_equal(compiled.D, reference.D)
+    parts = counter_parts(model)
+    for ours, theirs in zip(_reduced_terms(parts, "compiled"), _reduced_terms(parts, "numpy")):
+        assert np.array_equal(ours, theirs)
 
 
 def test_inertia_screen_passes_over_only_bodies_left_unchanged():

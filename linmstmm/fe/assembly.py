@@ -195,7 +195,8 @@ class Assembly:
     M, K : (n_dof, n_dof) symmetric bit for bit: mass (kg, kg m²) and stiffness
         (N/m, N m/rad); dense numpy arrays where formed densely, scipy CSR otherwise
         (:func:`~linmstmm.fe.sparse.scipy_csr` makes either CSR).
-    G, D : natural factor ``K = G.T @ diag(D) @ G``: G (n_strain, n_dof) scipy CSR,
+    G, D : natural factor ``K = G.T @ diag(D) @ G``: G (n_strain, n_dof) scipy CSR
+        (None where M and K were formed by a caller's ``forms``, which need no G),
         D (n_strain,).
     """
 
@@ -203,11 +204,11 @@ class Assembly:
     parts: ConstrainedParts
     M: np.ndarray | sp.csr_matrix
     K: np.ndarray | sp.csr_matrix
-    G: sp.csr_matrix
+    G: sp.csr_matrix | None
     D: np.ndarray
 
 
-def assembled(model: Model, elements_per_beam: int, constraints_of=node_constraints) -> Assembly:
+def assembled(model: Model, elements_per_beam: int, constraints_of=node_constraints, forms=None) -> Assembly:
     """The :class:`Assembly` of ``model`` with ``elements_per_beam`` (int >= 1) equal
     elements per beam; ``constraints_of`` (Model -> NodeConstraints) gives the
     constraints of its nodes (made anew by default, the kept ones of
@@ -217,7 +218,12 @@ def assembled(model: Model, elements_per_beam: int, constraints_of=node_constrai
 
     M = Tᵀ M_full T and K = (Gᵀ D) G are formed densely where their dense
     intermediate (n_dof × n_full) is small (:func:`linmstmm.fe.products.small`), by
-    scipy.sparse otherwise: the same matrices bit for bit either way.
+    scipy.sparse otherwise: the same matrices bit for bit either way. Where small,
+    ``forms`` (T, M_full, S, D) -> (Tᵀ M_full T, Gᵀ D G) dense, G = S T, with T
+    (n_full, n_dof) scipy CSR and M_full, S the CSR :class:`~linmstmm.fe.sparse.Compressed`
+    full mass and strain rows, may form them instead of :mod:`linmstmm.fe.products`:
+    the same numbers required (the coarse predictions pass compiled ones), and G is
+    then not formed.
     """
     light = _negligible_mass_removed(model)
     nodes = constraints_of(model)       # the model's own (kept ones shared with its counter)
@@ -230,9 +236,12 @@ def assembled(model: Model, elements_per_beam: int, constraints_of=node_constrai
     strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
     stiffness += parts.spring_stiffness
 
-    G = (strains.matrix(n_full) @ T).tocsr()
     D = np.concatenate(stiffness) if stiffness else np.zeros(0)
     mass = mass.compressed(n_full, n_full)
+    if forms is not None and small(T.shape[1], n_full):
+        M, K = forms(T, mass, strains.compressed(n_full), D)
+        return Assembly(model, parts, _symmetric_of_dense(M), _symmetric_of_dense(K), None, D)
+    G = (strains.matrix(n_full) @ T).tocsr()
     weighted = transposed(G, D)                 # Gᵀ diag(D), G's own arrays
     if small(T.shape[1], n_full):
         M, K = (_symmetric_of_dense(product) for product in (congruence(T, mass), dense_product(weighted, G)))

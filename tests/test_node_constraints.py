@@ -5,6 +5,10 @@
   constraints from the start gives, bit for bit, on the launchers, random
   models and models whose beams declare directions rigid (which are always
   eliminated mesh by mesh);
+* where every constraint is a fixed component of a point no body owns, the
+  nodes' T is the port map without those columns, the arrays the general
+  elimination gives (on the launchers and the random models of that kind; the
+  others are eliminated the general way);
 * the Wittrick–Williams counter and the coarse predicting mesh of one model
   object eliminate its nodes' constraints once, and forgetting the compiled
   models forgets that elimination too.
@@ -22,7 +26,8 @@ from linmstmm.coarse_prediction import coarse_pencil
 from linmstmm.compiled_model import forget_compiled_models
 from linmstmm.fe.assembly import _add_beam_constraints
 from linmstmm.fe.layout import _beam_axes, _layout, _Triplets, element_maps
-from linmstmm.fe.node_constraints import kept_node_constraints, node_constraints
+from linmstmm.fe import node_constraints as node_module
+from linmstmm.fe.node_constraints import _held_dropped, kept_node_constraints, node_constraints
 from linmstmm.model import load_model
 from linmstmm.wittrick_williams import mode_counter
 
@@ -55,6 +60,27 @@ def test_meshes_extend_the_nodes_elimination_exactly(name):
         assert T.shape == reference.shape and np.array_equal(masters, reference_masters)
         for ours, theirs in ((T.indptr, reference.indptr), (T.indices, reference.indices), (T.data, reference.data)):
             assert ours.dtype == theirs.dtype and np.array_equal(ours, theirs)
+
+
+def test_fixed_components_alone_are_dropped_as_the_general_elimination_drops_them(monkeypatch):
+    kinds = set()
+    for name, make in MODELS.items():
+        model = make()
+        nodes = node_constraints(model)
+        dropped = _held_dropped(nodes.port_map, nodes.kept, nodes.rows)
+        kinds.add(dropped is not None)
+        if dropped is None or nodes.elimination is None:
+            continue
+        with monkeypatch.context() as patched:
+            patched.setattr(node_module, "_held_dropped", lambda *parts: None)
+            reference, reference_masters = node_constraints(model).elimination
+        T, masters = nodes.elimination
+        assert T.shape == reference.shape and np.array_equal(masters, reference_masters)
+        for ours, theirs in ((T.indptr, reference.indptr), (T.indices, reference.indices), (T.data, reference.data)):
+            assert ours.dtype == theirs.dtype and np.array_equal(ours, theirs)
+    assert kinds == {True, False}
+    launcher = node_constraints(MODELS["launcher"]())
+    assert _held_dropped(launcher.port_map, launcher.kept, launcher.rows) is not None
 
 
 def test_models_with_rigid_beam_directions_are_eliminated_per_mesh():

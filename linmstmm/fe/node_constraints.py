@@ -141,10 +141,38 @@ def node_constraints(model: Model) -> NodeConstraints:
     rows = constraints.compressed(n_full)
     elimination = None
     if all(beam.axial and beam.torsion for beam in model.beams):
-        t0_csr = scipy_csr(t0)
-        t1, masters = _eliminate(reduced_constraints(rows, t0_csr))
-        elimination = ((t0_csr @ scipy_csr(t1)).tocsr(), kept[masters])
+        elimination = _held_dropped(t0, kept, rows)
+        if elimination is None:
+            t0_csr = scipy_csr(t0)
+            t1, masters = _eliminate(reduced_constraints(rows, t0_csr))
+            elimination = ((t0_csr @ scipy_csr(t1)).tocsr(), kept[masters])
     return NodeConstraints(layout, n_full, t0, kept, rows, strains, stiffness, mass, elimination)
+
+
+def _held_dropped(t0: Compressed, kept: np.ndarray, rows: Compressed) -> tuple[sp.csr_matrix, np.ndarray] | None:
+    """The elimination of :func:`node_constraints` where every constraint row is one
+    entry on a DOF the port map ``t0`` keeps as it is (a fixed component of a point no
+    body owns): those DOFs are dropped and every other kept, T is ``t0`` without their
+    columns. The arrays scipy's ``t0 @ T1`` stores (:func:`~linmstmm.fe.constraints._eliminate`
+    makes each such row a slave with no masters): each entry ``v · 1.0``, which is v,
+    zeros left out, each row's columns in the reverse of the order the product met
+    them. None where a row is of another kind."""
+    dofs, first = rows.indices, t0.indptr[rows.indices]
+    if np.any(np.diff(rows.indptr) != 1) or np.any(t0.indptr[dofs + 1] - first != 1) or np.any(t0.data[first] != 1.0):
+        return None
+    n_full, held = t0.shape[0], np.zeros(t0.shape[1], bool)
+    held[t0.indices[first]] = True
+    column = np.cumsum(~held) - 1
+    entries = np.flatnonzero(~held[t0.indices] & (t0.data != 0))
+    line = np.repeat(np.arange(n_full), np.diff(t0.indptr))[entries]
+    indptr = np.zeros(n_full + 1, int)
+    np.cumsum(np.bincount(line, minlength=n_full), out=indptr[1:])
+    place = indptr[line + 1] - 1 - (np.arange(len(entries)) - indptr[line])      # reversed within the row
+    indices, data = np.empty(len(entries), int), np.empty(len(entries))
+    indices[place], data[place] = column[t0.indices[entries]], t0.data[entries]
+    shape = (n_full, int(np.count_nonzero(~held)))
+    index = np.int32 if max(shape[1], len(data)) < 2 ** 31 else np.int64
+    return sp.csr_matrix((data, indices.astype(index), indptr.astype(index)), shape=shape), kept[~held]
 
 
 #: :func:`node_constraints` kept per model object (a Model cannot change): made on the

@@ -28,7 +28,7 @@ import numpy as np
 from linmstmm.fe.assembly import ConstrainedParts, constrained_parts
 from linmstmm.fe.layout import _beam_axes, _layout, _Triplets, element_maps
 from linmstmm.fe.node_constraints import _add_rigid_masses, _add_springs, _port_kinematics, kept_node_constraints
-from linmstmm.fe.sparse import _sorted_rows, scipy_csr
+from linmstmm.fe.sparse import Compressed, _sorted_rows
 from linmstmm.model import Model
 from linmstmm.model_structure import KeptByStructure
 
@@ -68,13 +68,14 @@ class _Elimination:
             self._springs[:] = records, (strains, stiffness)
         return self._springs[1]
 
-    def T(self, positions: np.ndarray):
-        """(n_full, n_dof) scipy CSR elimination of a model whose nodes sit at ``positions``
-        ((n_nodes, 3) m): the entries scipy's product T0 T1 stores (exact zeros left out)."""
+    def T(self, positions: np.ndarray) -> Compressed:
+        """(n_full, n_dof) CSR elimination of a model whose nodes sit at ``positions``
+        ((n_nodes, 3) m): the entries scipy's product T0 T1 stores (exact zeros left out),
+        columns ascending in each row."""
         values = np.concatenate([np.ones(self.unit),
                                  _port_kinematics(positions[self.ports], positions[self.centres]).ravel()])[self.order]
         stored = values != 0
-        return scipy_csr(_sorted_rows(self.position[stored], self.cols[stored], values[stored], self.shape))
+        return _sorted_rows(self.position[stored], self.cols[stored], values[stored], self.shape)
 
 
 #: The kept elimination of each structure seen last (None: one of another kind).
@@ -94,9 +95,10 @@ def counter_parts(model: Model) -> ConstrainedParts:
     Returns
     -------
     ConstrainedParts
-        Layout, T (scipy CSR), masters, n_full, spring strains and stiffnesses,
-        rigid masses and beam maps: the same numbers as the full build's, T's
-        entries in ascending columns within each row.
+        Layout, T (scipy CSR, or :class:`~linmstmm.fe.sparse.Compressed` CSR where
+        built on the kept elimination), masters, n_full, spring strains and
+        stiffnesses, rigid masses and beam maps: the same numbers as the full
+        build's, T's entries in ascending columns within each row where kept.
     """
     fresh = []
 
@@ -122,7 +124,7 @@ def _kept_elimination(model: Model, parts: ConstrainedParts) -> _Elimination | N
     bodies = [(body.name, port) for body in model.rigids for port in body.ports]
     owned = {port for _, port in bodies}
     if (len(owned) < len(bodies) or not owned.isdisjoint(model.boundary)
-            or any(np.isinf(spring.k).any() for spring in model.springs)
+            or np.isinf([spring.k for spring in model.springs]).any()
             or not all(beam.axial and beam.torsion for beam in model.beams)):
         return None
     index, (n_full, n_dof) = parts.layout.index, parts.T.shape
@@ -145,6 +147,9 @@ def _kept_elimination(model: Model, parts: ConstrainedParts) -> _Elimination | N
         return None
     elimination = _Elimination(ports, centres, order, position[order], cols[order], unit.size, parts.masters,
                                (n_full, n_dof))
-    kept, full = elimination.T(parts.layout.positions), parts.T.sorted_indices()
-    same = all(np.array_equal(getattr(kept, name), getattr(full, name)) for name in ("indptr", "indices", "data"))
+    kept, full = elimination.T(parts.layout.positions), parts.T
+    lines = np.repeat(np.arange(n_full), np.diff(full.indptr))
+    order = np.argsort(lines * n_dof + full.indices)          # the full build's entries, columns ascending
+    same = (np.array_equal(kept.indptr, full.indptr) and np.array_equal(kept.indices, full.indices[order])
+            and np.array_equal(kept.data, full.data[order]))
     return elimination if same else None

@@ -18,11 +18,9 @@ the test oracle (tests/test_wittrick_williams.py compares them):
   pivoting in the order of a :class:`~linmstmm.ordered_ldlt.EliminationPlan`),
   the same answer wherever it gives one and REFUSED where :func:`count` is to
   decide (a small pivot or growth); tests/test_sparse_count.py compares it with
-  :func:`count` and its factorisation with a dense numpy LDLᵀ;
-* :func:`minimum_degree` — the elimination order of D(ω)'s pattern that
-  :func:`linmstmm.ordered_ldlt.elimination_plan` plans the factorisation in
-  (any order gives the same count; compiled because the plan is made for every
-  compiled counter).
+  :func:`count` and its factorisation with a dense numpy LDLᵀ.
+
+The plan of that factorisation is made by :mod:`linmstmm._ordering_kernels`.
 """
 from __future__ import annotations
 
@@ -416,51 +414,3 @@ def ordered_count(omega, beams, maps, singular_pivot, most_growth, plan, terms, 
         negatives = found
     return clamped + negatives
 
-
-@njit(cache=True)
-def minimum_degree(pattern):
-    """Minimum-degree elimination: at each step the unknown joined to the fewest
-    others left (the lowest index among equals) is eliminated, and the others it
-    is joined to are joined to each other (the fill).
-
-    Parameters
-    ----------
-    pattern : (n, n) int64
-        1 where the symmetric matrix may be nonzero, else 0.
-
-    Returns
-    -------
-    order : (n,) int64
-        The unknowns in the order eliminated.
-    joined : (n, n) int64
-        Row k: 1 at the unknowns k was joined to when it was eliminated (the
-        pattern of its column of L below the diagonal).
-    """
-    n = pattern.shape[0]
-    live = pattern.copy()
-    joined = np.zeros((n, n), dtype=np.int64)
-    degree = np.zeros(n, dtype=np.int64)
-    for i in range(n):
-        live[i, i] = 0
-        for j in range(n):
-            degree[i] += live[i, j]
-    order = np.empty(n, dtype=np.int64)
-    for step in range(n):
-        k = 0
-        for i in range(n):
-            if degree[i] < degree[k]:
-                k = i
-        order[step] = k
-        degree[k] = n + 1  # eliminated: above any degree
-        for i in range(n):
-            joined[k, i] = live[k, i]
-        for i in range(n):
-            if joined[k, i]:
-                live[i, k] = 0
-                for j in range(n):
-                    if joined[k, j] and j != i:
-                        live[i, j] = 1
-                degree[i] = 0
-                for j in range(n):
-                    degree[i] += live[i, j]
-    return order, joined

@@ -18,7 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from linmstmm._stiffness_kernels import minimum_degree
+from linmstmm._ordering_kernels import minimum_degree, plan_slots
 
 
 @dataclass(frozen=True)
@@ -68,7 +68,8 @@ class EliminationPlan:
 
 def elimination_plan(pattern: np.ndarray) -> EliminationPlan:
     """The :class:`EliminationPlan` of the symmetric boolean (n, n) ``pattern`` in
-    its :func:`~linmstmm._stiffness_kernels.minimum_degree` order.
+    its :func:`~linmstmm._ordering_kernels.minimum_degree` order
+    (:func:`~linmstmm._ordering_kernels.plan_slots` lays out its slots).
 
     Parameters
     ----------
@@ -80,19 +81,5 @@ def elimination_plan(pattern: np.ndarray) -> EliminationPlan:
     EliminationPlan
     """
     order, joined = minimum_degree(pattern.astype(np.int64))
-    n = order.size
-    # L's pattern in the elimination order: (step, later step) of each slot, by step then row
-    steps, rows = np.nonzero((joined[np.ix_(order, order)] > 0) | np.eye(n, dtype=bool))
-    starts = np.searchsorted(steps, np.arange(n + 1)).astype(np.int64)
-    lookup = np.full((n, n), -1, dtype=np.int64)
-    lookup[rows, steps] = np.arange(rows.size)
-    # step k's pairs (a, b), b ≤ a, of off-diagonal slots: a - starts[k] of them for each a
-    off = np.flatnonzero(rows != steps)
-    firsts = starts[steps[off]] + 1
-    pairs = off - starts[steps[off]]
-    a = np.repeat(off, pairs)
-    b = np.repeat(firsts, pairs) + np.arange(a.size) - np.repeat(np.cumsum(pairs) - pairs, pairs)
-    updates = np.concatenate([[0], np.cumsum(np.bincount(steps[off], weights=pairs, minlength=n))]).astype(np.int64)
-    first, second = order[rows], order[steps]
-    return EliminationPlan(order=order, starts=starts, rows=rows.astype(np.int64), high=np.maximum(first, second),
-                           low=np.minimum(first, second), updates=updates, targets=lookup[rows[a], rows[b]])
+    starts, rows, high, low, updates, targets = plan_slots(order, joined)
+    return EliminationPlan(order=order, starts=starts, rows=rows, high=high, low=low, updates=updates, targets=targets)

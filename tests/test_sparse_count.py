@@ -6,6 +6,8 @@ References:
 
 * a dense LDLᵀ without pivoting written out in numpy, in the plan's order, for
   the kernel's factorisation (the same numbers, refusals included);
+* the plan's slots and updates derived in numpy from the minimum-degree order
+  (:func:`reference_plan`), for the compiled plan, array for array;
 * LAPACK's symmetric eigenvalues (dsyevd) for every count decided;
 * the dense count (:func:`linmstmm._stiffness_kernels.count`, LAPACK's dsytrf,
   itself compared with the numpy reference in test_wittrick_williams.py) at
@@ -24,6 +26,7 @@ from linmstmm import _stiffness_kernels as kernels
 from linmstmm.dynamic_stiffness import BeamTable, clamped_counts
 from linmstmm.fe import fe_frequencies
 from linmstmm.model import load_model
+from linmstmm._ordering_kernels import minimum_degree
 from linmstmm.ordered_ldlt import elimination_plan
 from linmstmm.wittrick_williams import MOST_GROWTH, SINGULAR_PIVOT, ModeCounter, _block_inertia
 from random_models import KINDS, random_model
@@ -51,6 +54,39 @@ def reference_inertia(matrix, order, singular, most_growth):
         growth[k + 1:] += np.abs(column * multipliers)
         work[k + 1:, k + 1:] -= np.outer(multipliers, column)
     return negatives
+
+
+def reference_plan(pattern):
+    """(starts, rows, high, low, updates, targets) of the elimination plan of ``pattern``
+    derived in numpy from its minimum-degree order: slots step by step (the diagonal,
+    then each later step joined to it), and for each step every pair of its
+    off-diagonal slots (s, t), t <= s, the slot of their rows' entry."""
+    order, joined = minimum_degree(pattern.astype(np.int64))
+    n = order.size
+    steps, rows = np.nonzero((joined[np.ix_(order, order)] > 0) | np.eye(n, dtype=bool))
+    starts = np.searchsorted(steps, np.arange(n + 1))
+    lookup = np.full((n, n), -1)
+    lookup[rows, steps] = np.arange(rows.size)
+    off = np.flatnonzero(rows != steps)
+    pairs = off - starts[steps[off]]
+    a = np.repeat(off, pairs)
+    b = np.repeat(starts[steps[off]] + 1, pairs) + np.arange(a.size) - np.repeat(np.cumsum(pairs) - pairs, pairs)
+    updates = np.concatenate([[0], np.cumsum(np.bincount(steps[off], weights=pairs, minlength=n))])
+    first, second = order[rows], order[steps]
+    return starts, rows, np.maximum(first, second), np.minimum(first, second), updates, lookup[rows[a], rows[b]]
+
+
+def test_compiled_plan_is_the_numpy_derivation():
+    rng = np.random.default_rng(11)
+    patterns = [random_sparse(rng, n, density)[1] for n in (1, 2, 5, 20, 60, 120) for density in (0.02, 0.2, 0.9)]
+    for path in LAUNCHERS:
+        counter = ModeCounter(load_model(path), "compiled")
+        patterns.append((counter._static != 0) | (counter._mass != 0) | np.eye(counter.n_dof, dtype=bool))
+    for pattern in patterns:
+        plan = elimination_plan(pattern)
+        ours = (plan.starts, plan.rows, plan.high, plan.low, plan.updates, plan.targets)
+        for mine, theirs in zip(ours, reference_plan(pattern)):
+            assert mine.dtype == np.int64 and np.array_equal(mine, theirs)
 
 
 def random_sparse(rng, n, density):

@@ -15,8 +15,9 @@ keeps every other: T is the port map T0 (each port following its body's mass
 centre by u_p = u_c + θ × (p − c)) without the fixed columns, its numbers the
 ports' lever arms. :func:`counter_parts` keeps, per such structure, where each
 entry of T comes from, and puts a new model's lever arms into it; the first
-model of a structure is built the full way, and the kept layout must give its
-T entry for entry, or none is kept. On the launcher: 0.16 ms a scene against
+model of a structure is built the full way; the layout is derived from that
+build when a second model of the structure asks (a model solved once never
+needs it), and must give the first model's T entry for entry, or none is kept. On the launcher: 0.16 ms a scene against
 0.5 ms for the full elimination, the counter's matrices the same bit for bit.
 """
 from __future__ import annotations
@@ -78,6 +79,23 @@ class _Elimination:
         return _sorted_rows(self.position[stored], self.cols[stored], values[stored], self.shape)
 
 
+class _FirstBuild:
+    """The kept elimination of a structure of the kind kept, derived from the full build
+    of its first model when a second model of it asks (:func:`_kept_elimination`): a
+    model solved once has no use for it (0.1 ms of the launcher's first counter)."""
+
+    def __init__(self, model: Model, parts: ConstrainedParts):
+        self._first = (model, parts)
+        self._elimination = None
+
+    def elimination(self) -> _Elimination | None:
+        """The :class:`_Elimination`, derived on the first call; None where the layout
+        does not give the first model's T entry for entry."""
+        if self._first is not None:
+            self._elimination, self._first = _kept_elimination(*self._first), None
+        return self._elimination
+
+
 #: The kept elimination of each structure seen last (None: one of another kind).
 _eliminations = KeptByStructure(8)
 
@@ -102,12 +120,13 @@ def counter_parts(model: Model) -> ConstrainedParts:
     """
     fresh = []
 
-    def derived(model: Model) -> _Elimination | None:
+    def derived(model: Model) -> _FirstBuild | None:
         fresh.append(constrained_parts(model, 1, kept_node_constraints(model)))
-        return _kept_elimination(model, fresh[0])
+        return _FirstBuild(model, fresh[0]) if _of_kept_kind(model) else None
 
-    elimination = _eliminations.get(model, derived)
-    if fresh or elimination is None:
+    kept = _eliminations.get(model, derived)
+    elimination = None if fresh or kept is None else kept.elimination()
+    if elimination is None:
         return fresh[0] if fresh else constrained_parts(model, 1, kept_node_constraints(model))
     layout = _layout(model, 1)
     mass = _Triplets(repeats=True)
@@ -117,16 +136,22 @@ def counter_parts(model: Model) -> ConstrainedParts:
                             element_maps(layout.beam_table, _beam_axes(model.beams)))
 
 
+def _of_kept_kind(model: Model) -> bool:
+    """Whether every constraint of ``model``'s structure is a fixed component of a point
+    that no rigid body owns: no point owned by two bodies, no ``inf`` spring direction,
+    no beam rigid axially or in torsion."""
+    ports = [port for body in model.rigids for port in body.ports]
+    owned = set(ports)
+    return (len(owned) == len(ports) and owned.isdisjoint(model.boundary)
+            and not np.isinf([spring.k for spring in model.springs]).any()
+            and all(beam.axial and beam.torsion for beam in model.beams))
+
+
 def _kept_elimination(model: Model, parts: ConstrainedParts) -> _Elimination | None:
-    """The :class:`_Elimination` of ``model``'s structure, checked against its full build
-    ``parts``; None where the structure is not of the kind kept, or the layout does not
-    give ``parts.T`` entry for entry."""
+    """The :class:`_Elimination` of ``model``'s structure (of the kind kept,
+    :func:`_of_kept_kind`), checked against its full build ``parts``; None where the
+    layout does not give ``parts.T`` entry for entry."""
     bodies = [(body.name, port) for body in model.rigids for port in body.ports]
-    owned = {port for _, port in bodies}
-    if (len(owned) < len(bodies) or not owned.isdisjoint(model.boundary)
-            or np.isinf([spring.k for spring in model.springs]).any()
-            or not all(beam.axial and beam.torsion for beam in model.beams)):
-        return None
     index, (n_full, n_dof) = parts.layout.index, parts.T.shape
     ports = np.array([index.points[port] for _, port in bodies], int)
     centres = np.array([index.rigids[name] for name, _ in bodies], int)

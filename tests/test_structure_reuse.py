@@ -69,9 +69,25 @@ def test_a_counter_on_a_kept_elimination_is_the_counter_built_afresh(model):
         assert len(kept) == len(fresh)
         for ours, theirs in zip(kept, fresh):
             assert ours.shape == theirs.shape and np.array_equal(ours, theirs)
-        reused += same and counter_parts._eliminations.get(edited, lambda m: None) is not None
+        layout = counter_parts._eliminations.get(edited, lambda m: None)
+        reused += same and layout is not None and layout.elimination() is not None
     if model.name.startswith("MLRS"):
         assert reused  # the launcher's structure is of the kind kept, and served
+
+
+def test_the_kept_elimination_is_derived_when_a_second_model_asks():
+    """A model solved once leaves its full build behind, not derived; the next model of
+    its structure derives the kept elimination from it and is built on it."""
+    model = load_model(MODELS / "mlrs/mlrs.toml")
+    forget_compiled_models()
+    ModeCounter(model)
+    first = counter_parts._eliminations.get(model, lambda m: None)
+    assert first._first is not None and first._elimination is None
+    edited = next(edit for edit in _edits(model)
+                  if model_structure.structure_of(edit) == model_structure.structure_of(model))
+    ModeCounter(edited)
+    assert first._first is None and first._elimination is not None
+    forget_compiled_models()
 
 
 def test_only_an_elimination_fixed_by_the_structure_is_kept():

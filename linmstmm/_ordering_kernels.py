@@ -6,7 +6,13 @@ Wittrick–Williams counter of a new pattern:
   gives the same count);
 * :func:`plan_slots` — the slots of L's pattern in that order and the updates of
   each elimination step, in one pass where numpy took a dozen calls on (n, n)
-  arrays (60-90 µs of the launchers' first counter build).
+  arrays (60-90 µs of the launchers' first counter build);
+* :func:`pattern_with_beams`, :func:`beam_slots` and :func:`slot_terms` — D(ω)'s
+  pattern with the entries the beams reach, where each beam's entries go among
+  the slots, and the springs' and bodies' terms there
+  (:func:`linmstmm.wittrick_williams.sparse_plan`).
+
+tests/test_sparse_count.py derives each in numpy and compares.
 """
 from __future__ import annotations
 
@@ -117,3 +123,53 @@ def plan_slots(order, joined):
         first, second = order[rows[s]], order[steps[s]]
         high[s], low[s] = max(first, second), min(first, second)
     return starts, rows, high, low, updates, targets
+
+
+@njit(cache=True)
+def pattern_with_beams(pattern, beam_pattern, columns):
+    """(n, n) bool: ``pattern`` (n, n) bool with every entry (columns[b, i], columns[b, j])
+    where ``beam_pattern`` (n_beams, k, k) is True (both below n: n pads), made symmetric."""
+    n = pattern.shape[0]
+    joined = pattern.copy()
+    for b in range(columns.shape[0]):
+        for i in range(columns.shape[1]):
+            for j in range(columns.shape[1]):
+                if beam_pattern[b, i, j] and columns[b, i] < n and columns[b, j] < n:
+                    joined[columns[b, i], columns[b, j]] = True
+    for i in range(n):
+        for j in range(i):
+            either = joined[i, j] or joined[j, i]
+            joined[i, j], joined[j, i] = either, either
+    return joined
+
+
+@njit(cache=True)
+def beam_slots(high, low, beam_pattern, columns, n):
+    """(n_beams, k, k) int64: where entry (i, j) of each beam's map goes among the slots
+    (``high``, ``low``) of a plan of :func:`pattern_with_beams`: its slot in the lower
+    triangle, slots + its slot in the upper one, −1 for padding (a column n) and for
+    entries ``beam_pattern`` leaves out."""
+    lookup = np.full((n, n), -1, dtype=np.int64)
+    for s in range(high.size):
+        lookup[high[s], low[s]] = s
+    placed = np.full(beam_pattern.shape, -1, dtype=np.int64)
+    for b in range(columns.shape[0]):
+        for i in range(columns.shape[1]):
+            for j in range(columns.shape[1]):
+                a, c = columns[b, i], columns[b, j]
+                if beam_pattern[b, i, j] and a < n and c < n:
+                    placed[b, i, j] = lookup[max(a, c), min(a, c)] + (high.size if a < c else 0)
+    return placed
+
+
+@njit(cache=True)
+def slot_terms(static, mass, high, low):
+    """(4, slots): ``static`` and ``mass`` (n, n) at the slots (``high``, ``low``) in the
+    lower triangle, then in the upper one (0.0 on the diagonal)."""
+    terms = np.zeros((4, high.size))
+    for s in range(high.size):
+        i, j = high[s], low[s]
+        terms[0, s], terms[1, s] = static[i, j], mass[i, j]
+        if i > j:
+            terms[2, s], terms[3, s] = static[j, i], mass[j, i]
+    return terms

@@ -56,15 +56,6 @@ class EliminationPlan:
     updates: np.ndarray
     targets: np.ndarray
 
-    def slot_of(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
-        """Slots of the entries (i, j) (original indices, either triangle, same
-        shapes); −1 where an entry is outside L's pattern."""
-        n = self.order.size
-        lookup = np.full((n, n), -1, dtype=np.int64)
-        lookup[self.high, self.low] = np.arange(self.high.size)
-        i, j = np.asarray(i), np.asarray(j)
-        return lookup[np.maximum(i, j), np.minimum(i, j)]
-
 
 def elimination_plan(pattern: np.ndarray) -> EliminationPlan:
     """The :class:`EliminationPlan` of the symmetric boolean (n, n) ``pattern`` in

@@ -285,16 +285,14 @@ def sparse_plan(static: np.ndarray, mass: np.ndarray, maps: np.ndarray, columns:
         ``static`` and ``mass`` at the slots in the lower triangle, then in the upper.
     """
     from linmstmm import _stiffness_kernels as kernels  # numba: imported where a count is compiled
+    from linmstmm._ordering_kernels import slot_terms
 
-    n = static.shape[0]
     pattern = (static != 0) | (mass != 0)
     # where a beam's map.T @ local @ map may be nonzero: any other entry is a sum of zeros
     reach = np.abs(maps) > 0
     beam_pattern = np.swapaxes(reach, 1, 2).astype(float) @ kernels.LOCAL_PATTERN @ reach > 0
     plan, beam_slots = _planned(pattern, beam_pattern, columns)
-    terms = np.stack([static[plan.high, plan.low], mass[plan.high, plan.low],
-                      np.where(plan.high > plan.low, static[plan.low, plan.high], 0.0),
-                      np.where(plan.high > plan.low, mass[plan.low, plan.high], 0.0)])
+    terms = slot_terms(static, mass, plan.high, plan.low)
     return (plan.order, plan.starts, plan.rows, plan.high, plan.low, plan.updates, plan.targets, beam_slots), terms
 
 
@@ -316,18 +314,12 @@ def _planned(pattern: np.ndarray, beam_pattern: np.ndarray, columns: np.ndarray)
 
 
 def _plan_of(pattern: np.ndarray, beam_pattern: np.ndarray, columns: np.ndarray) -> tuple:
-    """:func:`_planned` made anew."""
+    """:func:`_planned` made anew (:mod:`linmstmm._ordering_kernels`)."""
+    from linmstmm._ordering_kernels import beam_slots, pattern_with_beams
     from linmstmm.ordered_ldlt import elimination_plan
 
-    n = pattern.shape[0]
-    i, j = np.broadcast_arrays(columns[:, :, None], columns[:, None, :])
-    present = beam_pattern & (i < n) & (j < n)
-    pattern = pattern.copy()
-    pattern[i[present], j[present]] = True
-    pattern |= pattern.T
-    plan = elimination_plan(pattern)
-    placed = np.where(present, plan.slot_of(np.minimum(i, n - 1), np.minimum(j, n - 1)), -1)
-    return plan, np.where(present & (i < j), placed + plan.high.size, placed)
+    plan = elimination_plan(pattern_with_beams(pattern, beam_pattern, columns))
+    return plan, beam_slots(plan.high, plan.low, beam_pattern, columns, pattern.shape[0])
 
 
 def _reduced_terms(parts, engine: str) -> tuple[np.ndarray, np.ndarray]:

@@ -7,7 +7,8 @@ References:
 * a dense LDLᵀ without pivoting written out in numpy, in the plan's order, for
   the kernel's factorisation (the same numbers, refusals included);
 * the plan's slots and updates derived in numpy from the minimum-degree order
-  (:func:`reference_plan`), for the compiled plan, array for array;
+  (:func:`reference_plan`), for the compiled plan, array for array, and so the
+  beams' slots and the springs' and bodies' terms there;
 * LAPACK's symmetric eigenvalues (dsyevd) for every count decided;
 * the dense count (:func:`linmstmm._stiffness_kernels.count`, LAPACK's dsytrf,
   itself compared with the numpy reference in test_wittrick_williams.py) at
@@ -26,9 +27,9 @@ from linmstmm import _stiffness_kernels as kernels
 from linmstmm.dynamic_stiffness import BeamTable, clamped_counts
 from linmstmm.fe import fe_frequencies
 from linmstmm.model import load_model
-from linmstmm._ordering_kernels import minimum_degree
+from linmstmm._ordering_kernels import minimum_degree, pattern_with_beams, slot_terms
 from linmstmm.ordered_ldlt import elimination_plan
-from linmstmm.wittrick_williams import MOST_GROWTH, SINGULAR_PIVOT, ModeCounter, _block_inertia
+from linmstmm.wittrick_williams import MOST_GROWTH, SINGULAR_PIVOT, ModeCounter, _block_inertia, _plan_of
 from random_models import KINDS, random_model
 
 LAUNCHERS = ("models/mlrs/mlrs.toml", "models/launcher2/launcher2.toml")
@@ -87,6 +88,39 @@ def test_compiled_plan_is_the_numpy_derivation():
         ours = (plan.starts, plan.rows, plan.high, plan.low, plan.updates, plan.targets)
         for mine, theirs in zip(ours, reference_plan(pattern)):
             assert mine.dtype == np.int64 and np.array_equal(mine, theirs)
+
+
+def reference_beam_slots(pattern, beam_pattern, columns):
+    """(the pattern planned, beam_slots) of :func:`linmstmm.wittrick_williams._plan_of`
+    derived in numpy: each beam's reached entries added to ``pattern`` (symmetric), and
+    each one's slot in the plan of that pattern (+ slots in the upper triangle)."""
+    n = pattern.shape[0]
+    i, j = np.broadcast_arrays(columns[:, :, None], columns[:, None, :])
+    present = beam_pattern & (i < n) & (j < n)
+    joined = pattern.copy()
+    joined[i[present], j[present]] = True
+    joined |= joined.T
+    plan = elimination_plan(joined)
+    lookup = np.full((n, n), -1)
+    lookup[plan.high, plan.low] = np.arange(plan.high.size)
+    placed = np.where(present, lookup[np.maximum(i, j).clip(max=n - 1), np.minimum(i, j).clip(max=n - 1)], -1)
+    return joined, np.where(present & (i < j), placed + plan.high.size, placed)
+
+
+def test_beams_slots_are_the_numpy_derivation():
+    for path in LAUNCHERS + tuple(random_model(kind, 0) for kind in KINDS):
+        counter = ModeCounter(load_model(path) if isinstance(path, str) else path, "compiled")
+        pattern = (counter._static != 0) | (counter._mass != 0)
+        reach = np.abs(counter._maps) > 0
+        beam_pattern = np.swapaxes(reach, 1, 2).astype(float) @ kernels.LOCAL_PATTERN @ reach > 0
+        joined, slots = reference_beam_slots(pattern, beam_pattern, counter._columns)
+        assert np.array_equal(pattern_with_beams(pattern, beam_pattern, counter._columns), joined)
+        plan, placed = _plan_of(pattern, beam_pattern, counter._columns)
+        assert np.array_equal(placed, slots)
+        static, mass, high, low = counter._static, counter._mass, plan.high, plan.low
+        assert np.array_equal(slot_terms(static, mass, high, low), np.stack([
+            static[high, low], mass[high, low], np.where(high > low, static[low, high], 0.0),
+            np.where(high > low, mass[low, high], 0.0)]))
 
 
 def random_sparse(rng, n, density):

@@ -16,6 +16,7 @@
 from __future__ import annotations
 
 from dataclasses import replace
+from unittest import mock
 
 import numpy as np
 import pytest
@@ -27,7 +28,7 @@ from linmstmm.compiled_model import forget_compiled_models
 from linmstmm.fe.assembly import _add_beam_constraints
 from linmstmm.fe.layout import _beam_axes, _layout, _Triplets, element_maps
 from linmstmm.fe import node_constraints as node_module
-from linmstmm.fe.node_constraints import _held_dropped, kept_node_constraints, node_constraints
+from linmstmm.fe.node_constraints import held_at_free_points, kept_node_constraints, node_constraints
 from linmstmm.model import load_model
 from linmstmm.wittrick_williams import mode_counter
 
@@ -41,15 +42,21 @@ MODELS = {
 }
 
 
+def general_node_constraints(model):
+    """:func:`node_constraints` of ``model`` the general way: the port map formed and
+    every constraint row eliminated in turn."""
+    with mock.patch.object(node_module, "held_at_free_points", lambda model: False):
+        return node_constraints(model)
+
+
 def eliminations(model, n):
     """(T, masters) of ``model`` meshed with ``n`` elements per beam: by the nodes'
     shared elimination, and eliminated from the start."""
     layout = _layout(model, n)
     beam_rows = _Triplets()
     _add_beam_constraints(model.beams, element_maps(layout.beam_table, _beam_axes(model.beams)), n, beam_rows)
-    nodes = node_constraints(model)
-    return (nodes.eliminated(beam_rows, 6 * layout.n_nodes),
-            replace(nodes, elimination=None).eliminated(beam_rows, 6 * layout.n_nodes))
+    return (node_constraints(model).eliminated(beam_rows, 6 * layout.n_nodes),
+            replace(general_node_constraints(model), elimination=None).eliminated(beam_rows, 6 * layout.n_nodes))
 
 
 @pytest.mark.parametrize("name", MODELS)
@@ -62,25 +69,19 @@ def test_meshes_extend_the_nodes_elimination_exactly(name):
             assert ours.dtype == theirs.dtype and np.array_equal(ours, theirs)
 
 
-def test_fixed_components_alone_are_dropped_as_the_general_elimination_drops_them(monkeypatch):
+def test_fixed_components_alone_are_dropped_as_the_general_elimination_drops_them():
     kinds = set()
-    for name, make in MODELS.items():
+    for make in MODELS.values():
         model = make()
-        nodes = node_constraints(model)
-        dropped = _held_dropped(nodes.port_map, nodes.kept, nodes.rows)
-        kinds.add(dropped is not None)
-        if dropped is None or nodes.elimination is None:
+        kinds.add(held_at_free_points(model))
+        if not held_at_free_points(model):
             continue
-        with monkeypatch.context() as patched:
-            patched.setattr(node_module, "_held_dropped", lambda *parts: None)
-            reference, reference_masters = node_constraints(model).elimination
-        T, masters = nodes.elimination
+        (T, masters), (reference, reference_masters) = (nodes.elimination for nodes in (
+            node_constraints(model), general_node_constraints(model)))
         assert T.shape == reference.shape and np.array_equal(masters, reference_masters)
         for ours, theirs in ((T.indptr, reference.indptr), (T.indices, reference.indices), (T.data, reference.data)):
             assert ours.dtype == theirs.dtype and np.array_equal(ours, theirs)
-    assert kinds == {True, False}
-    launcher = node_constraints(MODELS["launcher"]())
-    assert _held_dropped(launcher.port_map, launcher.kept, launcher.rows) is not None
+    assert kinds == {True, False} and held_at_free_points(MODELS["launcher"]())
 
 
 def test_models_with_rigid_beam_directions_are_eliminated_per_mesh():

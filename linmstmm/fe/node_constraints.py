@@ -43,13 +43,15 @@ class NodeConstraints:
         The points and mass centres (the layout of one element per beam).
     n_full : int
         6 per point and mass centre.
-    port_map : Compressed
+    port_map : Compressed or None
         T0 (n_full, q0) CSR: each port moves with the first body that owns it.
-    kept : numpy.ndarray, shape (q0,)
+    kept : numpy.ndarray, shape (q0,), or None
         The full DOFs T0 keeps, ascending.
-    rows : Compressed
+    rows : Compressed or None
         (r, n_full) CSR constraint rows: infinite spring directions, fixed
         boundary components, ports joining further bodies, in that order.
+        These three are None where the model is :func:`held_at_free_points`: its
+        elimination is then made directly, and no mesh eliminates anew.
     spring_strains : linmstmm.fe.layout._Triplets
         The finite spring directions as strain rows (m or rad) on the full DOFs.
     spring_stiffness : list of numpy.ndarray
@@ -136,43 +138,74 @@ def node_constraints(model: Model) -> NodeConstraints:
     stiffness = []
     _add_springs(model, layout, strains, stiffness, constraints)
     _add_rigid_masses(model, layout, mass)
+    if held_at_free_points(model):
+        return NodeConstraints(layout, n_full, None, None, None, strains, stiffness, mass, _ports_followed(model, layout))
     _add_boundaries(model, layout, constraints)
     t0, kept = _port_map(model, layout, constraints)
     rows = constraints.compressed(n_full)
     elimination = None
     if all(beam.axial and beam.torsion for beam in model.beams):
-        elimination = _held_dropped(t0, kept, rows)
-        if elimination is None:
-            t0_csr = scipy_csr(t0)
-            t1, masters = _eliminate(reduced_constraints(rows, t0_csr))
-            elimination = ((t0_csr @ scipy_csr(t1)).tocsr(), kept[masters])
+        t0_csr = scipy_csr(t0)
+        t1, masters = _eliminate(reduced_constraints(rows, t0_csr))
+        elimination = ((t0_csr @ scipy_csr(t1)).tocsr(), kept[masters])
     return NodeConstraints(layout, n_full, t0, kept, rows, strains, stiffness, mass, elimination)
 
 
-def _held_dropped(t0: Compressed, kept: np.ndarray, rows: Compressed) -> tuple[sp.csr_matrix, np.ndarray] | None:
-    """The elimination of :func:`node_constraints` where every constraint row is one
-    entry on a DOF the port map ``t0`` keeps as it is (a fixed component of a point no
-    body owns): those DOFs are dropped and every other kept, T is ``t0`` without their
-    columns. The arrays scipy's ``t0 @ T1`` stores (:func:`~linmstmm.fe.constraints._eliminate`
-    makes each such row a slave with no masters): each entry ``v · 1.0``, which is v,
-    zeros left out, each row's columns in the reverse of the order the product met
-    them. None where a row is of another kind."""
-    dofs, first = rows.indices, t0.indptr[rows.indices]
-    if np.any(np.diff(rows.indptr) != 1) or np.any(t0.indptr[dofs + 1] - first != 1) or np.any(t0.data[first] != 1.0):
-        return None
-    n_full, held = t0.shape[0], np.zeros(t0.shape[1], bool)
-    held[t0.indices[first]] = True
-    column = np.cumsum(~held) - 1
-    entries = np.flatnonzero(~held[t0.indices] & (t0.data != 0))
-    line = np.repeat(np.arange(n_full), np.diff(t0.indptr))[entries]
+def held_at_free_points(model: Model) -> bool:
+    """Whether every constraint of ``model`` is a fixed boundary component of a point that
+    no rigid body owns: no point owned by two bodies, no ``inf`` spring direction, no
+    beam rigid axially or in torsion. Its structure decides it.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+
+    Returns
+    -------
+    bool
+    """
+    ports = [port for body in model.rigids for port in body.ports]
+    owned = set(ports)
+    return (len(owned) == len(ports) and owned.isdisjoint(model.boundary)
+            and not np.isinf([spring.k for spring in model.springs]).any()
+            and all(beam.axial and beam.torsion for beam in model.beams))
+
+
+def _ports_followed(model: Model, layout) -> tuple[sp.csr_matrix, np.ndarray]:
+    """The elimination (T, masters) of :func:`node_constraints` where the model is
+    :func:`held_at_free_points`: every port follows its body's mass centre and every
+    fixed component is dropped. The arrays the general route's scipy product
+    ``T0 T1`` stores (:func:`~linmstmm.fe.constraints._eliminate` makes each fixed
+    component a slave with no masters): a master's row its unit entry, a port's
+    row its body's lever-arm entries ``v · 1.0``, which are v, zeros left out, in
+    the reverse of the order the product met them (descending columns), a fixed
+    component's row empty."""
+    index, n_full = layout.index, 6 * layout.n_nodes
+    port_nodes = np.array([index.points[port] for body in model.rigids for port in body.ports], int)
+    centre_nodes = np.array([index.rigids[body.name] for body in model.rigids for _ in body.ports], int)
+    ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
+    dropped = np.zeros(n_full, bool)
+    dropped[ports] = True
+    for point, fixed in model.boundary.items():
+        dropped[index.point(point)[np.asarray(fixed, bool)]] = True
+    masters = np.flatnonzero(~dropped)
+    column = np.cumsum(~dropped) - 1
+    lever = _port_kinematics(layout.positions[port_nodes], layout.positions[centre_nodes])[:, :, ::-1]
+    stored = lever != 0
+    lengths = np.zeros(n_full, int)
+    lengths[masters] = 1
+    lengths[ports] = stored.sum(axis=2)
     indptr = np.zeros(n_full + 1, int)
-    np.cumsum(np.bincount(line, minlength=n_full), out=indptr[1:])
-    place = indptr[line + 1] - 1 - (np.arange(len(entries)) - indptr[line])      # reversed within the row
-    indices, data = np.empty(len(entries), int), np.empty(len(entries))
-    indices[place], data[place] = column[t0.indices[entries]], t0.data[entries]
-    shape = (n_full, int(np.count_nonzero(~held)))
-    index = np.int32 if max(shape[1], len(data)) < 2 ** 31 else np.int64
-    return sp.csr_matrix((data, indices.astype(index), indptr.astype(index)), shape=shape), kept[~held]
+    np.cumsum(lengths, out=indptr[1:])
+    indices, data = np.empty(indptr[-1], int), np.empty(indptr[-1])
+    indices[indptr[masters]], data[indptr[masters]] = np.arange(len(masters)), 1.0
+    place = (indptr[ports][:, :, None] + np.cumsum(stored, axis=2) - 1)[stored]
+    indices[place] = np.broadcast_to(column[centres][:, None, ::-1], lever.shape)[stored]
+    data[place] = lever[stored]
+    index_type = np.int32 if max(len(masters), len(data)) < 2 ** 31 else np.int64
+    T = sp.csr_matrix((data, indices.astype(index_type), indptr.astype(index_type)), shape=(n_full, len(masters)))
+    return T, masters
 
 
 #: :func:`node_constraints` kept per model object (a Model cannot change): made on the

@@ -414,3 +414,39 @@ def ordered_count(omega, beams, maps, singular_pivot, most_growth, plan, terms, 
         negatives = found
     return clamped + negatives
 
+
+
+@njit(cache=True)
+def touched_rows(t_indptr, t_indices, t_data, dofs, n):
+    """Each beam's rows of T on the reduced DOFs they touch, as
+    :func:`linmstmm.wittrick_williams._beam_maps` picks them in numpy.
+
+    t_indptr, t_indices, t_data : CSR arrays of T (n_full, n). dofs : (n_beams, 12)
+    the full DOFs of each beam's ends.
+
+    Returns
+    -------
+    columns : (n_beams, k) int64, the reduced DOFs each beam's rows touch (a nonzero
+        entry), ascending, then n for padding; k the most any beam touches.
+    picked : (n_beams, 12, k) float64, those rows' entries there (0.0 at padding).
+    """
+    rows = np.zeros((dofs.shape[0], dofs.shape[1], n))
+    touched = np.zeros((dofs.shape[0], n), dtype=np.bool_)
+    width = 0
+    for b in range(dofs.shape[0]):
+        for a in range(dofs.shape[1]):
+            for tt in range(t_indptr[dofs[b, a]], t_indptr[dofs[b, a] + 1]):
+                rows[b, a, t_indices[tt]] = t_data[tt]
+                touched[b, t_indices[tt]] |= t_data[tt] != 0.0
+        width = max(width, touched[b].sum())
+    columns = np.full((dofs.shape[0], width), n, dtype=np.int64)
+    picked = np.zeros((dofs.shape[0], dofs.shape[1], width))
+    for b in range(dofs.shape[0]):
+        w = 0
+        for c in range(n):
+            if touched[b, c]:
+                columns[b, w] = c
+                for a in range(dofs.shape[1]):
+                    picked[b, a, w] = rows[b, a, c]
+                w += 1
+    return columns, picked

@@ -129,7 +129,7 @@ class ModeCounter:
         self.n_dof = parts.T.shape[1]
         self._static, self._mass = _reduced_terms(parts, self.engine)
         self._beams = BeamTable.of(model.beams)
-        self._maps, self._columns = _beam_maps(parts)
+        self._maps, self._columns = _beam_maps(parts, self.engine)
         self._answers: dict[float, int | None] = {}
         self._table = None  # the beams as the compiled kernels take them, on their first call
         self._scratch = None  # this counter's own buffers for the compiled kernel, on its first call
@@ -342,23 +342,30 @@ def _reduced_terms(parts, engine: str) -> tuple[np.ndarray, np.ndarray]:
     return dense_product(transposed(springs), rows_scaled(springs, stiffness)), congruence(T, mass)
 
 
-def _beam_maps(parts) -> tuple[np.ndarray, np.ndarray]:
+def _beam_maps(parts, engine: str) -> tuple[np.ndarray, np.ndarray]:
     """((n_beams, 12, k) maps from the reduced DOFs each beam touches to its local
     ones, (n_beams, k) those DOFs), beams in ``model.beams`` order, of the
     :class:`~linmstmm.fe.assembly.ConstrainedParts` of one element per beam. k: the
     most reduced DOFs one beam touches; shorter lists are padded with the extra DOF
-    n_dof and zero columns."""
+    n_dof and zero columns. The rows of T each beam touches are picked by the
+    compiled :func:`~linmstmm._stiffness_kernels.touched_rows` for the compiled
+    ``engine``, the same arrays."""
     T, n = parts.T, parts.T.shape[1]
     dofs, to_local = (part[:, 0] for part in parts.beam_maps)           # (n_beams, 12), (n_beams, 12, 12)
-    rows = dense_rows(T, dofs)                                           # (n_beams, 12, n_dof)
-    touched = np.any(rows != 0.0, axis=1)                                # (n_beams, n_dof)
-    width = int(touched.sum(axis=1).max(initial=0))
-    # each beam's touched DOFs ascending, then the padding DOF n (a stable sort of "untouched")
-    columns = np.argsort(~touched, axis=1, kind="stable")[:, :width]
-    present = np.take_along_axis(touched, columns, axis=1)
-    picked = np.take_along_axis(rows, np.broadcast_to(columns[:, None, :], rows.shape[:2] + (width,)), axis=2)
-    maps = np.where(present[:, None, :], to_local @ picked, 0.0)
-    return maps, np.where(present, columns, n)
+    if engine == "compiled":
+        from linmstmm import _stiffness_kernels as kernels  # numba: imported where a count is compiled
+
+        columns, picked = kernels.touched_rows(T.indptr, T.indices, T.data, dofs, n)
+        present = columns < n
+    else:
+        rows = dense_rows(T, dofs)                                       # (n_beams, 12, n_dof)
+        touched = np.any(rows != 0.0, axis=1)                            # (n_beams, n_dof)
+        width = int(touched.sum(axis=1).max(initial=0))
+        # each beam's touched DOFs ascending, then the padding DOF n (a stable sort of "untouched")
+        columns = np.argsort(~touched, axis=1, kind="stable")[:, :width]
+        present = np.take_along_axis(touched, columns, axis=1)
+        picked = np.take_along_axis(rows, np.broadcast_to(columns[:, None, :], rows.shape[:2] + (width,)), axis=2)
+    return np.where(present[:, None, :], to_local @ picked, 0.0), np.where(present, columns, n)
 
 
 def _negative_eigenvalues(matrix: np.ndarray, magnitude: np.ndarray) -> int | None:

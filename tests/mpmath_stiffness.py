@@ -36,7 +36,7 @@ class ExactStiffness:
         self.n = T.shape[1]
         self.static = mp.matrix((springs.T @ springs.multiply(stiffness[:, None])).toarray().tolist())
         self.mass = mp.matrix((T.T @ parts.rigid_mass.matrix(parts.n_full, parts.n_full) @ T).toarray().tolist())
-        self.maps, self.columns = _beam_maps(parts)
+        self.maps, self.columns = _beam_maps(parts, "numpy")
         self.beams, self.elements = model.beams, elements
 
     def __call__(self, lam) -> mp.matrix:

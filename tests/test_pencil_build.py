@@ -9,8 +9,8 @@ through scipy.sparse, bit for bit.
   route forms (:func:`~linmstmm.fe.assembly.assemble`).
 * The same models with the products formed by the compiled kernels
   (:mod:`linmstmm._product_kernels`): the assembly's K and M at one, two and three
-  elements per beam, and the Wittrick–Williams counter's springs' stiffness and
-  bodies' mass, equal the numpy route's (:mod:`linmstmm.fe.products`, itself
+  elements per beam, and the Wittrick–Williams counter's springs' stiffness,
+  bodies' mass and beams' maps, equal the numpy route's (:mod:`linmstmm.fe.products`, itself
   checked against scipy.sparse) bit for bit.
 * A body whose inertia Gershgorin's bound cannot clear is looked at only where
   its least principal inertia is not clearly above the negligible one: every
@@ -45,7 +45,7 @@ from linmstmm.fe.products import small
 from linmstmm.fe.sparse import scipy_csr
 from linmstmm.model import load_model
 from linmstmm.counter_parts import counter_parts
-from linmstmm.wittrick_williams import ModeCounter, _reduced_terms
+from linmstmm.wittrick_williams import ModeCounter, _beam_maps, _reduced_terms
 
 MODELS = {path.stem: (lambda path=path: load_model(path)) for path in BUNDLED_MODELS}
 MODELS |= {f"{kind} {seed}": (lambda kind=kind, seed=seed: random_model(kind, seed))
@@ -90,8 +90,9 @@ def test_compiled_products_are_the_numpy_route_s(name):
         assert np.array_equal(scipy_csr(compiled.K).toarray(), K) and np.array_equal(scipy_csr(compiled.M).toarray(), M)
         assert np.array_equal(compiled.D, reference.D)
     parts = counter_parts(model)
-    for ours, theirs in zip(_reduced_terms(parts, "compiled"), _reduced_terms(parts, "numpy")):
-        assert np.array_equal(ours, theirs)
+    for ours, theirs in zip(_reduced_terms(parts, "compiled") + _beam_maps(parts, "compiled"),
+                            _reduced_terms(parts, "numpy") + _beam_maps(parts, "numpy")):
+        assert ours.shape == theirs.shape and np.array_equal(ours, theirs)
 
 
 def test_inertia_screen_passes_over_only_bodies_left_unchanged():

@@ -8,8 +8,10 @@ sum from zero those form, term after term in their order, with no fused
 multiply-add). The Wittrick–Williams counter (:mod:`linmstmm.wittrick_williams`,
 compiled engine) forms its springs' stiffness and bodies' mass with them, and the
 coarse predictions (:mod:`linmstmm.coarse_prediction`, once the compiled kernels are
-loaded) their K and M (:func:`pencil_forms`); tests/test_pencil_build.py and
-tests/test_wittrick_williams.py compare them with the numpy route.
+loaded) their K and M from the beams' elements, springs and bodies in one call
+(:func:`pencil_forms`), where :mod:`linmstmm.fe.assembly` first writes them as
+triplets and compresses them; tests/test_pencil_build.py compares both with the
+numpy route.
 """
 from __future__ import annotations
 
@@ -26,7 +28,8 @@ def ordered_congruence(t_indptr, t_indices, t_data, m_indptr, m_indices, m_data,
     Parameters
     ----------
     t_indptr, t_indices, t_data : CSR arrays of T (n_full, n).
-    m_indptr, m_indices, m_data : CSR arrays of M (n_full, n_full), canonical.
+    m_indptr, m_indices, m_data : CSR arrays of M (n_full, n_full), each position
+        once in a row (in any order; a stored zero adds nothing).
     n : int, T's columns.
 
     Returns
@@ -34,16 +37,29 @@ def ordered_congruence(t_indptr, t_indices, t_data, m_indptr, m_indices, m_data,
     (n, n) float64, not symmetrised.
     """
     n_full = t_indptr.size - 1
-    half = np.zeros((n, n_full))
+    # half[c, i] = (Tᵀ M)[i, c], and for each c the i it holds (members[starts[c]:filled[c]])
+    starts = np.zeros(n_full + 1, dtype=np.int64)
+    for k in range(n_full):
+        for mm in range(m_indptr[k], m_indptr[k + 1]):
+            starts[m_indices[mm] + 1] += t_indptr[k + 1] - t_indptr[k]
+    starts = np.cumsum(starts)
+    filled, members = starts[:-1].copy(), np.empty(starts[-1], dtype=np.int64)
+    half, held = np.zeros((n_full, n)), np.zeros((n_full, n), dtype=np.bool_)
     for k in range(n_full):
         for tt in range(t_indptr[k], t_indptr[k + 1]):
             i, t = t_indices[tt], t_data[tt]
             for mm in range(m_indptr[k], m_indptr[k + 1]):
-                half[i, m_indices[mm]] += t * m_data[mm]
+                c = m_indices[mm]
+                half[c, i] += t * m_data[mm]
+                if not held[c, i]:
+                    held[c, i] = True
+                    members[filled[c]] = i
+                    filled[c] += 1
     product = np.zeros((n, n))
-    for i in range(n):
-        for c in range(n_full):
-            a = half[i, c]
+    for c in range(n_full):  # each entry's terms over c ascending
+        for q in range(starts[c], filled[c]):
+            i = members[q]
+            a = half[c, i]
             if a != 0.0:
                 for tt in range(t_indptr[c], t_indptr[c + 1]):
                     product[i, t_indices[tt]] += a * t_data[tt]
@@ -68,52 +84,154 @@ def ordered_gram(s_indptr, s_indices, s_data, t_indptr, t_indices, t_data, weigh
     -------
     (n, n) float64, not symmetrised.
     """
-    product = np.zeros((n, n))
-    row = np.zeros(n)
-    touched = np.zeros(n, dtype=np.bool_)
-    columns = np.empty(n, dtype=np.int64)
+    product, scratch = np.zeros((n, n)), _gram_scratch(n)
     for r in range(s_indptr.size - 1):
-        used = 0
-        for ss in range(s_indptr[r], s_indptr[r + 1]):
-            k, s = s_indices[ss], s_data[ss]
-            for tt in range(t_indptr[k], t_indptr[k + 1]):
-                j = t_indices[tt]
-                row[j] += s * t_data[tt]
-                if not touched[j]:
-                    touched[j] = True
-                    columns[used] = j
-                    used += 1
-        w = weights[r]
-        for a in range(used):
-            i = columns[a]
-            if row[i] != 0.0:
-                left = row[i] * w if weight_left else row[i]
-                for b in range(used):
-                    j = columns[b]
-                    if row[j] != 0.0:
-                        product[i, j] += left * (row[j] if weight_left else row[j] * w)
-        for a in range(used):
-            row[columns[a]] = 0.0
-            touched[columns[a]] = False
+        _add_gram_row(s_indices, s_data, s_indptr[r], s_indptr[r + 1], t_indptr, t_indices, t_data, weights[r],
+                      weight_left, product, scratch)
     return product
 
 
-def pencil_forms(T, mass, strains, D: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+@njit(cache=True)
+def _gram_scratch(n):
+    """(row values (n,), touched (n,), their columns (n,)) for :func:`_add_gram_row`."""
+    return np.zeros(n), np.zeros(n, dtype=np.bool_), np.empty(n, dtype=np.int64)
+
+
+@njit(cache=True)
+def _add_gram_row(cols, values, start, stop, t_indptr, t_indices, t_data, w, weight_left, product, scratch):
+    """Add the term of one row of S (``cols``, ``values`` [start, stop), columns
+    ascending) to ``product``, as :func:`ordered_gram` does."""
+    row, touched, columns = scratch
+    used = 0
+    for ss in range(start, stop):
+        k, s = cols[ss], values[ss]
+        for tt in range(t_indptr[k], t_indptr[k + 1]):
+            j = t_indices[tt]
+            row[j] += s * t_data[tt]
+            if not touched[j]:
+                touched[j] = True
+                columns[used] = j
+                used += 1
+    for a in range(used):
+        i = columns[a]
+        if row[i] != 0.0:
+            left = row[i] * w if weight_left else row[i]
+            for b in range(used):
+                j = columns[b]
+                if row[j] != 0.0:
+                    product[i, j] += left * (row[j] if weight_left else row[j] * w)
+    for a in range(used):
+        row[columns[a]] = 0.0
+        touched[columns[a]] = False
+
+
+@njit(cache=True)
+def _full_mass(n_full, rigid_rows, rigid_cols, rigid_values, dofs, masses):
+    """The full mass as :func:`linmstmm.fe.sparse.compressed_of_summed` makes it of the
+    bodies' triplets followed by the elements' (b, n, 12, 12) ``masses`` on their
+    ``dofs`` (b, n, 12): each position's entries summed (a pair a + b is the same in
+    either order); CSR rows (indptr, cols, values), columns in the order first met,
+    zero sums kept (they add nothing to a product). indptr is empty where a position
+    is given three times or more (their sum depends on scipy's order)."""
+    starts = np.zeros(n_full + 1, dtype=np.int64)
+    for e in range(rigid_rows.size):
+        starts[rigid_rows[e] + 1] += 1
+    for b in range(dofs.shape[0]):
+        for e in range(dofs.shape[1]):
+            for a in range(12):
+                starts[dofs[b, e, a] + 1] += 12
+    starts = np.cumsum(starts)
+    cols, values, filled = np.empty(starts[-1], dtype=np.int64), np.empty(starts[-1]), starts[:-1].copy()
+    for e in range(rigid_rows.size):
+        r = rigid_rows[e]
+        cols[filled[r]], values[filled[r]] = rigid_cols[e], rigid_values[e]
+        filled[r] += 1
+    for b in range(dofs.shape[0]):
+        for e in range(dofs.shape[1]):
+            for a in range(12):
+                r = dofs[b, e, a]
+                for c in range(12):
+                    cols[filled[r]], values[filled[r]] = dofs[b, e, c], masses[b, e, a, c]
+                    filled[r] += 1
+    slot, times = np.full(n_full, -1, dtype=np.int64), np.zeros(starts[-1], dtype=np.int64)
+    indptr, kept = np.zeros(n_full + 1, dtype=np.int64), 0
+    for r in range(n_full):
+        first = kept
+        for p in range(starts[r], starts[r + 1]):
+            c = cols[p]
+            if slot[c] < 0:
+                slot[c] = kept
+                cols[kept], values[kept], times[kept] = c, values[p], 1
+                kept += 1
+            else:
+                values[slot[c]] += values[p]
+                times[slot[c]] += 1
+                if times[slot[c]] > 2:
+                    return np.zeros(0, dtype=np.int64), cols, values
+        for q in range(first, kept):
+            slot[cols[q]] = -1
+        indptr[r + 1] = kept
+    return indptr, cols, values
+
+
+@njit(cache=True)
+def _pencil(t_indptr, t_indices, t_data, n, rows, dofs, strain, d, s_indptr, s_indices, s_data, spring_stiffness,
+            rigid_rows, rigid_cols, rigid_values, masses):
+    """(M, K, formed) of :func:`pencil_forms`; formed False (M, K empty) where the full
+    mass gives a position three times or more."""
+    indptr, cols, values = _full_mass(t_indptr.size - 1, rigid_rows, rigid_cols, rigid_values, dofs, masses)
+    if indptr.size == 0:
+        return np.zeros((0, 0)), np.zeros((0, 0)), False
+    M = ordered_congruence(t_indptr, t_indices, t_data, indptr, cols, values, n)
+    K, scratch = np.zeros((n, n)), _gram_scratch(n)
+    ks, vs = np.empty(12, dtype=np.int64), np.empty(12)
+    for b in range(dofs.shape[0]):
+        for e in range(dofs.shape[1]):
+            for r in range(6):
+                if strain[b, r]:
+                    count = 0
+                    for a in range(12):  # the row's nonzero entries, columns ascending
+                        if rows[b, e, r, a] != 0.0:
+                            place = count
+                            while place > 0 and ks[place - 1] > dofs[b, e, a]:
+                                ks[place], vs[place] = ks[place - 1], vs[place - 1]
+                                place -= 1
+                            ks[place], vs[place] = dofs[b, e, a], rows[b, e, r, a]
+                            count += 1
+                    _add_gram_row(ks, vs, 0, count, t_indptr, t_indices, t_data, d[b, r], True, K, scratch)
+    for r in range(s_indptr.size - 1):
+        _add_gram_row(s_indices, s_data, s_indptr[r], s_indptr[r + 1], t_indptr, t_indices, t_data,
+                      spring_stiffness[r], True, K, scratch)
+    return M, K, True
+
+
+def pencil_forms(T, elements, parts) -> tuple[np.ndarray, np.ndarray] | None:
     """The ``forms`` of :func:`linmstmm.fe.assembly.assembled`: (Tᵀ M_full T, Gᵀ diag(D) G)
-    dense and not symmetrised, G = S T, as :func:`linmstmm.fe.products.congruence` and
-    ``dense_product(transposed(G, D), G)`` form them.
+    dense and not symmetrised, G = S T, the numbers :func:`linmstmm.fe.products.congruence`
+    and ``dense_product(transposed(G, D), G)`` form of the full mass and strain rows
+    that :func:`linmstmm.fe.assembly._add_beams` writes (the beams' strain rows, then
+    the springs'; the bodies' masses, then the elements'), without writing them.
 
     Parameters
     ----------
     T : (n_full, n) CSR (scipy or :class:`~linmstmm.fe.sparse.Compressed`).
-    mass : (n_full, n_full) canonical CSR, kg and kg m².
-    strains : (r, n_full) canonical CSR, the strain rows S (m or rad).
-    D : (r,) their stiffnesses.
+    elements : linmstmm.fe.assembly._BeamElements
+        The beams' elements on the full DOFs.
+    parts : linmstmm.fe.assembly.ConstrainedParts
+        Its springs' strain rows and stiffnesses and the bodies' mass triplets.
 
     Returns
     -------
-    M, K : (n, n) float64.
+    (M, K) : (n, n) float64 each, or None where a position of the full mass is given
+    three times or more (left to the numpy route, which sums them in scipy's order).
     """
-    n = T.shape[1]
-    return (ordered_congruence(T.indptr, T.indices, T.data, mass.indptr, mass.indices, mass.data, n),
-            ordered_gram(strains.indptr, strains.indices, strains.data, T.indptr, T.indices, T.data, D, n, True))
+    springs = parts.spring_strains.compressed(parts.n_full)
+    stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
+    bodies = parts.rigid_mass
+    rigid = [np.concatenate(part) if part else np.zeros(0, dtype)
+             for part, dtype in ((bodies.rows, np.int64), (bodies.cols, np.int64), (bodies.values, float))]
+    mass = np.swapaxes(elements.to_local, 2, 3) @ elements.m[:, None] @ elements.to_local
+    M, K, formed = _pencil(T.indptr, T.indices, T.data, T.shape[1], elements.rows, elements.dofs, elements.strain,
+                           elements.d, springs.indptr, springs.indices, springs.data, stiffness,
+                           rigid[0].astype(np.int64), rigid[1].astype(np.int64), rigid[2], mass)
+    return (M, K) if formed else None

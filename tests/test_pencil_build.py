@@ -11,7 +11,8 @@ through scipy.sparse, bit for bit.
   (:mod:`linmstmm._product_kernels`): the assembly's K and M at one, two and three
   elements per beam, and the Wittrick–Williams counter's springs' stiffness,
   bodies' mass and beams' maps, equal the numpy route's (:mod:`linmstmm.fe.products`, itself
-  checked against scipy.sparse) bit for bit.
+  checked against scipy.sparse) bit for bit; where three beams meet (a position of
+  the full mass given three times) the numpy route forms them.
 * A body whose inertia Gershgorin's bound cannot clear is looked at only where
   its least principal inertia is not clearly above the negligible one: every
   body the one-call screen passes over is returned unchanged by the full
@@ -27,7 +28,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from builders import BUNDLED_MODELS, make_rigid
+from builders import BUNDLED_MODELS, fixed, make_beam, make_rigid
 from random_models import KINDS, random_model, random_rotation
 from varied_models import varied_model
 
@@ -43,7 +44,7 @@ from linmstmm.fe.masses import (
 from linmstmm.fe.node_constraints import kept_node_constraints
 from linmstmm.fe.products import small
 from linmstmm.fe.sparse import scipy_csr
-from linmstmm.model import load_model
+from linmstmm.model import Model, load_model
 from linmstmm.counter_parts import counter_parts
 from linmstmm.wittrick_williams import ModeCounter, _beam_maps, _reduced_terms
 
@@ -93,6 +94,21 @@ def test_compiled_products_are_the_numpy_route_s(name):
     for ours, theirs in zip(_reduced_terms(parts, "compiled") + _beam_maps(parts, "compiled"),
                             _reduced_terms(parts, "numpy") + _beam_maps(parts, "numpy")):
         assert ours.shape == theirs.shape and np.array_equal(ours, theirs)
+
+
+def test_three_elements_at_a_node_leave_the_mass_to_the_numpy_route():
+    """Where three beams meet, a position of the full mass is given three times: its
+    sum is scipy's to order, and the compiled forms leave the assembly to the numpy
+    route (the same K and M as the reference)."""
+    points = {"hub": np.zeros(3), "x": np.array([1.0, 0.0, 0.0]), "y": np.array([0.0, 1.2, 0.0]),
+              "z": np.array([0.1, 0.2, 0.9])}
+    beams = tuple(make_beam(f"arm {end}", "hub", end, points) for end in ("x", "y", "z"))
+    model = Model("star", points, rigids=(make_rigid("tip", ["x"], 2.0, [1.0, 0.0, 0.1], [0.1, 0.2, 0.3]),),
+                  beams=beams, boundary={"y": fixed()})
+    for n in (1, 2):
+        compiled, reference = assembled(model, n, forms=pencil_forms), assembled(model, n)
+        assert compiled.G is not None                                   # the numpy route formed them
+        assert np.array_equal(compiled.K, reference.K) and np.array_equal(compiled.M, reference.M)
 
 
 def test_inertia_screen_passes_over_only_bodies_left_unchanged():

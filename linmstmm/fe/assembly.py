@@ -51,16 +51,20 @@ def _beam_elements(beams, maps, n) -> _BeamElements:
     return _BeamElements(dofs, to_local, rows[:, None] @ to_local, d, strain, m)
 
 
-def _add_beams(elements: _BeamElements, strains, stiffness, mass):
+def _add_beams(elements: _BeamElements, strains, mass):
     """Scatter the strains and masses of every beam element (beam after beam, element
-    after element)."""
+    after element; their stiffnesses in that order are :func:`_beam_stiffnesses`)."""
     dofs, to_local, rows, d, strain, m = elements
-    n = dofs.shape[1]
     kept = np.broadcast_to(strain[:, None], rows.shape[:3])
     strains.add(strains.new_rows(np.count_nonzero(kept))[:, None],
                 np.broadcast_to(dofs[:, :, None], kept.shape + (12,))[kept], rows[kept])
-    stiffness.append(np.repeat(d, n, axis=0)[np.repeat(strain, n, axis=0)])
     mass.add(dofs[..., :, None], dofs[..., None, :], np.swapaxes(to_local, 2, 3) @ m[:, None] @ to_local)
+
+
+def _beam_stiffnesses(elements: _BeamElements) -> np.ndarray:
+    """The stiffnesses of the strain rows :func:`_add_beams` writes, in its order."""
+    n = elements.dofs.shape[1]
+    return np.repeat(elements.d, n, axis=0)[np.repeat(elements.strain, n, axis=0)]
 
 
 def _add_beam_constraints(beams, maps, n, constraints):
@@ -219,9 +223,9 @@ def assembled(model: Model, elements_per_beam: int, constraints_of=node_constrai
     M = Tᵀ M_full T and K = (Gᵀ D) G are formed densely where their dense
     intermediate (n_dof × n_full) is small (:func:`linmstmm.fe.products.small`), by
     scipy.sparse otherwise: the same matrices bit for bit either way. Where small,
-    ``forms`` (T, M_full, S, D) -> (Tᵀ M_full T, Gᵀ D G) dense, G = S T, with T
-    (n_full, n_dof) scipy CSR and M_full, S the CSR :class:`~linmstmm.fe.sparse.Compressed`
-    full mass and strain rows, may form them instead of :mod:`linmstmm.fe.products`:
+    ``forms`` (T, elements, parts) -> (Tᵀ M_full T, Gᵀ D G) dense, or None, with T
+    (n_full, n_dof) scipy CSR, the beams' :class:`_BeamElements` and the
+    :class:`ConstrainedParts`, may form them instead of :mod:`linmstmm.fe.products`:
     the same numbers required (the coarse predictions pass compiled ones), and G is
     then not formed.
     """
@@ -231,16 +235,15 @@ def assembled(model: Model, elements_per_beam: int, constraints_of=node_constrai
         model, nodes = light, nodes.with_masses_of(light)
     parts = constrained_parts(model, elements_per_beam, nodes)
     T, n_full = parts.T, parts.n_full
-    strains, mass, stiffness = _Triplets(), parts.rigid_mass.copy(), []
-    _add_beams(_beam_elements(model.beams, parts.beam_maps, elements_per_beam), strains, stiffness, mass)
-    strains.extend(parts.spring_strains)       # beams' rows first, then the springs'
-    stiffness += parts.spring_stiffness
-
-    D = np.concatenate(stiffness) if stiffness else np.zeros(0)
+    elements = _beam_elements(model.beams, parts.beam_maps, elements_per_beam)
+    D = np.concatenate([_beam_stiffnesses(elements), *parts.spring_stiffness])   # beams' rows first, then the springs'
+    formed = forms(T, elements, parts) if forms is not None and small(T.shape[1], n_full) else None
+    if formed is not None:
+        return Assembly(model, parts, *(_symmetric_of_dense(product) for product in formed), None, D)
+    strains, mass = _Triplets(), parts.rigid_mass.copy()
+    _add_beams(elements, strains, mass)
+    strains.extend(parts.spring_strains)
     mass = mass.compressed(n_full, n_full)
-    if forms is not None and small(T.shape[1], n_full):
-        M, K = forms(T, mass, strains.compressed(n_full), D)
-        return Assembly(model, parts, _symmetric_of_dense(M), _symmetric_of_dense(K), None, D)
     G = (strains.matrix(n_full) @ T).tocsr()
     weighted = transposed(G, D)                 # Gᵀ diag(D), G's own arrays
     if small(T.shape[1], n_full):

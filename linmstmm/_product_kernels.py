@@ -126,6 +126,32 @@ def _add_gram_row(cols, values, start, stop, t_indptr, t_indices, t_data, w, wei
 
 
 @njit(cache=True)
+def _grouped_rows(n_rows, rows, cols, values):
+    """The CSR rows (indptr, cols, values) :func:`linmstmm.fe.sparse.compressed_of_distinct`
+    makes of triplets whose ``rows`` are grouped and ascending: each row's columns
+    ascending, zeros left out; indptr empty where a position is given twice."""
+    indptr = np.zeros(n_rows + 1, dtype=np.int64)
+    out_cols, out_values = np.empty(rows.size, dtype=np.int64), np.empty(rows.size)
+    kept, p = 0, 0
+    for r in range(n_rows):
+        while p < rows.size and rows[p] == r:
+            if values[p] != 0.0:
+                place = kept
+                while place > indptr[r] and out_cols[place - 1] > cols[p]:  # insertion, columns ascending
+                    out_cols[place], out_values[place] = out_cols[place - 1], out_values[place - 1]
+                    place -= 1
+                if place > indptr[r] and out_cols[place - 1] == cols[p]:
+                    return np.zeros(0, dtype=np.int64), out_cols, out_values
+                out_cols[place], out_values[place] = cols[p], values[p]
+                kept += 1
+            p += 1
+        indptr[r + 1] = kept
+    if p < rows.size:  # not grouped
+        return np.zeros(0, dtype=np.int64), out_cols, out_values
+    return indptr, out_cols, out_values
+
+
+@njit(cache=True)
 def _full_mass(n_full, rigid_rows, rigid_cols, rigid_values, dofs, masses):
     """The full mass as :func:`linmstmm.fe.sparse.compressed_of_summed` makes it of the
     bodies' triplets followed by the elements' (b, n, 12, 12) ``masses`` on their
@@ -205,6 +231,45 @@ def _pencil(t_indptr, t_indices, t_data, n, rows, dofs, strain, d, s_indptr, s_i
     return M, K, True
 
 
+def counter_terms(parts) -> tuple[np.ndarray, np.ndarray] | None:
+    """The Wittrick–Williams counter's springs' stiffness and bodies' mass on the reduced
+    DOFs of ``parts`` (:class:`~linmstmm.fe.assembly.ConstrainedParts`): the numbers
+    ``dense_product(transposed(G), rows_scaled(G, k))``, G = S T, and
+    :func:`~linmstmm.fe.products.congruence` form of the compressed spring rows S and
+    body masses, formed from their triplets.
+
+    Parameters
+    ----------
+    parts : linmstmm.fe.assembly.ConstrainedParts
+
+    Returns
+    -------
+    (static, mass) : (n, n) float64 each (N/m, N m/rad; kg, kg m²), or None where the
+    triplets are not of the kind compressed here (left to the numpy route).
+    """
+    T, n = parts.T, parts.T.shape[1]
+    springs = _triplet_rows(parts.spring_strains, parts.spring_strains.n_rows)
+    bodies = _triplet_arrays(parts.rigid_mass)
+    indptr, cols, values = _full_mass(T.shape[0], *bodies, np.zeros((0, 0, 12), np.int64), np.zeros((0, 0, 12, 12)))
+    if springs is None or indptr.size == 0:
+        return None
+    stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
+    return (ordered_gram(*springs, T.indptr, T.indices, T.data, stiffness, n, False),
+            ordered_congruence(T.indptr, T.indices, T.data, indptr, cols, values, n))
+
+
+def _triplet_arrays(triplets) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(rows, cols, values) of a :class:`~linmstmm.fe.layout._Triplets`, int64 and float64."""
+    return tuple(np.concatenate(part).astype(dtype, copy=False) if part else np.zeros(0, dtype)
+                 for part, dtype in ((triplets.rows, np.int64), (triplets.cols, np.int64), (triplets.values, float)))
+
+
+def _triplet_rows(triplets, n_rows) -> tuple | None:
+    """CSR arrays (:func:`_grouped_rows`) of ``triplets`` with ``n_rows`` rows, or None."""
+    indptr, cols, values = _grouped_rows(n_rows, *_triplet_arrays(triplets))
+    return None if indptr.size == 0 else (indptr, cols, values)
+
+
 def pencil_forms(T, elements, parts) -> tuple[np.ndarray, np.ndarray] | None:
     """The ``forms`` of :func:`linmstmm.fe.assembly.assembled`: (Tᵀ M_full T, Gᵀ diag(D) G)
     dense and not symmetrised, G = S T, the numbers :func:`linmstmm.fe.products.congruence`
@@ -223,15 +288,14 @@ def pencil_forms(T, elements, parts) -> tuple[np.ndarray, np.ndarray] | None:
     Returns
     -------
     (M, K) : (n, n) float64 each, or None where a position of the full mass is given
-    three times or more (left to the numpy route, which sums them in scipy's order).
+    three times or more (left to the numpy route, which sums them in scipy's order),
+    or a spring row's twice (which the numpy route refuses).
     """
-    springs = parts.spring_strains.compressed(parts.n_full)
+    springs = _triplet_rows(parts.spring_strains, parts.spring_strains.n_rows)
+    if springs is None:
+        return None
     stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
-    bodies = parts.rigid_mass
-    rigid = [np.concatenate(part) if part else np.zeros(0, dtype)
-             for part, dtype in ((bodies.rows, np.int64), (bodies.cols, np.int64), (bodies.values, float))]
     mass = np.swapaxes(elements.to_local, 2, 3) @ elements.m[:, None] @ elements.to_local
     M, K, formed = _pencil(T.indptr, T.indices, T.data, T.shape[1], elements.rows, elements.dofs, elements.strain,
-                           elements.d, springs.indptr, springs.indices, springs.data, stiffness,
-                           rigid[0].astype(np.int64), rigid[1].astype(np.int64), rigid[2], mass)
+                           elements.d, *springs, stiffness, *_triplet_arrays(parts.rigid_mass), mass)
     return (M, K) if formed else None

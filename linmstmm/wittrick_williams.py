@@ -325,20 +325,19 @@ def _plan_of(pattern: np.ndarray, beam_pattern: np.ndarray, columns: np.ndarray)
 def _reduced_terms(parts, engine: str) -> tuple[np.ndarray, np.ndarray]:
     """(n, n) springs' stiffness (N/m, N m/rad) and bodies' mass (kg, kg m²) on the
     reduced DOFs of ``parts`` (:class:`~linmstmm.fe.assembly.ConstrainedParts`), dense,
-    each entry summed as scipy.sparse sums it: by :mod:`linmstmm.fe.products`, or by
-    the compiled :mod:`linmstmm._product_kernels` for the compiled ``engine`` (the
-    same numbers in one call each)."""
-    T, n = parts.T, parts.T.shape[1]
-    strains = parts.spring_strains.compressed(parts.n_full)
+    each entry summed as scipy.sparse sums it: by :mod:`linmstmm.fe.products`, or for
+    the compiled ``engine`` from the triplets by
+    :func:`linmstmm._product_kernels.counter_terms` (the same numbers)."""
+    if engine == "compiled":
+        from linmstmm._product_kernels import counter_terms  # numba: imported where a count is compiled
+
+        formed = counter_terms(parts)
+        if formed is not None:
+            return formed
+    T = parts.T
+    springs = compressed_rows(dense_product(parts.spring_strains.compressed(parts.n_full), T))
     stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
     mass = parts.rigid_mass.compressed(parts.n_full, parts.n_full)
-    if engine == "compiled":
-        from linmstmm import _product_kernels as kernels  # numba: imported where a count is compiled
-
-        return (kernels.ordered_gram(strains.indptr, strains.indices, strains.data, T.indptr, T.indices, T.data,
-                                     stiffness, n, False),
-                kernels.ordered_congruence(T.indptr, T.indices, T.data, mass.indptr, mass.indices, mass.data, n))
-    springs = compressed_rows(dense_product(strains, T))
     return dense_product(transposed(springs), rows_scaled(springs, stiffness)), congruence(T, mass)
 
 

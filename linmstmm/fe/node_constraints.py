@@ -185,26 +185,22 @@ def _ports_followed(model: Model, layout) -> tuple[sp.csr_matrix, np.ndarray]:
     port_nodes = np.array([index.points[port] for body in model.rigids for port in body.ports], int)
     centre_nodes = np.array([index.rigids[body.name] for body in model.rigids for _ in body.ports], int)
     ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
+    fixed = np.array([components for components in model.boundary.values()], bool).reshape(-1, 6)
     dropped = np.zeros(n_full, bool)
     dropped[ports] = True
-    for point, fixed in model.boundary.items():
-        dropped[index.point(point)[np.asarray(fixed, bool)]] = True
+    dropped[(6 * np.array([index.points[point] for point in model.boundary], int).reshape(-1, 1)
+             + np.arange(6))[fixed]] = True
     masters = np.flatnonzero(~dropped)
-    column = np.cumsum(~dropped) - 1
-    lever = _port_kinematics(layout.positions[port_nodes], layout.positions[centre_nodes])[:, :, ::-1]
-    stored = lever != 0
-    lengths = np.zeros(n_full, int)
-    lengths[masters] = 1
-    lengths[ports] = stored.sum(axis=2)
-    indptr = np.zeros(n_full + 1, int)
-    np.cumsum(lengths, out=indptr[1:])
-    indices, data = np.empty(indptr[-1], int), np.empty(indptr[-1])
-    indices[indptr[masters]], data[indptr[masters]] = np.arange(len(masters)), 1.0
-    place = (indptr[ports][:, :, None] + np.cumsum(stored, axis=2) - 1)[stored]
-    indices[place] = np.broadcast_to(column[centres][:, None, ::-1], lever.shape)[stored]
-    data[place] = lever[stored]
-    index_type = np.int32 if max(len(masters), len(data)) < 2 ** 31 else np.int64
-    T = sp.csr_matrix((data, indices.astype(index_type), indptr.astype(index_type)), shape=(n_full, len(masters)))
+    # each row's possible entries (columns, values), stored where the value is not zero
+    cols, values = np.zeros((n_full, 6), int), np.zeros((n_full, 6))
+    cols[masters, 0], values[masters, 0] = np.arange(len(masters)), 1.0
+    cols[ports] = (np.cumsum(~dropped) - 1)[centres][:, None, ::-1]
+    values[ports] = _port_kinematics(layout.positions[port_nodes], layout.positions[centre_nodes])[:, :, ::-1]
+    stored = values != 0
+    indptr = np.concatenate([[0], np.cumsum(np.count_nonzero(stored, axis=1))])
+    index_type = np.int32 if max(len(masters), indptr[-1]) < 2 ** 31 else np.int64
+    T = sp.csr_matrix((values[stored], cols[stored].astype(index_type), indptr.astype(index_type)),
+                      shape=(n_full, len(masters)))
     return T, masters
 
 

@@ -90,6 +90,9 @@ def _layout(model: Model, elements_per_beam: int, nodes: _Layout | None = None) 
                                               nodes.beam_table, nodes.beam_axes)
         if n == 1:
             return nodes
+    if n == 1:  # no interior node: the points and mass centres as they are
+        return _Layout(DofIndex(points, rigids, {beam.name: nodes for beam, nodes in zip(model.beams, ends)}),
+                       placed, np.broadcast_to(np.eye(3), (len(placed), 3, 3)).copy(), ends, axes)
     interior = len(placed) + np.arange(len(ends) * (n - 1)).reshape(len(ends), n - 1)
     table = np.concatenate([ends[:, :1], interior, ends[:, 1:]], axis=1)
     xa, xb = placed[ends[:, 0]], placed[ends[:, 1]]

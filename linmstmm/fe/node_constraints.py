@@ -238,7 +238,8 @@ def _add_springs(model, layout, strains, stiffness, constraints):
     rigid = np.isinf(k)
     strains.add(strains.new_rows(np.count_nonzero(~rigid))[:, None], cols[~rigid], values[~rigid])
     stiffness.append(k[~rigid])
-    constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None], cols[rigid], values[rigid])
+    if rigid.any():
+        constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None], cols[rigid], values[rigid])
 
 
 def _add_rigid_masses(model, layout, mass):
@@ -263,12 +264,11 @@ def _port_kinematics(ports, centres) -> np.ndarray:
     ports, centres : (p, 3) positions of the ports and of their bodies' mass centres, m.
     """
     r = ports - centres
-    cross = np.zeros((len(r), 3, 3))
-    cross[:, [0, 0, 1, 1, 2, 2], [1, 2, 0, 2, 0, 1]] = np.stack([-r[:, 2], r[:, 1], r[:, 2], -r[:, 0],
-                                                               -r[:, 1], r[:, 0]], axis=1)
     block = np.zeros((len(r), 6, 6))
     block[:, np.arange(6), np.arange(6)] = 1.0
-    block[:, :3, 3:] = -cross
+    # −[r]ₓ, whose zero diagonal stays +0.0 (a −0.0 there would be dropped as any zero is)
+    block[:, [0, 0, 1, 1, 2, 2], [4, 5, 3, 5, 3, 4]] = np.stack([r[:, 2], -r[:, 1], -r[:, 2], r[:, 0],
+                                                                r[:, 1], -r[:, 0]], axis=1)
     return block
 
 

@@ -2,7 +2,7 @@
 elimination T of a meshed model (:class:`FEModel`, :func:`assemble`)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -19,7 +19,7 @@ from linmstmm.fe.masses import _negligible_mass_removed
 from linmstmm.fe.node_constraints import NodeConstraints, node_constraints
 from linmstmm.fe.products import congruence, dense_product, small, transposed
 from linmstmm.fe.rigid_motions import rigid_modes
-from linmstmm.fe.sparse import scipy_csr, symmetric_part
+from linmstmm.fe.sparse import as_scipy, scipy_csr, symmetric_part
 from linmstmm.model import Model
 
 
@@ -90,7 +90,8 @@ class ConstrainedParts:
     layout : the node numbering, positions and frames.
     T : (n_full, n_dof) sparse elimination of every constraint (boundaries,
         rigid bodies' ports, infinite spring directions, beam directions declared
-        rigid); the full vector is ``T @ q``.
+        rigid); the full vector is ``T @ q``. scipy CSR, or its arrays as a CSR
+        :class:`~linmstmm.fe.sparse.Compressed` (:meth:`NodeConstraints.eliminated`).
     masters : (n_dof,) full DOFs kept as the reduced ones.
     n_full : 6 per node.
     spring_strains, spring_stiffness : the finite spring directions, as rows of
@@ -240,6 +241,8 @@ def assembled(model: Model, elements_per_beam: int, constraints_of=node_constrai
     formed = forms(T, elements, parts) if forms is not None and small(T.shape[1], n_full) else None
     if formed is not None:
         return Assembly(model, parts, *(_symmetric_of_dense(product) for product in formed), None, D)
+    parts = replace(parts, T=as_scipy(T))      # scipy's products below, and the FE model's T
+    T = parts.T
     strains, mass = _Triplets(), parts.rigid_mass.copy()
     _add_beams(elements, strains, mass)
     strains.extend(parts.spring_strains)

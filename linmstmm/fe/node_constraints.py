@@ -104,8 +104,10 @@ class NodeConstraints:
 
         Returns
         -------
-        T : scipy.sparse.csr_matrix, shape (n_full, n_dof)
-            The full vector is ``T @ q``.
+        T : scipy.sparse.csr_matrix or Compressed, shape (n_full, n_dof)
+            The full vector is ``T @ q``. Where the nodes' elimination is extended by
+            the interior nodes' identity, the arrays as :class:`Compressed` CSR (their
+            scipy matrix: :func:`~linmstmm.fe.sparse.as_scipy`).
         masters : numpy.ndarray, shape (n_dof,)
             The full DOFs kept as the reduced ones, ascending.
         """
@@ -114,6 +116,7 @@ class NodeConstraints:
             T, masters = self.elimination
             if not interior.size:       # the nodes themselves (one element per beam)
                 return T, masters
+            T = Compressed("csr", T.indptr, T.indices, T.data, T.shape)
             return _with_identity(T, len(interior)), np.concatenate([masters, interior])
         t0 = scipy_csr(_with_identity(self.port_map, len(interior)))
         t1, masters = _eliminate(reduced_constraints(_stacked(beam_rows.compressed(n_full), self.rows), t0))

@@ -131,6 +131,23 @@ def stored_entries(indptr: np.ndarray, which: np.ndarray) -> tuple[np.ndarray, n
     return owner, indptr[which][owner] + np.arange(len(owner)) - (np.cumsum(lengths) - lengths)[owner]
 
 
+def as_scipy(matrix) -> sp.csr_matrix:
+    """The scipy CSR matrix of a CSR :class:`Compressed` with its arrays as they are
+    (indices in their stored order, not flagged sorted), or ``matrix`` itself.
+
+    Parameters
+    ----------
+    matrix : Compressed (CSR) or scipy sparse matrix.
+
+    Returns
+    -------
+    scipy.sparse.csr_matrix, or ``matrix`` where it is not a :class:`Compressed`.
+    """
+    if not isinstance(matrix, Compressed):
+        return matrix
+    return sp.csr_matrix((matrix.data, matrix.indices, matrix.indptr), shape=matrix.shape)
+
+
 def scipy_csr(matrix) -> sp.csr_matrix:
     """The scipy CSR matrix of a dense array, of a CSR :class:`Compressed` whose indices
     ascend in each row, or of a scipy sparse matrix (itself if CSR). The index arrays

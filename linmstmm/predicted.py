@@ -65,20 +65,18 @@ COUNTED_PREDICTION = 1e-6
 def _clusters(predictions: np.ndarray) -> list[list[int]]:
     """Indices of ``predictions`` (ascending) grouped where neighbours are within CLUSTER."""
     groups: list[list[int]] = []
-    for i, omega in enumerate(predictions):
-        if groups and omega - predictions[groups[-1][-1]] <= CLUSTER * omega:
+    values = predictions.tolist()
+    for i, omega in enumerate(values):
+        if groups and omega - values[groups[-1][-1]] <= CLUSTER * omega:
             groups[-1].append(i)
         else:
             groups.append([i])
     return groups
 
 
-def _in_cluster(predictions: np.ndarray) -> np.ndarray:
-    """(m,) bool: which of ``predictions`` (ascending) share a cluster (:func:`_clusters`) with another."""
-    in_cluster = np.zeros(predictions.size, dtype=bool)
-    for group in _clusters(predictions):
-        in_cluster[group] = len(group) > 1
-    return in_cluster
+def _in_cluster(predictions: np.ndarray) -> list[bool]:
+    """(m,): which of ``predictions`` (ascending) share a cluster (:func:`_clusters`) with another."""
+    return [len(group) > 1 for group in _clusters(predictions) for _ in group]
 
 
 def predicted_roots(finder, predictions: np.ndarray, count: int):
@@ -214,23 +212,22 @@ def _counted_predictions(finder, predictions: np.ndarray, start: int, stop: int)
     again as a new one (thousands of evaluations and a refinement in mpmath where
     the default rtol took a few hundred).
     """
-    indices = np.arange(start, stop)
     counter = finder.counter
-    if counter is None or finder.rtol < COUNTED_PREDICTION or not indices.size:
-        return [], indices
-    tried = indices[~_in_cluster(predictions)[indices]]
-    width = finder.rtol
+    if counter is None or finder.rtol < COUNTED_PREDICTION or start >= stop:
+        return [], np.arange(start, stop)
+    in_cluster, values, width = _in_cluster(predictions), predictions.tolist(), finder.rtol
+    tried = [i for i in range(start, stop) if not in_cluster[i]]
     prefetch = getattr(counter, "prefetch", None)
     if prefetch is not None:
-        prefetch([omega * (1 + sign * width) for omega in predictions[tried] for sign in (-1, 1)])
-    stands = np.zeros(tried.size, dtype=bool)
-    for j, omega in enumerate(predictions[tried]):
-        below, above = counter(omega * (1 - width)), counter(omega * (1 + width))
-        stands[j] = below is not None and above is not None and above - below == 1
-    counted = [float(omega) for omega in predictions[tried[stands]]]
-    for omega in counted:
-        finder.last_step[omega] = width
-    return counted, np.setdiff1d(indices, tried[stands])
+        prefetch([values[i] * (1 + sign * width) for i in tried for sign in (-1, 1)])
+    stands = set()
+    for i in tried:
+        below, above = counter(values[i] * (1 - width)), counter(values[i] * (1 + width))
+        if below is not None and above is not None and above - below == 1:
+            stands.add(i)
+            finder.last_step[values[i]] = width
+    return ([values[i] for i in sorted(stands)],
+            np.array([i for i in range(start, stop) if i not in stands], dtype=np.int64))
 
 
 def _secant_polished(finder, predictions: np.ndarray, indices: np.ndarray,

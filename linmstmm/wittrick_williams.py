@@ -34,6 +34,7 @@ the count answers None, and callers count another way.
 from __future__ import annotations
 
 import copy
+import functools
 
 import numpy as np
 import scipy.linalg.lapack as lapack
@@ -92,6 +93,14 @@ COUNT_BATCH = 24
 #: Frequencies whose D(ω) the numpy engine forms at once (:meth:`ModeCounter.prefetch`):
 #: one at a time, forming D(ω) took 176 of the 308 µs of a count on the launcher.
 NUMPY_BATCH = 64
+
+
+@functools.cache
+def _stiffness_kernels():
+    """:mod:`linmstmm._stiffness_kernels`, imported on the first compiled count (numba loads there)."""
+    from linmstmm import _stiffness_kernels as kernels
+
+    return kernels
 
 
 def mode_counter(model: Model, engine: str = "auto") -> ModeCounter | None:
@@ -157,9 +166,10 @@ class ModeCounter:
 
     def __call__(self, omega: float) -> int | None:
         omega = float(omega)
-        if omega not in self._answers:  # the certifying steps ask at the same ω more than once
-            self._answers[omega] = self._compiled(omega) if self.engine == "compiled" else self._numpy(omega)
-        return self._answers[omega]
+        answers = self._answers  # the certifying steps ask at the same ω more than once
+        if omega not in answers:
+            answers[omega] = self._compiled(omega) if self.engine == "compiled" else self._numpy(omega)
+        return answers[omega]
 
     def _numpy(self, omega: float) -> int | None:
         """:meth:`__call__` by the numpy reference."""
@@ -191,13 +201,19 @@ class ModeCounter:
         omegas : iterable of float
             rad/s, the frequencies a search is about to count at.
         """
-        wanted = sorted({float(omega) for omega in omegas} - set(self._answers))
+        answers = self._answers
+        wanted = sorted({omega for omega in map(float, omegas) if omega not in answers})
+        if not wanted:
+            return
         if self.engine != "compiled":
             for start in range(0, len(wanted), NUMPY_BATCH):
                 batch = wanted[start:start + NUMPY_BATCH]
-                self._answers.update(zip(batch, self._numpy_at(batch)))
+                answers.update(zip(batch, self._numpy_at(batch)))
             return
-        counts = np.empty(len(wanted), dtype=np.int64)
+        if len(wanted) < COUNT_BATCH:  # on this thread, in this counter's own buffers
+            answers.update(zip(wanted, map(self._compiled, wanted)))
+            return
+        counts = [0] * len(wanted)
         self._beam_table()  # made here, not by two pieces at once
 
         def count_piece(start: int, stop: int) -> None:
@@ -206,7 +222,7 @@ class ModeCounter:
                 counts[i] = self._kernel_count(wanted[i], scratch)
 
         spread(count_piece, len(wanted), COUNT_BATCH)
-        self._answers.update((omega, None if count < 0 else int(count)) for omega, count in zip(wanted, counts))
+        answers.update((omega, None if count < 0 else count) for omega, count in zip(wanted, counts))
 
     def _compiled(self, omega: float) -> int | None:
         """:meth:`__call__` by the compiled kernel (:func:`linmstmm._stiffness_kernels.count`)."""
@@ -228,23 +244,19 @@ class ModeCounter:
     def _beam_table(self) -> np.ndarray:
         """The beams as the compiled kernel takes them (:func:`linmstmm._stiffness_kernels.beam_columns`),
         made on the first call."""
-        from linmstmm import _stiffness_kernels as kernels
-
         if self._table is None:
-            self._table = kernels.beam_columns(self._beams)
+            self._table = _stiffness_kernels().beam_columns(self._beams)
         return self._table
 
     def _kernel_count(self, omega: float, scratch: tuple) -> int:
         """J(ω) by :func:`linmstmm._stiffness_kernels.ordered_count` in ``scratch``, or
         by the dense :func:`~linmstmm._stiffness_kernels.count` where that one
         refuses; −1 where undecided."""
-        from linmstmm import _stiffness_kernels as kernels
-
+        kernels, table = _stiffness_kernels(), self._beam_table()
         matrix, magnitude, work, buffers = scratch
-        found = kernels.ordered_count(omega, self._beam_table(), self._maps, SINGULAR_PIVOT, MOST_GROWTH, *self._plan,
-                                      buffers)
+        found = kernels.ordered_count(omega, table, self._maps, SINGULAR_PIVOT, MOST_GROWTH, *self._plan, buffers)
         if found == kernels.REFUSED:
-            found = kernels.count(omega, self._beam_table(), self._maps, self._columns, self._static, self._mass,
+            found = kernels.count(omega, table, self._maps, self._columns, self._static, self._mass,
                                   SINGULAR_PIVOT, matrix, magnitude, work)
         return found
 

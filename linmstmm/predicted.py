@@ -30,6 +30,8 @@ roots are predicted first and each evaluation goes where a root is:
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from linmstmm.counting import deflated
@@ -245,18 +247,19 @@ def _secant_polished(finder, predictions: np.ndarray, indices: np.ndarray,
     1.3e-9 on a ring's 10th root with the default rtol, goes to the pencil).
     """
     found, steps = secant_roots(finder.log_det, predictions[indices], finder.xtol, finder.UNCERTAIN)
-    in_cluster = _in_cluster(predictions)
-    settled = np.array([not np.isnan(root) and abs(root - predictions[i]) <= 0.5 * _gap(predictions, i)
-                        and step <= (finder.xtol if in_cluster[i] else finder.rtol)
-                        and not _known(root, known, _same_root(finder))
-                        for i, root, step in zip(indices, found, steps)], dtype=bool)
-    for i in np.flatnonzero(settled):  # two that settled on one root: neither stands
-        twins = settled & (np.abs(found - found[i]) <= _same_root(finder) * found[i])
-        if twins.sum() > 1:
-            settled[twins] = False
-    for root, step in zip(found[settled], steps[settled]):
-        finder.last_step[root] = step
-    return list(found[settled]), [float(p) for p in predictions[indices][~settled]]
+    in_cluster, values, same = _in_cluster(predictions), predictions.tolist(), _same_root(finder)
+    roots = found.tolist()
+    settled = [not math.isnan(root) and abs(root - values[i]) <= 0.5 * _gap(values, i)
+               and step <= (finder.xtol if in_cluster[i] else finder.rtol) and not _known(root, known, same)
+               for i, root, step in zip(indices.tolist(), roots, steps.tolist())]
+    for i in [k for k, stands in enumerate(settled) if stands]:  # two that settled on one root: neither stands
+        twins = [k for k, stands in enumerate(settled) if stands and abs(roots[k] - roots[i]) <= same * roots[i]]
+        if len(twins) > 1:
+            for k in twins:
+                settled[k] = False
+    for k in np.flatnonzero(settled):
+        finder.last_step[found[k]] = steps[k]
+    return [found[k] for k in np.flatnonzero(settled)], [values[i] for i, stands in zip(indices, settled) if not stands]
 
 
 def _completed_by_counts(finder, found: list[float], lo: float, hi: float):
@@ -425,10 +428,11 @@ def _cluster_reach(predictions: np.ndarray, start: float) -> float:
                                          np.abs(outside - predictions[group[-1]]))))
 
 
-def _gap(predictions: np.ndarray, i: int) -> float:
-    """Distance from prediction i to its nearest neighbour (its own size if alone)."""
-    others = np.delete(predictions, i)
-    return float(np.min(np.abs(others - predictions[i]))) if others.size else float(predictions[i])
+def _gap(predictions: list[float], i: int) -> float:
+    """Distance from prediction i of ``predictions`` (ascending) to its nearest
+    neighbour, one of the two beside it (its own size if alone)."""
+    beside = [abs(predictions[j] - predictions[i]) for j in (i - 1, i + 1) if 0 <= j < len(predictions)]
+    return min(beside) if beside else predictions[i]
 
 
 def _gap_above(roots: list[float], count: int, same: float, beyond: list[float]) -> float:

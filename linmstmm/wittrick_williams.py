@@ -157,8 +157,11 @@ class ModeCounter:
         The compiled kernel writes D(ω) into buffers of the counter it is called
         for: the twin gets its own, so that searches of the same model on two
         threads at once (each with its own twin) do not write into each other's.
-        One counter serves one thread at a time.
+        One counter serves one thread at a time. The beams' table the kernels read
+        (never write) is made here once and shared, not again for every twin.
         """
+        if self.engine == "compiled":
+            self._beam_table()
         twin = copy.copy(self)
         twin._answers = {}
         twin._scratch = None

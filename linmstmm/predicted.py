@@ -159,8 +159,9 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
     standing, indices = (_counted_predictions(finder, predictions, start, stop) if stand
                          else ([], np.arange(start, stop)))
     leaders, followers = _coincident(predictions, indices)
-    found, unsettled = _secant_polished(finder, predictions, np.setdiff1d(indices, np.r_[leaders, followers]),
-                                        list(roots) + standing)
+    coincident = {*leaders.tolist(), *followers.tolist()}
+    alone = np.array([i for i in indices.tolist() if i not in coincident], dtype=np.int64)
+    found, unsettled = _secant_polished(finder, predictions, alone, list(roots) + standing)
     found, troubled = _pencil_polished(finder, list(roots) + standing + found,
                                        unsettled + [float(p) for p in predictions[leaders]])
     found, troubled = _deflated_polished(finder, found, troubled, predictions)

@@ -247,6 +247,8 @@ def _secant_polished(finder, predictions: np.ndarray, indices: np.ndarray,
     the finder's rtol for the others (a secant that stalled above it on a noisy det,
     1.3e-9 on a ring's 10th root with the default rtol, goes to the pencil).
     """
+    if not indices.size:  # every prediction stood, or went to the pencil
+        return [], []
     found, steps = secant_roots(finder.log_det, predictions[indices], finder.xtol, finder.UNCERTAIN)
     in_cluster, values, same = _in_cluster(predictions), predictions.tolist(), _same_root(finder)
     roots = found.tolist()
@@ -283,6 +285,8 @@ def _pencil_polished(finder, roots: list[float], starts: list[float]) -> tuple[l
     random loops 57 had its 40th and 41st 9.7e-6 apart, certified as one double
     root): the segment search takes the stretch around them."""
     roots, troubled, partners = list(roots), [], []
+    if not starts:
+        return roots, troubled
     for start, (root, offsets) in zip(starts, finder.polish(starts)):
         if root is not None and not _known(root, roots, _same_root(finder)):
             roots.append(root)

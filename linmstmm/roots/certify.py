@@ -243,9 +243,9 @@ def _on_an_end(ordered: list[float], root: float, width: float) -> bool:
     side of it the root lies is then not known, and the count there says nothing
     about it (a rod's pair exactly 1e-7 apart: a duplicate of one member and the
     other on the end made the count at 1e-7 hold)."""
-    band = 0.1 * width * root
-    return any(bisect_left(ordered, end + band) > bisect_left(ordered, end - band)
-               for end in (root * (1 - width), root * (1 + width)))
+    band, low, high = 0.1 * width * root, root * (1 - width), root * (1 + width)
+    return (bisect_left(ordered, low + band) > bisect_left(ordered, low - band)
+            or bisect_left(ordered, high + band) > bisect_left(ordered, high - band))
 
 
 def _known_within(ordered: list[float], root: float, width: float) -> int:

@@ -90,12 +90,17 @@ def spread(task, size: int, min_batch: int = MIN_BATCH) -> None:
                 claimed[0] = min(start + piece, size)
             if start >= size:
                 return
+            failed = None
             try:
                 task(start, min(start + piece, size))
-            except BaseException as error:  # raised in the caller once every piece has run
-                errors.append(error)
+            except BaseException as error:  # raised in the caller; the pieces not begun are dropped
+                failed = error
             with lock:
                 done[0] += 1
+                if failed is not None:
+                    errors.append(failed)
+                    done[0] += math.ceil((size - claimed[0]) / piece)
+                    claimed[0] = size
                 if done[0] == pieces:
                     all_done.set()
 

@@ -109,3 +109,19 @@ def test_the_caller_waits_for_no_thread_that_has_not_started(monkeypatch):
         assert np.all(seen == 1)
     finally:
         release.set()
+
+
+@pytest.mark.parametrize("cores", [1, 2])
+def test_a_failed_piece_stops_the_pieces_not_begun(monkeypatch, cores):
+    """After a piece fails, the pieces no thread has begun are dropped (an interrupted
+    batch of 512 frequencies does not run to its end first), and the error is raised."""
+    monkeypatch.setattr(spread, "cores", lambda: cores)
+    ran = []
+
+    def task(start, stop):
+        ran.append(start)
+        raise KeyError("first piece")
+
+    with pytest.raises(KeyError):
+        spread.spread(task, 1000)
+    assert len(ran) <= cores

@@ -260,9 +260,10 @@ def _secant_polished(finder, predictions: np.ndarray, indices: np.ndarray,
         if len(twins) > 1:
             for k in twins:
                 settled[k] = False
-    for k in np.flatnonzero(settled):
+    kept = np.flatnonzero(settled)
+    for k in kept:
         finder.last_step[found[k]] = steps[k]
-    return [found[k] for k in np.flatnonzero(settled)], [values[i] for i, stands in zip(indices, settled) if not stands]
+    return [found[k] for k in kept], [values[i] for i, stands in zip(indices, settled) if not stands]
 
 
 def _completed_by_counts(finder, found: list[float], lo: float, hi: float):

@@ -255,8 +255,8 @@ class ModeCounter:
         """J(ω) at each of ``omegas`` (m,) rad/s into ``found`` (m,) int64, −1 where undecided,
         by :func:`linmstmm._count_batch.counts` in ``scratch`` (:meth:`_new_scratch`)."""
         matrix, magnitude, work, buffers = scratch
-        _batched_counts()(omegas, self._beam_table(), self._maps, self._columns, self._static, self._mass, SINGULAR_PIVOT,
-               MOST_GROWTH, *self._plan, buffers, matrix, magnitude, work, found)
+        _batched_counts()(omegas, self._beam_table(), self._maps, self._columns, self._static, self._mass,
+                          SINGULAR_PIVOT, MOST_GROWTH, *self._plan, buffers, matrix, magnitude, work, found)
 
     def matrices(self, omegas) -> tuple[np.ndarray, np.ndarray]:
         """(D(ω), |D|(ω)) at each of the m ``omegas`` (rad/s): the reduced exact dynamic

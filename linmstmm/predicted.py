@@ -30,6 +30,8 @@ roots are predicted first and each evaluation goes where a root is:
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from linmstmm.counting import deflated
@@ -65,20 +67,18 @@ COUNTED_PREDICTION = 1e-6
 def _clusters(predictions: np.ndarray) -> list[list[int]]:
     """Indices of ``predictions`` (ascending) grouped where neighbours are within CLUSTER."""
     groups: list[list[int]] = []
-    for i, omega in enumerate(predictions):
-        if groups and omega - predictions[groups[-1][-1]] <= CLUSTER * omega:
+    values = predictions.tolist()
+    for i, omega in enumerate(values):
+        if groups and omega - values[groups[-1][-1]] <= CLUSTER * omega:
             groups[-1].append(i)
         else:
             groups.append([i])
     return groups
 
 
-def _in_cluster(predictions: np.ndarray) -> np.ndarray:
-    """(m,) bool: which of ``predictions`` (ascending) share a cluster (:func:`_clusters`) with another."""
-    in_cluster = np.zeros(predictions.size, dtype=bool)
-    for group in _clusters(predictions):
-        in_cluster[group] = len(group) > 1
-    return in_cluster
+def _in_cluster(predictions: np.ndarray) -> list[bool]:
+    """(m,): which of ``predictions`` (ascending) share a cluster (:func:`_clusters`) with another."""
+    return [len(group) > 1 for group in _clusters(predictions) for _ in group]
 
 
 def predicted_roots(finder, predictions: np.ndarray, count: int):
@@ -159,8 +159,9 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
     standing, indices = (_counted_predictions(finder, predictions, start, stop) if stand
                          else ([], np.arange(start, stop)))
     leaders, followers = _coincident(predictions, indices)
-    found, unsettled = _secant_polished(finder, predictions, np.setdiff1d(indices, np.r_[leaders, followers]),
-                                        list(roots) + standing)
+    coincident = {*leaders.tolist(), *followers.tolist()}
+    alone = np.array([i for i in indices.tolist() if i not in coincident], dtype=np.int64)
+    found, unsettled = _secant_polished(finder, predictions, alone, list(roots) + standing)
     found, troubled = _pencil_polished(finder, list(roots) + standing + found,
                                        unsettled + [float(p) for p in predictions[leaders]])
     found, troubled = _deflated_polished(finder, found, troubled, predictions)
@@ -214,23 +215,22 @@ def _counted_predictions(finder, predictions: np.ndarray, start: int, stop: int)
     again as a new one (thousands of evaluations and a refinement in mpmath where
     the default rtol took a few hundred).
     """
-    indices = np.arange(start, stop)
     counter = finder.counter
-    if counter is None or finder.rtol < COUNTED_PREDICTION or not indices.size:
-        return [], indices
-    tried = indices[~_in_cluster(predictions)[indices]]
-    width = finder.rtol
+    if counter is None or finder.rtol < COUNTED_PREDICTION or start >= stop:
+        return [], np.arange(start, stop)
+    in_cluster, values, width = _in_cluster(predictions), predictions.tolist(), finder.rtol
+    tried = [i for i in range(start, stop) if not in_cluster[i]]
     prefetch = getattr(counter, "prefetch", None)
     if prefetch is not None:
-        prefetch([omega * (1 + sign * width) for omega in predictions[tried] for sign in (-1, 1)])
-    stands = np.zeros(tried.size, dtype=bool)
-    for j, omega in enumerate(predictions[tried]):
-        below, above = counter(omega * (1 - width)), counter(omega * (1 + width))
-        stands[j] = below is not None and above is not None and above - below == 1
-    counted = [float(omega) for omega in predictions[tried[stands]]]
-    for omega in counted:
-        finder.last_step[omega] = width
-    return counted, np.setdiff1d(indices, tried[stands])
+        prefetch([values[i] * (1 + sign * width) for i in tried for sign in (-1, 1)])
+    stands = set()
+    for i in tried:
+        below, above = counter(values[i] * (1 - width)), counter(values[i] * (1 + width))
+        if below is not None and above is not None and above - below == 1:
+            stands.add(i)
+            finder.last_step[values[i]] = width
+    return ([values[i] for i in sorted(stands)],
+            np.array([i for i in range(start, stop) if i not in stands], dtype=np.int64))
 
 
 def _secant_polished(finder, predictions: np.ndarray, indices: np.ndarray,
@@ -247,19 +247,23 @@ def _secant_polished(finder, predictions: np.ndarray, indices: np.ndarray,
     the finder's rtol for the others (a secant that stalled above it on a noisy det,
     1.3e-9 on a ring's 10th root with the default rtol, goes to the pencil).
     """
+    if not indices.size:  # every prediction stood, or went to the pencil
+        return [], []
     found, steps = secant_roots(finder.log_det, predictions[indices], finder.xtol, finder.UNCERTAIN)
-    in_cluster = _in_cluster(predictions)
-    settled = np.array([not np.isnan(root) and abs(root - predictions[i]) <= 0.5 * _gap(predictions, i)
-                        and step <= (finder.xtol if in_cluster[i] else finder.rtol)
-                        and not _known(root, known, _same_root(finder))
-                        for i, root, step in zip(indices, found, steps)], dtype=bool)
-    for i in np.flatnonzero(settled):  # two that settled on one root: neither stands
-        twins = settled & (np.abs(found - found[i]) <= _same_root(finder) * found[i])
-        if twins.sum() > 1:
-            settled[twins] = False
-    for root, step in zip(found[settled], steps[settled]):
-        finder.last_step[root] = step
-    return list(found[settled]), [float(p) for p in predictions[indices][~settled]]
+    in_cluster, values, same = _in_cluster(predictions), predictions.tolist(), _same_root(finder)
+    roots = found.tolist()
+    settled = [not math.isnan(root) and abs(root - values[i]) <= 0.5 * _gap(values, i)
+               and step <= (finder.xtol if in_cluster[i] else finder.rtol) and not _known(root, known, same)
+               for i, root, step in zip(indices.tolist(), roots, steps.tolist())]
+    for i in [k for k, stands in enumerate(settled) if stands]:  # two that settled on one root: neither stands
+        twins = [k for k, stands in enumerate(settled) if stands and abs(roots[k] - roots[i]) <= same * roots[i]]
+        if len(twins) > 1:
+            for k in twins:
+                settled[k] = False
+    kept = np.flatnonzero(settled)
+    for k in kept:
+        finder.last_step[found[k]] = steps[k]
+    return [found[k] for k in kept], [values[i] for i, stands in zip(indices, settled) if not stands]
 
 
 def _completed_by_counts(finder, found: list[float], lo: float, hi: float):
@@ -282,6 +286,8 @@ def _pencil_polished(finder, roots: list[float], starts: list[float]) -> tuple[l
     random loops 57 had its 40th and 41st 9.7e-6 apart, certified as one double
     root): the segment search takes the stretch around them."""
     roots, troubled, partners = list(roots), [], []
+    if not starts:
+        return roots, troubled
     for start, (root, offsets) in zip(starts, finder.polish(starts)):
         if root is not None and not _known(root, roots, _same_root(finder)):
             roots.append(root)
@@ -428,10 +434,11 @@ def _cluster_reach(predictions: np.ndarray, start: float) -> float:
                                          np.abs(outside - predictions[group[-1]]))))
 
 
-def _gap(predictions: np.ndarray, i: int) -> float:
-    """Distance from prediction i to its nearest neighbour (its own size if alone)."""
-    others = np.delete(predictions, i)
-    return float(np.min(np.abs(others - predictions[i]))) if others.size else float(predictions[i])
+def _gap(predictions: list[float], i: int) -> float:
+    """Distance from prediction i of ``predictions`` (ascending) to its nearest
+    neighbour, one of the two beside it (its own size if alone)."""
+    beside = [abs(predictions[j] - predictions[i]) for j in (i - 1, i + 1) if 0 <= j < len(predictions)]
+    return min(beside) if beside else predictions[i]
 
 
 def _gap_above(roots: list[float], count: int, same: float, beyond: list[float]) -> float:

@@ -31,8 +31,9 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
     if not x_old.size:
         return np.zeros(0), np.zeros(0)
     x = x_old * (1 + FIRST_STEP)
-    sign_old, log_old = log_det(x_old)
-    sign, log_abs = log_det(x)
+    # both starting points in one batch (each frequency is evaluated on its own: the same numbers)
+    signs, logs = log_det(np.concatenate([x_old, x]))
+    (sign_old, sign), (log_old, log_abs) = np.split(signs, 2), np.split(logs, 2)
     roots = np.full(x.size, np.nan)
     steps = np.full(x.size, np.inf)
     active = np.arange(x.size)

@@ -79,7 +79,9 @@ def spread(task, size: int, min_batch: int = MIN_BATCH) -> None:
             _pool.shutdown(wait=False)
         _pool, _pool_threads = ThreadPoolExecutor(max_workers=threads - 1, thread_name_prefix="linmstmm"), threads - 1
     piece = max(1, math.ceil(size / (PIECES_PER_THREAD * threads)))
-    lock, claimed = threading.Lock(), [0]
+    pieces = math.ceil(size / piece)
+    lock, all_done = threading.Lock(), threading.Event()
+    claimed, done, errors = [0], [0], []
 
     def work() -> None:
         while True:
@@ -88,11 +90,23 @@ def spread(task, size: int, min_batch: int = MIN_BATCH) -> None:
                 claimed[0] = min(start + piece, size)
             if start >= size:
                 return
-            task(start, min(start + piece, size))
+            failed = None
+            try:
+                task(start, min(start + piece, size))
+            except BaseException as error:  # raised in the caller; the pieces not begun are dropped
+                failed = error
+            with lock:
+                done[0] += 1
+                if failed is not None:
+                    errors.append(failed)
+                    done[0] += math.ceil((size - claimed[0]) / piece)
+                    claimed[0] = size
+                if done[0] == pieces:
+                    all_done.set()
 
-    helpers = [_pool.submit(work) for _ in range(threads - 1)]
-    try:
-        work()
-    finally:
-        for helper in helpers:
-            helper.result()
+    for _ in range(threads - 1):
+        _pool.submit(work)
+    work()
+    all_done.wait()  # for the pieces others are running; a thread that has not started finds none left
+    if errors:
+        raise errors[0]

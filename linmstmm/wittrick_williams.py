@@ -34,6 +34,7 @@ the count answers None, and callers count another way.
 from __future__ import annotations
 
 import copy
+import functools
 
 import numpy as np
 import scipy.linalg.lapack as lapack
@@ -94,6 +95,22 @@ COUNT_BATCH = 24
 NUMPY_BATCH = 64
 
 
+@functools.cache
+def _stiffness_kernels():
+    """:mod:`linmstmm._stiffness_kernels`, imported where a counter is first compiled (numba loads there)."""
+    from linmstmm import _stiffness_kernels as kernels
+
+    return kernels
+
+
+@functools.cache
+def _batched_counts():
+    """:func:`linmstmm._count_batch.counts`, imported on the first compiled count."""
+    from linmstmm._count_batch import counts
+
+    return counts
+
+
 def mode_counter(model: Model, engine: str = "auto") -> ModeCounter | None:
     """The :class:`ModeCounter` of ``model``, or None where D(ω) would be larger than
     MAX_ORDER (decided from the nodes before anything is built, then from the order
@@ -143,8 +160,11 @@ class ModeCounter:
         The compiled kernel writes D(ω) into buffers of the counter it is called
         for: the twin gets its own, so that searches of the same model on two
         threads at once (each with its own twin) do not write into each other's.
-        One counter serves one thread at a time.
+        One counter serves one thread at a time. The beams' table the kernels read
+        (never write) is made here once and shared, not again for every twin.
         """
+        if self.engine == "compiled":
+            self._beam_table()
         twin = copy.copy(self)
         twin._answers = {}
         twin._scratch = None
@@ -153,12 +173,8 @@ class ModeCounter:
     def __call__(self, omega: float) -> int | None:
         omega = float(omega)
         if omega not in self._answers:  # the certifying steps ask at the same ω more than once
-            self._answers[omega] = self._compiled(omega) if self.engine == "compiled" else self._numpy(omega)
+            self._count_now([omega])
         return self._answers[omega]
-
-    def _numpy(self, omega: float) -> int | None:
-        """:meth:`__call__` by the numpy reference."""
-        return self._numpy_at([omega])[0]
 
     def _numpy_at(self, omegas) -> list[int | None]:
         """:meth:`__call__` at each of ``omegas`` (rad/s) by the numpy reference, J₀ and
@@ -186,29 +202,32 @@ class ModeCounter:
         omegas : iterable of float
             rad/s, the frequencies a search is about to count at.
         """
-        wanted = sorted({float(omega) for omega in omegas} - set(self._answers))
+        answers = self._answers
+        wanted = sorted({omega for omega in map(float, omegas) if omega not in answers})
+        if wanted:
+            self._count_now(wanted)
+
+    def _count_now(self, wanted: list[float]) -> None:
+        """Count at each of ``wanted`` (rad/s, none counted yet) and remember the answers:
+        compiled, in one kernel call (:func:`linmstmm._count_batch.counts`) on this
+        thread in this counter's own buffers, or from COUNT_BATCH of them shared among
+        the cores, each piece in buffers of its own; by the numpy reference, D(ω) formed
+        for NUMPY_BATCH of them at a time."""
         if self.engine != "compiled":
             for start in range(0, len(wanted), NUMPY_BATCH):
                 batch = wanted[start:start + NUMPY_BATCH]
                 self._answers.update(zip(batch, self._numpy_at(batch)))
             return
-        counts = np.empty(len(wanted), dtype=np.int64)
-        self._beam_table()  # made here, not by two pieces at once
-
-        def count_piece(start: int, stop: int) -> None:
-            scratch = self._new_scratch()
-            for i in range(start, stop):
-                counts[i] = self._kernel_count(wanted[i], scratch)
-
-        spread(count_piece, len(wanted), COUNT_BATCH)
-        self._answers.update((omega, None if count < 0 else int(count)) for omega, count in zip(wanted, counts))
-
-    def _compiled(self, omega: float) -> int | None:
-        """:meth:`__call__` by the compiled kernel (:func:`linmstmm._stiffness_kernels.count`)."""
-        if self._scratch is None:
-            self._scratch = self._new_scratch()
-        count = self._kernel_count(omega, self._scratch)
-        return None if count < 0 else count
+        omegas, found = np.array(wanted), np.empty(len(wanted), dtype=np.int64)
+        if len(wanted) < COUNT_BATCH:
+            if self._scratch is None:
+                self._scratch = self._new_scratch()
+            self._kernel_counts(omegas, found, self._scratch)
+        else:
+            self._beam_table()  # made here, not by two pieces at once
+            spread(lambda start, stop: self._kernel_counts(omegas[start:stop], found[start:stop], self._new_scratch()),
+                   len(wanted), COUNT_BATCH)
+        self._answers.update((omega, None if count < 0 else count) for omega, count in zip(wanted, found.tolist()))
 
     def _new_scratch(self) -> tuple:
         """Buffers the compiled kernel writes into: D(ω) and |D|(ω) ((n_dof + 1)², a row
@@ -223,25 +242,16 @@ class ModeCounter:
     def _beam_table(self) -> np.ndarray:
         """The beams as the compiled kernel takes them (:func:`linmstmm._stiffness_kernels.beam_columns`),
         made on the first call."""
-        from linmstmm import _stiffness_kernels as kernels
-
         if self._table is None:
-            self._table = kernels.beam_columns(self._beams)
+            self._table = _stiffness_kernels().beam_columns(self._beams)
         return self._table
 
-    def _kernel_count(self, omega: float, scratch: tuple) -> int:
-        """J(ω) by :func:`linmstmm._stiffness_kernels.ordered_count` in ``scratch``, or
-        by the dense :func:`~linmstmm._stiffness_kernels.count` where that one
-        refuses; −1 where undecided."""
-        from linmstmm import _stiffness_kernels as kernels
-
+    def _kernel_counts(self, omegas: np.ndarray, found: np.ndarray, scratch: tuple) -> None:
+        """J(ω) at each of ``omegas`` (m,) rad/s into ``found`` (m,) int64, −1 where undecided,
+        by :func:`linmstmm._count_batch.counts` in ``scratch`` (:meth:`_new_scratch`)."""
         matrix, magnitude, work, buffers = scratch
-        found = kernels.ordered_count(omega, self._beam_table(), self._maps, SINGULAR_PIVOT, MOST_GROWTH, *self._plan,
-                                      buffers)
-        if found == kernels.REFUSED:
-            found = kernels.count(omega, self._beam_table(), self._maps, self._columns, self._static, self._mass,
-                                  SINGULAR_PIVOT, matrix, magnitude, work)
-        return found
+        _batched_counts()(omegas, self._beam_table(), self._maps, self._columns, self._static, self._mass,
+                          SINGULAR_PIVOT, MOST_GROWTH, *self._plan, buffers, matrix, magnitude, work, found)
 
     def matrices(self, omegas) -> tuple[np.ndarray, np.ndarray]:
         """(D(ω), |D|(ω)) at each of the m ``omegas`` (rad/s): the reduced exact dynamic

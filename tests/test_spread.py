@@ -86,3 +86,42 @@ def test_a_forked_child_shares_its_batches_on_threads_of_its_own(monkeypatch):
     context = multiprocessing.get_context("fork")
     with context.Pool(1) as pool:
         assert pool.apply_async(_spread_sum, (1000,)).get(timeout=60) == sum(range(1000))
+
+
+def test_the_caller_waits_for_no_thread_that_has_not_started(monkeypatch):
+    """On a machine whose other cores are busy a helper thread may not run for a long
+    while: the caller does every piece itself and returns, without waiting for it
+    (it used to wait for each helper to start and find nothing left)."""
+    monkeypatch.setattr(spread, "cores", lambda: 2)
+    assert _spread_sum(100) == sum(range(100))  # the pool exists now
+    release = threading.Event()
+    for _ in range(spread._pool_threads):  # every thread of the pool busy elsewhere
+        spread._pool.submit(release.wait, 60)
+    try:
+        seen, finished = np.zeros(100, dtype=int), threading.Event()
+
+        def task(start, stop):
+            seen[start:stop] += 1
+
+        caller = threading.Thread(target=lambda: (spread.spread(task, 100), finished.set()))
+        caller.start()
+        assert finished.wait(20)
+        assert np.all(seen == 1)
+    finally:
+        release.set()
+
+
+@pytest.mark.parametrize("cores", [1, 2])
+def test_a_failed_piece_stops_the_pieces_not_begun(monkeypatch, cores):
+    """After a piece fails, the pieces no thread has begun are dropped (an interrupted
+    batch of 512 frequencies does not run to its end first), and the error is raised."""
+    monkeypatch.setattr(spread, "cores", lambda: cores)
+    ran = []
+
+    def task(start, stop):
+        ran.append(start)
+        raise KeyError("first piece")
+
+    with pytest.raises(KeyError):
+        spread.spread(task, 1000)
+    assert len(ran) <= cores

@@ -4,6 +4,8 @@ out), and the recovery of those a count says are missing."""
 
 from __future__ import annotations
 
+from bisect import bisect_left, bisect_right
+
 import numpy as np
 
 from linmstmm.counting import count_zeros, count_zeros_many, deflated
@@ -191,7 +193,7 @@ def misplaced(finder, known: list[float], lo: float | None, hi: float) -> int | 
     reported as certified before)."""
     start, wrong = 0.0 if lo is None else lo, 0
     roots = sorted({r for r in known if start < r < hi})
-    ordered = np.sort(np.asarray(known, dtype=float))
+    ordered = sorted(known)
     first, held = _counted_widths(finder, ordered, roots)
     for root in roots:
         if root not in first:
@@ -203,7 +205,7 @@ def misplaced(finder, known: list[float], lo: float | None, hi: float) -> int | 
     return wrong
 
 
-def _counted_widths(finder, ordered: np.ndarray, roots: list[float]) -> tuple[dict, dict]:
+def _counted_widths(finder, ordered: list[float], roots: list[float]) -> tuple[dict, dict]:
     """({root: (count, width)} at the narrowest width where the count across it decides,
     {root: width} at the narrowest where it holds the known roots ``ordered`` (rad/s,
     ascending, with repeats) there), over
@@ -211,43 +213,46 @@ def _counted_widths(finder, ordered: np.ndarray, roots: list[float]) -> tuple[di
     :func:`_counts_near` gives root by root, counted here width by width so that
     each width's counts for all the roots are made together
     (:meth:`~linmstmm.wittrick_williams.ModeCounter.prefetch`, shared among the cores)."""
-    pending = {root: _widths(finder, root) for root in roots}
+    counter, near = finder.counter, near_widths(finder.rtol)
+    pending = [(root, _widths(finder, root, near)) for root in roots]
     first, held, level = {}, {}, 0
-    prefetch = getattr(finder.counter, "prefetch", None)
+    prefetch = getattr(counter, "prefetch", None)
     while pending:
-        pending = {root: widths for root, widths in pending.items() if level < len(widths)}
+        pending = [(root, widths) for root, widths in pending if level < len(widths)]
         if prefetch is not None:
-            prefetch([root * (1 + sign * widths[level]) for root, widths in pending.items() for sign in (-1, 1)])
-        for root, widths in list(pending.items()):
+            prefetch([root * (1 + sign * widths[level]) for root, widths in pending for sign in (-1, 1)])
+        unheld = []
+        for root, widths in pending:
             width = widths[level]
-            below, above = finder.counter(root * (1 - width)), finder.counter(root * (1 + width))
+            below, above = counter(root * (1 - width)), counter(root * (1 + width))
             if below is None or above is None or _on_an_end(ordered, root, width):
+                unheld.append((root, widths))
                 continue
             first.setdefault(root, (above - below, width))
             if above - below == _known_within(ordered, root, width):
                 held[root] = width
-                del pending[root]
-        level += 1
+            else:
+                unheld.append((root, widths))
+        pending, level = unheld, level + 1
     return first, held
 
 
-def _on_an_end(ordered: np.ndarray, root: float, width: float) -> bool:
+def _on_an_end(ordered: list[float], root: float, width: float) -> bool:
     """Whether one of the known roots ``ordered`` (rad/s, ascending) lies within a tenth
     of ``width`` of an end of the count across ``root`` (relative ±``width``): which
     side of it the root lies is then not known, and the count there says nothing
     about it (a rod's pair exactly 1e-7 apart: a duplicate of one member and the
     other on the end made the count at 1e-7 hold)."""
-    band = 0.1 * width * root
-    ends = np.array([root * (1 - width), root * (1 + width)])
-    return bool(np.any(np.searchsorted(ordered, ends + band) > np.searchsorted(ordered, ends - band)))
+    band, low, high = 0.1 * width * root, root * (1 - width), root * (1 + width)
+    return (bisect_left(ordered, low + band) > bisect_left(ordered, low - band)
+            or bisect_left(ordered, high + band) > bisect_left(ordered, high - band))
 
 
-def _known_within(ordered: np.ndarray, root: float, width: float) -> int:
+def _known_within(ordered: list[float], root: float, width: float) -> int:
     """How many of the known roots ``ordered`` (rad/s, ascending, with repeats) lie
     within ±``width`` (relative) of ``root``, ends excluded: its own multiplicity, and
     a close neighbour's that the same count sees."""
-    return int(np.searchsorted(ordered, root * (1 + width), side="left")
-               - np.searchsorted(ordered, root * (1 - width), side="right"))
+    return bisect_left(ordered, root * (1 + width)) - bisect_right(ordered, root * (1 - width))
 
 
 def stiffness_count(finder, known: list[float], lo: float | None, hi: float) -> int | None:
@@ -277,7 +282,7 @@ def counted_multiplicities(finder, roots: list[float], lo: float | None, hi: flo
     if finder.counter is None:
         return roots
     start, counted = 0.0 if lo is None else lo, []
-    ordered = np.sort(np.asarray(roots, dtype=float))
+    ordered = sorted(roots)
     for root in sorted(set(roots)):
         have = roots.count(root)
         if start < root < hi:
@@ -292,7 +297,7 @@ def counted_multiplicities(finder, roots: list[float], lo: float | None, hi: flo
     return counted
 
 
-def _count_near(finder, root: float, ordered: np.ndarray) -> tuple[int, float] | None:
+def _count_near(finder, root: float, ordered: list[float]) -> tuple[int, float] | None:
     """(natural frequencies within ±width of ``root``, width (relative)) at the
     narrowest width of :func:`_counts_near` where the count decides and no root of
     ``ordered`` (rad/s, ascending) lies on an end (:func:`_on_an_end`); None where
@@ -313,11 +318,12 @@ def _counts_near(finder, root: float):
         yield (None if below is None or above is None else above - below), width
 
 
-def _widths(finder, root: float) -> list[float]:
-    """The relative half-widths :func:`_counts_near` counts across ``root`` at, narrowest first."""
+def _widths(finder, root: float, near: list[float] | None = None) -> list[float]:
+    """The relative half-widths :func:`_counts_near` counts across ``root`` at, narrowest
+    first: of ``near`` (:func:`near_widths` of the finder's rtol where None)."""
     step = finder.last_step.get(root, 0.0)
     least = 4 * step if step > finder.rtol else 0.0   # a certified root is held to the narrowest
-    return [w for w in near_widths(finder.rtol) if w >= least] or [least]
+    return [w for w in (near_widths(finder.rtol) if near is None else near) if w >= least] or [least]
 
 
 def near_widths(rtol: float) -> list[float]:

@@ -4,6 +4,8 @@ count over a small circle), and multiple roots split into the distinct ones of a
 
 from __future__ import annotations
 
+from collections import Counter
+
 import numpy as np
 
 from linmstmm.counting import count_zeros_many
@@ -173,9 +175,10 @@ def separated(finder, roots: list[float]) -> list[float]:
     is split into them (:func:`_apart_by_offsets`).
     """
     roots = _apart_by_offsets(finder, roots)
-    distinct = sorted(set(roots))
+    tally = Counter(roots)
+    distinct = sorted(tally)
     # (a list cut at a count may hold one copy of a root counted as multiple)
-    multiple = [r for r in distinct if max(roots.count(r), finder._counted.get(r, 1)) > 1]
+    multiple = [r for r in distinct if max(tally[r], finder._counted.get(r, 1)) > 1]
     if not multiple:
         return roots
     radii = [finder._circle_radius(r, distinct) for r in multiple]
@@ -233,7 +236,7 @@ def _apart_by_offsets(finder, roots: list[float]) -> list[float]:
     """``roots`` with each multiple one whose pencil shows a distinct root beside it
     (:func:`beside`) split: that root takes one of its copies. The counts of
     :func:`separated` only say how many roots a circle holds."""
-    copies = {r: max(roots.count(r), finder._counted.get(r, 1)) for r in set(roots)}
+    copies = {r: max(m, finder._counted.get(r, 1)) for r, m in Counter(roots).items()}
     multiple = sorted(r for r, m in copies.items() if m > 1)
     if not multiple:
         return roots

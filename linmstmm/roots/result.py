@@ -4,6 +4,7 @@ on the same :class:`~linmstmm.roots.RootFinder` does can change them."""
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -85,15 +86,15 @@ def search_result(finder, roots: list[float]) -> RootSearchResult:
         finder's previous search ended (since the determinant was made, for
         the first).
     """
-    distinct, counts = np.unique(np.asarray(roots, dtype=float), return_counts=True)
-    distinct = distinct.tolist()
+    tally = Counter(map(float, roots))
+    distinct = sorted(tally)
     counter = finder.determinant
     evaluations = None if counter is None else counter.evaluations - finder._evaluations_reported
     if counter is not None:
         finder._evaluations_reported = counter.evaluations
     return RootSearchResult(
         roots=roots,
-        multiplicities=dict(zip(distinct, counts.tolist())),
+        multiplicities={root: tally[root] for root in distinct},
         last_steps={r: finder.last_step.get(r, np.nan) for r in distinct},
         unseparated=finder.unseparated_among(distinct),
         note=finder.note,

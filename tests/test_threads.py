@@ -1,0 +1,42 @@
+"""One BLAS thread while solving (linmstmm.threads): every BLAS library at one thread
+inside, the thread counts found on entry back on exit, nested uses included."""
+from __future__ import annotations
+
+import scipy.linalg  # noqa: F401  (its BLAS loaded before the libraries are looked up)
+from threadpoolctl import threadpool_info, threadpool_limits
+
+from linmstmm.threads import one_blas_thread, single_blas_thread
+
+
+def blas_threads() -> list[int]:
+    return [library["num_threads"] for library in threadpool_info() if library["user_api"] == "blas"]
+
+
+def test_one_thread_inside_and_the_counts_found_restored_after():
+    with threadpool_limits(limits=2, user_api="blas"):
+        before = blas_threads()
+        assert before and all(threads == 2 for threads in before)
+        with one_blas_thread():
+            assert all(threads == 1 for threads in blas_threads())
+            with one_blas_thread():  # nested: left at one, and still one after the inner exit
+                assert all(threads == 1 for threads in blas_threads())
+            assert all(threads == 1 for threads in blas_threads())
+        assert blas_threads() == before
+
+
+def test_the_decorated_solve_runs_on_one_thread_and_restores_on_error():
+    seen = []
+
+    @single_blas_thread
+    def failing():
+        seen.extend(blas_threads())
+        raise ValueError("inside")
+
+    with threadpool_limits(limits=2, user_api="blas"):
+        before = blas_threads()
+        try:
+            failing()
+        except ValueError:
+            pass
+        assert seen and all(threads == 1 for threads in seen)
+        assert blas_threads() == before

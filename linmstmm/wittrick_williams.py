@@ -103,14 +103,6 @@ def _stiffness_kernels():
     return kernels
 
 
-@functools.cache
-def _batched_counts():
-    """:func:`linmstmm._count_batch.counts`, imported on the first compiled count."""
-    from linmstmm._count_batch import counts
-
-    return counts
-
-
 def mode_counter(model: Model, engine: str = "auto") -> ModeCounter | None:
     """The :class:`ModeCounter` of ``model``, or None where D(ω) would be larger than
     MAX_ORDER (decided from the nodes before anything is built, then from the order
@@ -209,7 +201,7 @@ class ModeCounter:
 
     def _count_now(self, wanted: list[float]) -> None:
         """Count at each of ``wanted`` (rad/s, none counted yet) and remember the answers:
-        compiled, in one kernel call (:func:`linmstmm._count_batch.counts`) on this
+        compiled, in one kernel call (:func:`linmstmm._stiffness_kernels.counts`) on this
         thread in this counter's own buffers, or from COUNT_BATCH of them shared among
         the cores, each piece in buffers of its own; by the numpy reference, D(ω) formed
         for NUMPY_BATCH of them at a time."""
@@ -248,9 +240,9 @@ class ModeCounter:
 
     def _kernel_counts(self, omegas: np.ndarray, found: np.ndarray, scratch: tuple) -> None:
         """J(ω) at each of ``omegas`` (m,) rad/s into ``found`` (m,) int64, −1 where undecided,
-        by :func:`linmstmm._count_batch.counts` in ``scratch`` (:meth:`_new_scratch`)."""
+        by :func:`linmstmm._stiffness_kernels.counts` in ``scratch`` (:meth:`_new_scratch`)."""
         matrix, magnitude, work, buffers = scratch
-        _batched_counts()(omegas, self._beam_table(), self._maps, self._columns, self._static, self._mass,
+        _stiffness_kernels().counts(omegas, self._beam_table(), self._maps, self._columns, self._static, self._mass,
                           SINGULAR_PIVOT, MOST_GROWTH, *self._plan, buffers, matrix, magnitude, work, found)
 
     def matrices(self, omegas) -> tuple[np.ndarray, np.ndarray]:

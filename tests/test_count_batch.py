@@ -1,4 +1,4 @@
-"""The compiled count at many frequencies in one call (linmstmm._count_batch) against
+"""The compiled count at many frequencies in one call (linmstmm._stiffness_kernels.counts) against
 the count one frequency at a time: the sparse kernel, and the dense one where that
 refuses, called from Python per frequency, on the bundled launchers and random
 models, over frequencies that include refusals and undecided counts."""
@@ -7,7 +7,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from linmstmm import _count_batch, _lapack, dynamic_stiffness
 from linmstmm import _stiffness_kernels as kernels
 from linmstmm.model import load_model
 from linmstmm.wittrick_williams import MOST_GROWTH, SINGULAR_PIVOT, ModeCounter
@@ -44,19 +43,3 @@ def test_counts_in_one_call_are_the_counts_one_at_a_time(source):
                                         *counter._plan, counter._new_scratch()[3]) for omega in omegas]
         assert kernels.REFUSED in sparse
 
-
-def test_the_cached_batch_is_keyed_by_the_kernels_sources(tmp_path):
-    """numba keys cached machine code by the function's own source and what it closes
-    over: the batch closes over a digest of every source file its kernels come from,
-    which an edit to one of them changes."""
-    closed_over = [cell.cell_contents for cell in _count_batch.counts.py_func.__closure__]
-    assert _count_batch.source_digest(kernels, dynamic_stiffness, _lapack) in closed_over
-    first, second = tmp_path / "a.py", tmp_path / "b.py"
-    first.write_text("x = 1\n")
-    second.write_text("x = 2\n")
-
-    class Module:
-        def __init__(self, path):
-            self.__file__ = str(path)
-
-    assert _count_batch.source_digest(Module(first)) != _count_batch.source_digest(Module(second))

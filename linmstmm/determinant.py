@@ -174,8 +174,8 @@ class CompiledDeterminant(EvaluationCount):
         p = self.program
         self._operations = _kernel_operations(p, p.orthos)
         self._layout = (p.slot_offset, p.slot_width, p.slot_columns, p.slot_columns_start, p.workspace,
-                        p.slot_rows.size, p.root, p.root_row, p.geometric_rows, p.order, p.kept_rows,
-                        p.kept_columns, p.slot_rows)
+                        p.slot_rows.size, p.root, p.root_row, p.geometric_rows, _kept_at(p.kept_rows, p.order),
+                        _kept_at(p.kept_columns, p.order), p.kept_columns.size, p.slot_rows)
 
     @property
     def order(self) -> int:
@@ -253,3 +253,11 @@ def _kernel_operations(program, orthos: np.ndarray) -> tuple:
     p = program
     return (p.slot_offset, p.slot_rows, p.slot_width, p.operations, p.terms, p.places, p.places_start,
             p.matrices, orthos, p.ortho_blocks, p.beams, p.beam_rotation)
+
+
+def _kept_at(kept: np.ndarray, order: int) -> np.ndarray:
+    """(order,) int64: where each of the full Ū_all's ``order`` rows (or columns) stands among
+    the ``kept`` ones (k,) of the compiled Ū_all, -1 for one released."""
+    position = np.full(order, -1, dtype=np.int64)
+    position[kept] = np.arange(kept.size)
+    return position

@@ -26,7 +26,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 from linmstmm._lapack import lapack_routine
 from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, STATE_BLOCK, TIP
@@ -43,6 +45,32 @@ _XZ = np.array([2, 4, 7, 11])
 _XZ_SIGNS = np.array([1.0, -1.0, -1.0, 1.0])
 _ONES = np.ones(4)
 _BENDING_SIGNS = np.outer([1.0, 1.0, -1.0, 1.0], [1.0, 1.0, -1.0, 1.0])
+
+
+@intrinsic
+def _unowned(typingctx, value):
+    """``value``, an array or a tuple of arrays and integers, with every array's owner
+    dropped: the same data, shape and strides, and no reference counts. numba counts
+    references to an array's owner with an atomic operation wherever the array is passed
+    to a function or viewed, some thousands of times per evaluation; an array without
+    an owner skips them. Only for arrays the caller keeps alive meanwhile, such as the
+    arguments of the kernel that calls it."""
+    def codegen(context, builder, signature, arguments):
+        return _without_owners(context, builder, value, arguments[0])
+    return value(value), codegen
+
+
+def _without_owners(context, builder, kind, value):
+    """The LLVM ``value`` of numba type ``kind`` with a null owner (meminfo) in every array."""
+    if isinstance(kind, types.Array):
+        array = context.make_array(kind)(context, builder, value)
+        array.meminfo = cgutils.get_null_value(array.meminfo.type)
+        return array._getvalue()
+    if isinstance(kind, types.BaseTuple):
+        members = [_without_owners(context, builder, member, builder.extract_value(value, i))
+                   for i, member in enumerate(kind)]
+        return context.make_tuple(builder, kind, members)
+    return value
 
 
 @njit(cache=True)
@@ -433,6 +461,8 @@ def _beam_scratch(program, group, like):
 def _run(program, omegas, work, reference, log_scale, ortho_scratch, beam_scratch):
     """Replay the operations for one group of frequencies ``omegas`` (g,), in the
     workspaces of :func:`_orthonormal_scratch` and :func:`_beam_scratch`."""
+    program, work, reference, log_scale = _unowned((program, work, reference, log_scale))  # kept by the caller
+    ortho_scratch, beam_scratch = _unowned((ortho_scratch, beam_scratch))
     (slot_offset, slot_rows, slot_width, operations, terms, places, places_start, matrices,
      orthos, ortho_blocks, beams, beam_rotation) = program
     ortho_program = (slot_offset, slot_rows, slot_width, places, places_start, orthos, ortho_blocks)

@@ -28,7 +28,9 @@ import math
 import numpy as np
 from numba import njit, types
 from numba.core import cgutils
+from numba.core.imputils import impl_ret_borrowed
 from numba.extending import intrinsic
+from numba.np.arrayobj import populate_array
 
 from linmstmm._lapack import lapack_routine
 from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, STATE_BLOCK, TIP
@@ -147,9 +149,8 @@ def beam_piece(beam, rotation, omega, length, out, local, functions, turned):
 
 
 @njit(cache=True)
-def _size(values):
-    """Largest |Re| + |Im| of ``values`` (contiguous), NaN ignored."""
-    flat = values.ravel()
+def _size(flat):
+    """Largest |Re| + |Im| of ``flat`` (n,), NaN ignored."""
     first = second = third = fourth = 0.0  # four running maxima: no chain of comparisons
     whole = flat.size - flat.size % 4
     for start in range(0, whole, 4):
@@ -169,9 +170,25 @@ def _magnitude(v):
     return s if s > 0.0 else 0.0
 
 
-@njit(cache=True)
-def _view(work, offset, rows, width):
-    return work[offset:offset + rows * width].reshape((rows, width))
+@intrinsic
+def _view(typingctx, work, offset, rows, width):
+    """``work[offset:offset + rows * width]`` (``work`` contiguous, 1-D) as a (rows, width)
+    array: what ``reshape`` gives, without numba's call that works out the strides of a
+    reshape of any layout (a few per cent of an evaluation). Unchecked: the program's
+    slots lie inside the workspace."""
+    if not (isinstance(work, types.Array) and work.ndim == 1 and work.layout == "C"):
+        return None
+    block = work.copy(ndim=2)
+
+    def codegen(context, builder, signature, arguments):
+        source = context.make_array(work)(context, builder, arguments[0])
+        view = context.make_array(block)(context, builder)
+        start, count, columns = arguments[1:]
+        populate_array(view, data=cgutils.gep_inbounds(builder, source.data, start), shape=[count, columns],
+                       strides=[builder.mul(columns, source.itemsize), source.itemsize], itemsize=source.itemsize,
+                       meminfo=source.meminfo, parent=source.parent)
+        return impl_ret_borrowed(context, builder, block, view._getvalue())
+    return block(work, types.intp, types.intp, types.intp), codegen
 
 
 @njit(cache=True)
@@ -205,14 +222,13 @@ def _place_add(source, target, place, sign, rows):
 
 
 @njit(cache=True)
-def _unit_scale(columns, kinds, scale, kind_size):
+def _unit_scale(columns, peak, kinds, scale, kind_size):
     """Row scales of the gathered blocks ``columns`` (k, rows), one unknown's column
     per row of the array, into ``scale`` (rows,): one per kind of row (``kinds``:
     0 displacement, 1 rotation, 2 moment, 3 force), the inverse root-mean-square size
-    of all rows of that kind (:meth:`linmstmm.godunov._Orthonormaliser._unit_scale`);
-    ``kind_size`` (4,) is workspace."""
+    of all rows of that kind (:meth:`linmstmm.godunov._Orthonormaliser._unit_scale`).
+    ``peak``: the :func:`_size` of ``columns``; ``kind_size`` (4,) is workspace."""
     width, rows = columns.shape
-    peak = _size(columns)
     peak = 2.0 ** np.round(np.log2(peak)) if peak > 0.0 else 1.0  # a power of two: exact division
     inverse_peak = 1.0 / peak
     scale[:] = 0.0  # the squares of each row first, relative to the peak: no overflow
@@ -291,18 +307,23 @@ def _orthonormal_columns(columns, diagonal, projections):
 @njit(cache=True)
 def _gathered(program, index, work_m, columns, kinds):
     """The blocks of orthonormalisation record ``index`` stacked on its columns, one
-    unknown per row of ``columns`` (width, rows), and each row's kind into ``kinds``."""
+    unknown per row of ``columns`` (width, rows), zero where a block has no column or
+    past the blocks' rows, and each row's kind into ``kinds`` (0 past the blocks' rows)."""
     (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
     first, count = orthos[index, 0], orthos[index, 1]
+    width, total = columns.shape
     row = 0
     for b in range(first, first + count):
         src, rows, place_index = blocks[b, 0], blocks[b, 2], blocks[b, 4]
         source = _view(work_m, slot_offset[src], rows, slot_width[src])
-        if place_index < 0:
+        if place_index < 0:  # on all the columns
             for i in range(rows):
                 for c in range(source.shape[1]):
                     columns[c, row + i] = source[i, c]
         else:
+            for c in range(width):
+                for i in range(rows):
+                    columns[c, row + i] = 0.0
             place = places[places_start[place_index]:places_start[place_index + 1]]
             for i in range(rows):
                 for c in range(source.shape[1]):
@@ -311,6 +332,10 @@ def _gathered(program, index, work_m, columns, kinds):
         for i in range(rows):
             kinds[row + i] = i // 3 if forces < 0 else (3 if i < forces else 2)
         row += rows
+    for i in range(row, total):
+        kinds[i] = 0
+        for c in range(width):
+            columns[c, i] = 0.0
 
 
 @njit(cache=True)
@@ -332,7 +357,7 @@ def _scattered(program, index, columns, scale, work_m, reference_m):
         for i in range(rows):
             for c in range(width):
                 target[i, c] = columns[c, row + i] * back[row + i]
-        size = _size(target)
+        size = _size(work_m[slot_offset[dst]:slot_offset[dst] + rows * width])
         peak = max(peak, size)
         if kind == STATE_BLOCK:
             reference_m[dst] = size
@@ -422,13 +447,11 @@ def _orthonormalise(program, index, work, reference, log_scale, group, scratch):
         _laid_out(program, index, work, reference, group)
         return
     kinds = kinds_all[:total]
-    kinds[:] = 0
     for m in range(group):
         columns = _view(columns_all[m], 0, width, total)  # each unknown's column, contiguous
-        columns[:, :] = 0.0
         _gathered(program, index, work[m], columns, kinds)
         scale = scale_all[m, :total]
-        _unit_scale(columns, kinds, scale, kind_size)
+        _unit_scale(columns, _size(columns_all[m, :width * total]), kinds, scale, kind_size)
         for c in range(width):
             for i in range(total):
                 columns[c, i] *= scale[i]

@@ -568,29 +568,16 @@ def _run(program, omegas, work, reference, log_scale, ortho_scratch, beam_scratc
 
 
 @njit(cache=True)
-def _assembled(root, root_row, rows, row_of, column_of, work_m, slot_offset, slot_width, slot_columns,
-               slot_columns_start, slot_rows, transposed):
-    """Ū_all (N, N) of one frequency from its workspace, in Fortran order (what LAPACK
-    factorises, without reordering): the transpose of ``transposed`` (N, N), which it
-    overwrites. ``row_of``, ``column_of`` (order,): where each row and column of the full
-    Ū_all is kept, -1 where released."""
-    transposed[:, :] = 0.0
-    start = 0
-    for g in range(-2, rows.size):
-        slot = root if g == -2 else (root_row if g == -1 else rows[g])
-        block = _view(work_m, slot_offset[slot], slot_rows[slot], slot_width[slot])
-        columns = slot_columns[slot_columns_start[slot]:slot_columns_start[slot + 1]]
-        for i in range(slot_rows[slot]):
-            row = row_of[start + i]
-            if row < 0:
-                continue
-            for c in range(columns.size):
-                column = column_of[columns[c]]
-                if column >= 0:
-                    transposed[column, row] += block[i, c]
-        if g != -2:  # the root state and −Z_root share the first twelve rows
-            start += slot_rows[slot]
-    return transposed.T
+def _assembled(work_m, sources, targets, transposed, order):
+    """Ū_all (N, N), N = ``order``, of one frequency from its workspace ``work_m``, in
+    Fortran order (what LAPACK factorises, without reordering): the transpose of
+    ``transposed`` (N², ) row by row, which it overwrites with entry ``sources[e]`` of the
+    workspace added at index ``targets[e]`` for each e in turn (see
+    :func:`linmstmm.determinant._assembly`)."""
+    transposed[:] = 0.0
+    for e in range(sources.size):
+        transposed[targets[e]] += work_m[sources[e]]
+    return _view(transposed, 0, order, order).T
 
 
 _DGETRF, _ZGETRF = lapack_routine("dgetrf", 6), lapack_routine("zgetrf", 6)
@@ -636,8 +623,7 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
     log_abs_out : (n,) sign (phase) and log|det Ū_all| (log-scale included);
     log_scale_out : (n,) the log-scale alone (det Ū_all = det(matrix) e^log_scale).
     """
-    (slot_offset, slot_width, slot_columns, slot_columns_start, workspace, n_slots, root, root_row,
-     rows, row_of, column_of, kept, slot_rows) = layout
+    workspace, n_slots, kept, sources, targets = layout
     n = omegas.size
     largest = min(group, n)
     # every operation writes the whole of its target: the workspace needs no clearing
@@ -646,7 +632,7 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
     orthos, ortho_blocks = program[8], program[9]
     ortho_scratch = _orthonormal_scratch(orthos, ortho_blocks, largest, omegas)
     beam_scratch = _beam_scratch(program, largest, omegas)
-    transposed = np.empty((kept, kept), dtype=omegas.dtype)
+    transposed = np.empty(kept * kept, dtype=omegas.dtype)
     for start in range(0, n, group):
         stop = min(start + group, n)
         size = stop - start
@@ -655,8 +641,7 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
         log_scale[:] = 0.0
         _run(program, omegas[start:stop], work, reference, log_scale, ortho_scratch, beam_scratch)
         for m in range(size):
-            ubar = _assembled(root, root_row, rows, row_of, column_of, work[m], slot_offset, slot_width,
-                              slot_columns, slot_columns_start, slot_rows, transposed)
+            ubar = _assembled(work[m], sources, targets, transposed, kept)
             if matrices_out.shape[0]:
                 matrices_out[start + m] = ubar
             sign, log_abs = _log_det(ubar)  # NaN where not finite, which the root counts step round

@@ -173,9 +173,7 @@ class CompiledDeterminant(EvaluationCount):
         deduction.adopt_row_kinds(self.program.row_kinds)
         p = self.program
         self._operations = _kernel_operations(p, p.orthos)
-        self._layout = (p.slot_offset, p.slot_width, p.slot_columns, p.slot_columns_start, p.workspace,
-                        p.slot_rows.size, p.root, p.root_row, p.geometric_rows, _kept_at(p.kept_rows, p.order),
-                        _kept_at(p.kept_columns, p.order), p.kept_columns.size, p.slot_rows)
+        self._layout = (p.workspace, p.slot_rows.size, p.kept_columns.size, *_assembly(p))
 
     @property
     def order(self) -> int:
@@ -253,6 +251,30 @@ def _kernel_operations(program, orthos: np.ndarray) -> tuple:
     p = program
     return (p.slot_offset, p.slot_rows, p.slot_width, p.operations, p.terms, p.places, p.places_start,
             p.matrices, orthos, p.ortho_blocks, p.beams, p.beam_rotation)
+
+
+def _assembly(program) -> tuple[np.ndarray, np.ndarray]:
+    """Where each entry of Ū_all comes from: (sources (E,), targets (E,)) int64, entry
+    ``sources[e]`` of a frequency's workspace added to entry ``targets[e]`` of the
+    transposed Ū_all (N, N) flattened, in the order the blocks stand (the root state
+    and −Z_root share the first twelve rows: entries met twice add up in that order);
+    rows and columns released are left out."""
+    p = program
+    order, kept = p.order, p.kept_columns.size
+    row_of, column_of = _kept_at(p.kept_rows, order), _kept_at(p.kept_columns, order)
+    sources, targets = [], []
+    start = 0
+    for position, slot in enumerate([p.root, p.root_row, *p.geometric_rows]):
+        rows, width = p.slot_rows[slot], p.slot_width[slot]
+        columns = column_of[p.slot_columns[p.slot_columns_start[slot]:p.slot_columns_start[slot + 1]]]
+        entries = p.slot_offset[slot] + np.arange(rows * width).reshape(rows, width)
+        row = row_of[start:start + rows][:, None]
+        kept_entries = (row >= 0) & (columns[None, :] >= 0)
+        sources.append(entries[kept_entries])
+        targets.append((columns[None, :] * kept + row)[kept_entries])
+        if position > 0:  # the root state and −Z_root share the first twelve rows
+            start += rows
+    return np.concatenate(sources).astype(np.int64), np.concatenate(targets).astype(np.int64)
 
 
 def _kept_at(kept: np.ndarray, order: int) -> np.ndarray:

@@ -198,10 +198,10 @@ class CompiledDeterminant(EvaluationCount):
         from linmstmm import _kernels  # numba loads here, not at import
 
         n, order = omega.size, self.order
-        matrices = np.zeros((n if with_matrices else 0, order, order), dtype=omega.dtype)
-        sign = np.zeros(n, dtype=omega.dtype)
-        log_abs, log_scale = np.zeros(n), np.zeros(n)
-        if group == 1 and not with_matrices:  # each frequency on its own: shared among the cores
+        matrices = np.empty((n if with_matrices else 0, order, order), dtype=omega.dtype)  # the kernel writes all
+        sign = np.empty(n, dtype=omega.dtype)
+        log_abs, log_scale = np.empty(n), np.empty(n)
+        if group == 1 and not with_matrices and n > 1:  # each frequency on its own: shared among the cores
             spread(lambda start, stop: _kernels.evaluate(operations, self._layout, omega[start:stop], 1, matrices,
                                                          sign[start:stop], log_abs[start:stop],
                                                          log_scale[start:stop]), n)

@@ -11,6 +11,11 @@ counterpart that stays the readable reference and the test oracle:
   with Godunov orthonormalisation (:class:`linmstmm.godunov._Orthonormaliser`),
   beams cut into pieces of βL ≤ 4, Ū_all assembled, LU.
 
+Two intrinsics build array views directly in LLVM, where numba's own cost more
+than the arithmetic around them: :func:`_view` (a slot's block of the workspace)
+and :func:`_unowned` (the replay's arrays without reference counts). Scratch is
+allocated once per call of :func:`evaluate`.
+
 Frequencies are evaluated in groups of consecutive entries that take the
 same decisions (pieces per beam, orthonormalisations skipped), as one numpy
 stack does: a group of two, ω and ω + δω, gives a smooth difference of the

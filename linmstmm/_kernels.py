@@ -259,21 +259,35 @@ _KEPT_ENOUGH = 0.5
 
 
 @njit(cache=True, inline="always")
-def _dot(columns, p, j):
-    """Σ conj(columns[p]) columns[j], in four interleaved partial sums added in a fixed
-    order: the same rounding wherever numba compiles it (a reassociated sum is
-    vectorised as each caller's context allows, and rounds differently)."""
+def _dots(columns, p, q, j):
+    """(Σ conj(columns[p]) columns[j], Σ conj(columns[q]) columns[j]), each in four
+    interleaved partial sums added in a fixed order: the same rounding wherever numba
+    compiles it (a reassociated sum is vectorised as each caller's context allows, and
+    rounds differently). Two at once share the loads of ``columns[j]`` and keep eight
+    sums in flight."""
     m = columns.shape[1]
-    first = second = third = fourth = 0.0 * columns[j, 0]
+    a0 = a1 = a2 = a3 = b0 = b1 = b2 = b3 = 0.0 * columns[j, 0]
     whole = m - m % 4
     for i in range(0, whole, 4):
-        first += np.conj(columns[p, i]) * columns[j, i]
-        second += np.conj(columns[p, i + 1]) * columns[j, i + 1]
-        third += np.conj(columns[p, i + 2]) * columns[j, i + 2]
-        fourth += np.conj(columns[p, i + 3]) * columns[j, i + 3]
+        x0, x1, x2, x3 = columns[j, i], columns[j, i + 1], columns[j, i + 2], columns[j, i + 3]
+        a0 += np.conj(columns[p, i]) * x0
+        a1 += np.conj(columns[p, i + 1]) * x1
+        a2 += np.conj(columns[p, i + 2]) * x2
+        a3 += np.conj(columns[p, i + 3]) * x3
+        b0 += np.conj(columns[q, i]) * x0
+        b1 += np.conj(columns[q, i + 1]) * x1
+        b2 += np.conj(columns[q, i + 2]) * x2
+        b3 += np.conj(columns[q, i + 3]) * x3
     for i in range(whole, m):
-        first += np.conj(columns[p, i]) * columns[j, i]
-    return (first + second) + (third + fourth)
+        a0 += np.conj(columns[p, i]) * columns[j, i]
+        b0 += np.conj(columns[q, i]) * columns[j, i]
+    return (a0 + a1) + (a2 + a3), (b0 + b1) + (b2 + b3)
+
+
+@njit(cache=True, inline="always")
+def _dot(columns, p, j):
+    """Σ conj(columns[p]) columns[j], as :func:`_dots` sums it."""
+    return _dots(columns, p, p, j)[0]
 
 
 @njit(cache=True)
@@ -292,8 +306,10 @@ def _orthonormal_columns(columns, diagonal, projections):
             return False
         for _ in range(2):
             before = norm
-            for p in range(j):  # every projection from the same column: independent sums
-                projections[p] = _dot(columns, p, j)
+            for p in range(0, j - 1, 2):  # every projection from the same column: independent sums
+                projections[p], projections[p + 1] = _dots(columns, p, p + 1, j)
+            if j % 2:
+                projections[j - 1] = _dot(columns, j - 1, j)
             for p in range(j):
                 for i in range(m):
                     columns[j, i] -= projections[p] * columns[p, i]

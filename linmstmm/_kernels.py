@@ -11,6 +11,11 @@ counterpart that stays the readable reference and the test oracle:
   with Godunov orthonormalisation (:class:`linmstmm.godunov._Orthonormaliser`),
   beams cut into pieces of βL ≤ 4, Ū_all assembled, LU.
 
+Two intrinsics build array views directly in LLVM, where numba's own cost more
+than the arithmetic around them: :func:`_view` (a slot's block of the workspace)
+and :func:`_unowned` (the replay's arrays without reference counts). Scratch is
+allocated once per call of :func:`evaluate`.
+
 Frequencies are evaluated in groups of consecutive entries that take the
 same decisions (pieces per beam, orthonormalisations skipped), as one numpy
 stack does: a group of two, ω and ω + δω, gives a smooth difference of the
@@ -26,7 +31,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.core import cgutils
+from numba.core.imputils import impl_ret_borrowed
+from numba.extending import intrinsic
+from numba.np.arrayobj import populate_array
 
 from linmstmm._lapack import lapack_routine
 from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, STATE_BLOCK, TIP
@@ -43,6 +52,32 @@ _XZ = np.array([2, 4, 7, 11])
 _XZ_SIGNS = np.array([1.0, -1.0, -1.0, 1.0])
 _ONES = np.ones(4)
 _BENDING_SIGNS = np.outer([1.0, 1.0, -1.0, 1.0], [1.0, 1.0, -1.0, 1.0])
+
+
+@intrinsic
+def _unowned(typingctx, value):
+    """``value``, an array or a tuple of arrays and integers, with every array's owner
+    dropped: the same data, shape and strides, and no reference counts. numba counts
+    references to an array's owner with an atomic operation wherever the array is passed
+    to a function or viewed, some thousands of times per evaluation; an array without
+    an owner skips them. Only for arrays the caller keeps alive meanwhile, such as the
+    arguments of the kernel that calls it."""
+    def codegen(context, builder, signature, arguments):
+        return _without_owners(context, builder, value, arguments[0])
+    return value(value), codegen
+
+
+def _without_owners(context, builder, kind, value):
+    """The LLVM ``value`` of numba type ``kind`` with a null owner (meminfo) in every array."""
+    if isinstance(kind, types.Array):
+        array = context.make_array(kind)(context, builder, value)
+        array.meminfo = cgutils.get_null_value(array.meminfo.type)
+        return array._getvalue()
+    if isinstance(kind, types.BaseTuple):
+        members = [_without_owners(context, builder, member, builder.extract_value(value, i))
+                   for i, member in enumerate(kind)]
+        return context.make_tuple(builder, kind, members)
+    return value
 
 
 @njit(cache=True)
@@ -99,28 +134,28 @@ def _rod(stiffness, inertia, L, omega, rigid, local, a, b):
 
 
 @njit(cache=True)
-def beam_piece(beam, rotation, omega, length, out):
-    """Inertial transfer matrix (12, 12) of a beam piece of ``length`` m at ``omega`` into ``out``.
+def beam_piece(beam, rotation, omega, length, out, local, functions, turned):
+    """Inertial transfer matrix (12, 12) of a beam piece of ``length`` m at ``omega`` into ``out``:
+    :func:`linmstmm.elements.beam.beam_transfer`.
 
     beam : (10,) (E, G, rho, A, Iy, Iz, J, Ip, length, flags), flags = axial + 2 torsion.
-    rotation : (12, 12) state rotation of the traversal direction.
+    rotation : (12, 12) state rotation of the traversal direction, of ``out``'s type.
+    local, functions, turned : (12, 12), (4,) and (12, 12) of ``out``'s type, workspace.
     """
     E, G, rho, A, Iy, Iz, J, Ip = beam[0], beam[1], beam[2], beam[3], beam[4], beam[5], beam[6], beam[7]
     flags = int(beam[9])
-    local = np.zeros((12, 12), dtype=out.dtype)
-    functions = np.empty(4, dtype=out.dtype)
+    local[:, :] = 0.0
     _bending(E * Iz, rho * A, length, omega, local, _XY, _ONES, functions)
     _bending(E * Iy, rho * A, length, omega, local, _XZ, _XZ_SIGNS, functions)
     _rod(E * A, rho * A, length, omega, (flags & 1) == 0, local, 0, 9)
     _rod(G * J, rho * Ip, length, omega, (flags & 2) == 0, local, 3, 6)
-    turned = rotation.astype(out.dtype) @ local  # as numpy's rotation @ local @ rotation.T, to the bit
-    out[:, :] = turned @ rotation.T.astype(out.dtype)
+    np.dot(rotation, local, turned)  # as numpy's rotation @ local @ rotation.T, to the bit
+    np.dot(turned, rotation.T, out)
 
 
 @njit(cache=True)
-def _size(values):
-    """Largest |Re| + |Im| of ``values`` (contiguous), NaN ignored."""
-    flat = values.ravel()
+def _size(flat):
+    """Largest |Re| + |Im| of ``flat`` (n,), NaN ignored."""
     first = second = third = fourth = 0.0  # four running maxima: no chain of comparisons
     whole = flat.size - flat.size % 4
     for start in range(0, whole, 4):
@@ -140,9 +175,25 @@ def _magnitude(v):
     return s if s > 0.0 else 0.0
 
 
-@njit(cache=True)
-def _view(work, offset, rows, width):
-    return work[offset:offset + rows * width].reshape((rows, width))
+@intrinsic
+def _view(typingctx, work, offset, rows, width):
+    """``work[offset:offset + rows * width]`` (``work`` contiguous, 1-D) as a (rows, width)
+    array: what ``reshape`` gives, without numba's call that works out the strides of a
+    reshape of any layout (a few per cent of an evaluation). Unchecked: the program's
+    slots lie inside the workspace."""
+    if not (isinstance(work, types.Array) and work.ndim == 1 and work.layout == "C"):
+        return None
+    block = work.copy(ndim=2)
+
+    def codegen(context, builder, signature, arguments):
+        source = context.make_array(work)(context, builder, arguments[0])
+        view = context.make_array(block)(context, builder)
+        start, count, columns = arguments[1:]
+        populate_array(view, data=cgutils.gep_inbounds(builder, source.data, start), shape=[count, columns],
+                       strides=[builder.mul(columns, source.itemsize), source.itemsize], itemsize=source.itemsize,
+                       meminfo=source.meminfo, parent=source.parent)
+        return impl_ret_borrowed(context, builder, block, view._getvalue())
+    return block(work, types.intp, types.intp, types.intp), codegen
 
 
 @njit(cache=True)
@@ -176,13 +227,13 @@ def _place_add(source, target, place, sign, rows):
 
 
 @njit(cache=True)
-def _unit_scale(columns, kinds, scale):
+def _unit_scale(columns, peak, kinds, scale, kind_size):
     """Row scales of the gathered blocks ``columns`` (k, rows), one unknown's column
     per row of the array, into ``scale`` (rows,): one per kind of row (``kinds``:
     0 displacement, 1 rotation, 2 moment, 3 force), the inverse root-mean-square size
-    of all rows of that kind (:meth:`linmstmm.godunov._Orthonormaliser._unit_scale`)."""
+    of all rows of that kind (:meth:`linmstmm.godunov._Orthonormaliser._unit_scale`).
+    ``peak``: the :func:`_size` of ``columns``; ``kind_size`` (4,) is workspace."""
     width, rows = columns.shape
-    peak = _size(columns)
     peak = 2.0 ** np.round(np.log2(peak)) if peak > 0.0 else 1.0  # a power of two: exact division
     inverse_peak = 1.0 / peak
     scale[:] = 0.0  # the squares of each row first, relative to the peak: no overflow
@@ -190,10 +241,11 @@ def _unit_scale(columns, kinds, scale):
         for i in range(rows):
             v = columns[c, i] * inverse_peak
             scale[i] += v.real * v.real + v.imag * v.imag
-    kind_size = np.zeros(4)
+    kind_size[:] = 0.0
     for i in range(rows):
         kind_size[kinds[i]] += scale[i]
-    kind_size = np.sqrt(kind_size)
+    for kind in range(4):
+        kind_size[kind] = math.sqrt(kind_size[kind])
     largest = kind_size.max()
     for i in range(rows):
         size = kind_size[kinds[i]] if kind_size[kinds[i]] > 0 else largest
@@ -207,21 +259,35 @@ _KEPT_ENOUGH = 0.5
 
 
 @njit(cache=True, inline="always")
-def _dot(columns, p, j):
-    """Σ conj(columns[p]) columns[j], in four interleaved partial sums added in a fixed
-    order: the same rounding wherever numba compiles it (a reassociated sum is
-    vectorised as each caller's context allows, and rounds differently)."""
+def _dots(columns, p, q, j):
+    """(Σ conj(columns[p]) columns[j], Σ conj(columns[q]) columns[j]), each in four
+    interleaved partial sums added in a fixed order: the same rounding wherever numba
+    compiles it (a reassociated sum is vectorised as each caller's context allows, and
+    rounds differently). Two at once share the loads of ``columns[j]`` and keep eight
+    sums in flight."""
     m = columns.shape[1]
-    first = second = third = fourth = 0.0 * columns[j, 0]
+    a0 = a1 = a2 = a3 = b0 = b1 = b2 = b3 = 0.0 * columns[j, 0]
     whole = m - m % 4
     for i in range(0, whole, 4):
-        first += np.conj(columns[p, i]) * columns[j, i]
-        second += np.conj(columns[p, i + 1]) * columns[j, i + 1]
-        third += np.conj(columns[p, i + 2]) * columns[j, i + 2]
-        fourth += np.conj(columns[p, i + 3]) * columns[j, i + 3]
+        x0, x1, x2, x3 = columns[j, i], columns[j, i + 1], columns[j, i + 2], columns[j, i + 3]
+        a0 += np.conj(columns[p, i]) * x0
+        a1 += np.conj(columns[p, i + 1]) * x1
+        a2 += np.conj(columns[p, i + 2]) * x2
+        a3 += np.conj(columns[p, i + 3]) * x3
+        b0 += np.conj(columns[q, i]) * x0
+        b1 += np.conj(columns[q, i + 1]) * x1
+        b2 += np.conj(columns[q, i + 2]) * x2
+        b3 += np.conj(columns[q, i + 3]) * x3
     for i in range(whole, m):
-        first += np.conj(columns[p, i]) * columns[j, i]
-    return (first + second) + (third + fourth)
+        a0 += np.conj(columns[p, i]) * columns[j, i]
+        b0 += np.conj(columns[q, i]) * columns[j, i]
+    return (a0 + a1) + (a2 + a3), (b0 + b1) + (b2 + b3)
+
+
+@njit(cache=True, inline="always")
+def _dot(columns, p, j):
+    """Σ conj(columns[p]) columns[j], as :func:`_dots` sums it."""
+    return _dots(columns, p, p, j)[0]
 
 
 @njit(cache=True)
@@ -240,8 +306,10 @@ def _orthonormal_columns(columns, diagonal, projections):
             return False
         for _ in range(2):
             before = norm
-            for p in range(j):  # every projection from the same column: independent sums
-                projections[p] = _dot(columns, p, j)
+            for p in range(0, j - 1, 2):  # every projection from the same column: independent sums
+                projections[p], projections[p + 1] = _dots(columns, p, p + 1, j)
+            if j % 2:
+                projections[j - 1] = _dot(columns, j - 1, j)
             for p in range(j):
                 for i in range(m):
                     columns[j, i] -= projections[p] * columns[p, i]
@@ -260,18 +328,23 @@ def _orthonormal_columns(columns, diagonal, projections):
 @njit(cache=True)
 def _gathered(program, index, work_m, columns, kinds):
     """The blocks of orthonormalisation record ``index`` stacked on its columns, one
-    unknown per row of ``columns`` (width, rows), and each row's kind into ``kinds``."""
+    unknown per row of ``columns`` (width, rows), zero where a block has no column or
+    past the blocks' rows, and each row's kind into ``kinds`` (0 past the blocks' rows)."""
     (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
     first, count = orthos[index, 0], orthos[index, 1]
+    width, total = columns.shape
     row = 0
     for b in range(first, first + count):
         src, rows, place_index = blocks[b, 0], blocks[b, 2], blocks[b, 4]
         source = _view(work_m, slot_offset[src], rows, slot_width[src])
-        if place_index < 0:
+        if place_index < 0:  # on all the columns
             for i in range(rows):
                 for c in range(source.shape[1]):
                     columns[c, row + i] = source[i, c]
         else:
+            for c in range(width):
+                for i in range(rows):
+                    columns[c, row + i] = 0.0
             place = places[places_start[place_index]:places_start[place_index + 1]]
             for i in range(rows):
                 for c in range(source.shape[1]):
@@ -280,16 +353,23 @@ def _gathered(program, index, work_m, columns, kinds):
         for i in range(rows):
             kinds[row + i] = i // 3 if forces < 0 else (3 if i < forces else 2)
         row += rows
+    for i in range(row, total):
+        kinds[i] = 0
+        for c in range(width):
+            columns[c, i] = 0.0
 
 
 @njit(cache=True)
 def _scattered(program, index, columns, scale, work_m, reference_m):
     """Write the orthonormalised ``columns`` (width, rows) back into the record's
-    blocks, each row divided by its ``scale``; returns the log of the common power of
-    two taken out of them past :data:`FAR` (0 if none)."""
+    blocks, each row divided by its ``scale`` (which this overwrites with its inverse);
+    returns the log of the common power of two taken out of them past :data:`FAR`
+    (0 if none)."""
     (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
     first, count, width = orthos[index, 0], orthos[index, 1], orthos[index, 3]
-    back = 1.0 / scale
+    back = scale
+    for i in range(scale.size):
+        back[i] = 1.0 / scale[i]
     peak = 0.0
     row = 0
     for b in range(first, first + count):
@@ -298,7 +378,7 @@ def _scattered(program, index, columns, scale, work_m, reference_m):
         for i in range(rows):
             for c in range(width):
                 target[i, c] = columns[c, row + i] * back[row + i]
-        size = _size(target)
+        size = _size(work_m[slot_offset[dst]:slot_offset[dst] + rows * width])
         peak = max(peak, size)
         if kind == STATE_BLOCK:
             reference_m[dst] = size
@@ -316,78 +396,131 @@ def _scattered(program, index, columns, scale, work_m, reference_m):
 
 
 @njit(cache=True)
-def _orthonormalise(program, index, work, reference, log_scale, group):
-    """Orthonormalisation record ``index`` for the ``group`` members' workspaces ``work`` (g, W)."""
-    (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
-    first, count, state, width = orthos[index, 0], orthos[index, 1], orthos[index, 2], orthos[index, 3]
-    state_src = blocks[first + state, 0]
-    skip = True
-    for m in range(group if orthos[index, 4] == 0 else 0):
-        ref = reference[m, state_src]
-        if math.isnan(ref) or ref == 0.0:  # no reference, or grown from nothing (numpy: inf)
-            skip = False
-            break
-        start = slot_offset[state_src]
-        growth = _size(work[m, start:start + slot_rows[state_src] * slot_width[state_src]]) / ref
-        if not (growth < GROWTH and growth > 1 / GROWTH):
-            skip = False
-            break
-    if not skip:
-        total = 3  # rows, padded with zeros to a multiple of four: Gram–Schmidt's sums run in whole vectors
-        for b in range(first, first + count):
-            total += blocks[b, 2]
-        total -= total % 4
-        columns = np.zeros((group, width, total), dtype=work.dtype)  # each unknown's column, contiguous
-        kinds = np.zeros(total, dtype=np.int64)
-        scale = np.empty((group, total))
-        diagonals = np.empty((group, width))
-        projections = np.empty(width, dtype=work.dtype)
-        for m in range(group):
-            _gathered(program, index, work[m], columns[m], kinds)
-            _unit_scale(columns[m], kinds, scale[m])
-            for c in range(width):
-                for i in range(total):
-                    columns[m, c, i] *= scale[m, i]
-            if not _orthonormal_columns(columns[m], diagonals[m], projections):
-                skip = True  # exactly dependent columns (at a root) are kept as they are
-                break
-    if skip:  # lay the blocks out on the plan's columns, nothing else
-        for m in range(group):
-            for b in range(first, first + count):
-                src, dst, rows, place_index = blocks[b, 0], blocks[b, 1], blocks[b, 2], blocks[b, 4]
-                if place_index < 0:
-                    continue
-                source = _view(work[m], slot_offset[src], rows, slot_width[src])
-                target = _view(work[m], slot_offset[dst], rows, width)
-                target[:, :] = 0.0
-                place = places[places_start[place_index]:places_start[place_index + 1]]
-                _place_add(source, target, place, 1.0, rows)
-                if blocks[b, 3] == STATE_BLOCK:
-                    reference[m, dst] = reference[m, src]
-        return
-    for m in range(group):
-        for c in range(width):
-            log_scale[m] += math.log(diagonals[m, c])
-        log_scale[m] -= _scattered(program, index, columns[m], scale[m], work[m], reference[m]) * width
+def _orthonormal_scratch(orthos, blocks, group, like):
+    """Workspace of :func:`_orthonormalise` for every record of ``orthos`` (O, 5) with
+    ``blocks`` (B, 6), for ``group`` frequencies of the type of the array ``like``:
+    (columns (g, k·rows), kinds (rows,), scale (g, rows), diagonals (g, k),
+    projections (k,), kind sizes (4,)), k and rows the most any record takes."""
+    width = 1
+    total = 4
+    for index in range(orthos.shape[0]):
+        width = max(width, orthos[index, 3])
+        total = max(total, _padded_rows(orthos, blocks, index))
+    return (np.empty((group, width * total), dtype=like.dtype), np.empty(total, dtype=np.int64),
+            np.empty((group, total)), np.empty((group, width)), np.empty(width, dtype=like.dtype),
+            np.empty(4))
 
 
 @njit(cache=True)
-def _run(program, omegas, work, reference, log_scale):
-    """Replay the operations for one group of frequencies ``omegas`` (g,)."""
+def _padded_rows(orthos, blocks, index):
+    """Rows of record ``index``'s blocks, padded with zeros to a multiple of four:
+    Gram–Schmidt's sums run in whole vectors."""
+    total = 3
+    for b in range(orthos[index, 0], orthos[index, 0] + orthos[index, 1]):
+        total += blocks[b, 2]
+    return total - total % 4
+
+
+@njit(cache=True)
+def _grown(program, index, work, reference, group):
+    """Whether record ``index`` is due: its state grew or shrank by :data:`GROWTH` or more
+    since its reference in some member of the group (or has none)."""
+    (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
+    state_src = blocks[orthos[index, 0] + orthos[index, 2], 0]
+    for m in range(group):
+        ref = reference[m, state_src]
+        if math.isnan(ref) or ref == 0.0:  # no reference, or grown from nothing (numpy: inf)
+            return True
+        start = slot_offset[state_src]
+        growth = _size(work[m, start:start + slot_rows[state_src] * slot_width[state_src]]) / ref
+        if not (growth < GROWTH and growth > 1 / GROWTH):
+            return True
+    return False
+
+
+@njit(cache=True)
+def _laid_out(program, index, work, reference, group):
+    """Lay record ``index``'s blocks out on its columns, nothing else."""
+    (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
+    first, count, width = orthos[index, 0], orthos[index, 1], orthos[index, 3]
+    for m in range(group):
+        for b in range(first, first + count):
+            src, dst, rows, place_index = blocks[b, 0], blocks[b, 1], blocks[b, 2], blocks[b, 4]
+            if place_index < 0:
+                continue
+            source = _view(work[m], slot_offset[src], rows, slot_width[src])
+            target = _view(work[m], slot_offset[dst], rows, width)
+            target[:, :] = 0.0
+            place = places[places_start[place_index]:places_start[place_index + 1]]
+            _place_add(source, target, place, 1.0, rows)
+            if blocks[b, 3] == STATE_BLOCK:
+                reference[m, dst] = reference[m, src]
+
+
+@njit(cache=True)
+def _orthonormalise(program, index, work, reference, log_scale, group, scratch):
+    """Orthonormalisation record ``index`` for the ``group`` members' workspaces ``work``
+    (g, W), in ``scratch`` (:func:`_orthonormal_scratch`)."""
+    (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
+    columns_all, kinds_all, scale_all, diagonals, projections, kind_size = scratch
+    width, total = orthos[index, 3], _padded_rows(orthos, blocks, index)
+    if orthos[index, 4] != 0 or not _grown(program, index, work, reference, group):
+        _laid_out(program, index, work, reference, group)
+        return
+    kinds = kinds_all[:total]
+    for m in range(group):
+        columns = _view(columns_all[m], 0, width, total)  # each unknown's column, contiguous
+        _gathered(program, index, work[m], columns, kinds)
+        scale = scale_all[m, :total]
+        _unit_scale(columns, _size(columns_all[m, :width * total]), kinds, scale, kind_size)
+        for c in range(width):
+            for i in range(total):
+                columns[c, i] *= scale[i]
+        if not _orthonormal_columns(columns, diagonals[m, :width], projections[:width]):
+            _laid_out(program, index, work, reference, group)  # exactly dependent (at a root): kept as they are
+            return
+    for m in range(group):
+        for c in range(width):
+            log_scale[m] += math.log(diagonals[m, c])
+        log_scale[m] -= _scattered(program, index, _view(columns_all[m], 0, width, total), scale_all[m, :total],
+                                   work[m], reference[m]) * width
+
+
+@njit(cache=True)
+def _beam_scratch(program, group, like):
+    """Workspace of the beams' carries in :func:`_run` for ``group`` frequencies of the type
+    of the array ``like``: (pieces (nb,), each beam's piece per frequency (nb, g, 12, 12),
+    the rotations (nb, 12, 12), local (12, 12), Krylov functions (4,), turned (12, 12),
+    a carried state (12·k,) of the widest slot)."""
+    (slot_offset, slot_rows, slot_width, operations, terms, places, places_start, matrices,
+     orthos, ortho_blocks, beams, beam_rotation) = program
+    count = beams.shape[0]
+    return (np.ones(count, dtype=np.int64), np.empty((count, group, 12, 12), dtype=like.dtype),
+            beam_rotation.astype(like.dtype), np.empty((12, 12), dtype=like.dtype),
+            np.empty(4, dtype=like.dtype), np.empty((12, 12), dtype=like.dtype),
+            np.empty(12 * max(slot_width.max(), 1), dtype=like.dtype))
+
+
+@njit(cache=True)
+def _run(program, omegas, work, reference, log_scale, ortho_scratch, beam_scratch):
+    """Replay the operations for one group of frequencies ``omegas`` (g,), in the
+    workspaces of :func:`_orthonormal_scratch` and :func:`_beam_scratch`."""
+    program, work, reference, log_scale = _unowned((program, work, reference, log_scale))  # kept by the caller
+    ortho_scratch, beam_scratch = _unowned((ortho_scratch, beam_scratch))
     (slot_offset, slot_rows, slot_width, operations, terms, places, places_start, matrices,
      orthos, ortho_blocks, beams, beam_rotation) = program
     ortho_program = (slot_offset, slot_rows, slot_width, places, places_start, orthos, ortho_blocks)
+    pieces, piece, rotations, local, functions, turned, carried = beam_scratch
     group = omegas.size
     largest = 0.0
     for m in range(group):
         largest = max(largest, abs(omegas[m]))
-    pieces = np.ones(beams.shape[0], dtype=np.int64)
-    piece = np.empty((beams.shape[0], group, 12, 12), dtype=omegas.dtype)  # each beam's, per frequency
+    pieces[:] = 1
     for op in range(operations.shape[0]):
         code, a, b, c, d = (operations[op, 0], operations[op, 1], operations[op, 2], operations[op, 3],
                             operations[op, 4])
         if code == ORTHO:
-            _orthonormalise(ortho_program, a, work, reference, log_scale, group)
+            _orthonormalise(ortho_program, a, work, reference, log_scale, group, ortho_scratch)
             continue
         for m in range(group):
             if code == TIP:
@@ -443,43 +576,29 @@ def _run(program, omegas, work, reference, log_scale):
                 beta_L = (beam[2] * beam[3] * largest ** 2 / (beam[0] * softer)) ** 0.25 * beam[8]
                 pieces[b] = max(int(math.ceil(beta_L / BEAM_PIECE_BETA_L)), 1)
                 for m in range(group):
-                    beam_piece(beam, beam_rotation[b], omegas[m], beam[8] / pieces[b], piece[b, m])
+                    beam_piece(beam, rotations[b], omegas[m], beam[8] / pieces[b], piece[b, m], local, functions,
+                               turned)
             for repeat in range(1 if c == 1 else pieces[b] - 1):
                 for m in range(group):
                     state = _view(work[m], slot_offset[a], 12, slot_width[a])
-                    state[:, :] = piece[b, m] @ state.copy()
+                    before = _view(carried, 0, 12, slot_width[a])
+                    before[:, :] = state
+                    np.dot(piece[b, m], before, state)  # BLAS's product, as numpy's
                 if c == 0 and d >= 0:
-                    _orthonormalise(ortho_program, d, work, reference, log_scale, group)
+                    _orthonormalise(ortho_program, d, work, reference, log_scale, group, ortho_scratch)
 
 
 @njit(cache=True)
-def _assembled(root, root_row, rows, order, kept_rows, kept_columns, work_m, slot_offset, slot_width,
-               slot_columns, slot_columns_start, slot_rows):
-    """Ū_all (N, N) of one frequency from its workspace, in Fortran order (what LAPACK
-    factorises, without reordering)."""
-    row_of = np.full(order, -1)  # where each row and column of the full Ū_all is kept, -1: released
-    column_of = np.full(order, -1)
-    for i in range(kept_rows.size):
-        row_of[kept_rows[i]] = i
-    for j in range(kept_columns.size):
-        column_of[kept_columns[j]] = j
-    transposed = np.zeros((kept_columns.size, kept_rows.size), dtype=work_m.dtype)
-    start = 0
-    for g in range(-2, rows.size):
-        slot = root if g == -2 else (root_row if g == -1 else rows[g])
-        block = _view(work_m, slot_offset[slot], slot_rows[slot], slot_width[slot])
-        columns = slot_columns[slot_columns_start[slot]:slot_columns_start[slot + 1]]
-        for i in range(slot_rows[slot]):
-            row = row_of[start + i]
-            if row < 0:
-                continue
-            for c in range(columns.size):
-                column = column_of[columns[c]]
-                if column >= 0:
-                    transposed[column, row] += block[i, c]
-        if g != -2:  # the root state and −Z_root share the first twelve rows
-            start += slot_rows[slot]
-    return transposed.T
+def _assembled(work_m, sources, targets, transposed, order):
+    """Ū_all (N, N), N = ``order``, of one frequency from its workspace ``work_m``, in
+    Fortran order (what LAPACK factorises, without reordering): the transpose of
+    ``transposed`` (N², ) row by row, which it overwrites with entry ``sources[e]`` of the
+    workspace added at index ``targets[e]`` for each e in turn (see
+    :func:`linmstmm.determinant._assembly`)."""
+    transposed[:] = 0.0
+    for e in range(sources.size):
+        transposed[targets[e]] += work_m[sources[e]]
+    return _view(transposed, 0, order, order).T
 
 
 _DGETRF, _ZGETRF = lapack_routine("dgetrf", 6), lapack_routine("zgetrf", 6)
@@ -525,21 +644,25 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
     log_abs_out : (n,) sign (phase) and log|det Ū_all| (log-scale included);
     log_scale_out : (n,) the log-scale alone (det Ū_all = det(matrix) e^log_scale).
     """
-    (slot_offset, slot_width, slot_columns, slot_columns_start, workspace, n_slots, root, root_row,
-     rows, order, kept_rows, kept_columns, slot_rows) = layout
+    workspace, n_slots, kept, sources, targets = layout
     n = omegas.size
+    largest = min(group, n)
     # every operation writes the whole of its target: the workspace needs no clearing
-    whole = np.empty((min(group, n), workspace), dtype=omegas.dtype)
+    whole = np.empty((largest, workspace), dtype=omegas.dtype)
+    references, log_scales = np.empty((largest, n_slots)), np.empty(largest)
+    orthos, ortho_blocks = program[8], program[9]
+    ortho_scratch = _orthonormal_scratch(orthos, ortho_blocks, largest, omegas)
+    beam_scratch = _beam_scratch(program, largest, omegas)
+    transposed = np.empty(kept * kept, dtype=omegas.dtype)
     for start in range(0, n, group):
         stop = min(start + group, n)
         size = stop - start
-        work = whole[:size]
-        reference = np.full((size, n_slots), np.nan)
-        log_scale = np.zeros(size)
-        _run(program, omegas[start:stop], work, reference, log_scale)
+        work, reference, log_scale = whole[:size], references[:size], log_scales[:size]
+        reference[:, :] = np.nan
+        log_scale[:] = 0.0
+        _run(program, omegas[start:stop], work, reference, log_scale, ortho_scratch, beam_scratch)
         for m in range(size):
-            ubar = _assembled(root, root_row, rows, order, kept_rows, kept_columns, work[m], slot_offset,
-                              slot_width, slot_columns, slot_columns_start, slot_rows)
+            ubar = _assembled(work[m], sources, targets, transposed, kept)
             if matrices_out.shape[0]:
                 matrices_out[start + m] = ubar
             sign, log_abs = _log_det(ubar)  # NaN where not finite, which the root counts step round

@@ -173,9 +173,7 @@ class CompiledDeterminant(EvaluationCount):
         deduction.adopt_row_kinds(self.program.row_kinds)
         p = self.program
         self._operations = _kernel_operations(p, p.orthos)
-        self._layout = (p.slot_offset, p.slot_width, p.slot_columns, p.slot_columns_start, p.workspace,
-                        p.slot_rows.size, p.root, p.root_row, p.geometric_rows, p.order, p.kept_rows,
-                        p.kept_columns, p.slot_rows)
+        self._layout = (p.workspace, p.slot_rows.size, p.kept_columns.size, *_assembly(p))
 
     @property
     def order(self) -> int:
@@ -200,10 +198,10 @@ class CompiledDeterminant(EvaluationCount):
         from linmstmm import _kernels  # numba loads here, not at import
 
         n, order = omega.size, self.order
-        matrices = np.zeros((n if with_matrices else 0, order, order), dtype=omega.dtype)
-        sign = np.zeros(n, dtype=omega.dtype)
-        log_abs, log_scale = np.zeros(n), np.zeros(n)
-        if group == 1 and not with_matrices:  # each frequency on its own: shared among the cores
+        matrices = np.empty((n if with_matrices else 0, order, order), dtype=omega.dtype)  # the kernel writes all
+        sign = np.empty(n, dtype=omega.dtype)
+        log_abs, log_scale = np.empty(n), np.empty(n)
+        if group == 1 and not with_matrices and n > 1:  # each frequency on its own: shared among the cores
             spread(lambda start, stop: _kernels.evaluate(operations, self._layout, omega[start:stop], 1, matrices,
                                                          sign[start:stop], log_abs[start:stop],
                                                          log_scale[start:stop]), n)
@@ -253,3 +251,35 @@ def _kernel_operations(program, orthos: np.ndarray) -> tuple:
     p = program
     return (p.slot_offset, p.slot_rows, p.slot_width, p.operations, p.terms, p.places, p.places_start,
             p.matrices, orthos, p.ortho_blocks, p.beams, p.beam_rotation)
+
+
+def _assembly(program) -> tuple[np.ndarray, np.ndarray]:
+    """Where each entry of Ū_all comes from: (sources (E,), targets (E,)) int64, entry
+    ``sources[e]`` of a frequency's workspace added to entry ``targets[e]`` of the
+    transposed Ū_all (N, N) flattened, in the order the blocks stand (the root state
+    and −Z_root share the first twelve rows: entries met twice add up in that order);
+    rows and columns released are left out."""
+    p = program
+    order, kept = p.order, p.kept_columns.size
+    row_of, column_of = _kept_at(p.kept_rows, order), _kept_at(p.kept_columns, order)
+    sources, targets = [], []
+    start = 0
+    for position, slot in enumerate([p.root, p.root_row, *p.geometric_rows]):
+        rows, width = p.slot_rows[slot], p.slot_width[slot]
+        columns = column_of[p.slot_columns[p.slot_columns_start[slot]:p.slot_columns_start[slot + 1]]]
+        entries = p.slot_offset[slot] + np.arange(rows * width).reshape(rows, width)
+        row = row_of[start:start + rows][:, None]
+        kept_entries = (row >= 0) & (columns[None, :] >= 0)
+        sources.append(entries[kept_entries])
+        targets.append((columns[None, :] * kept + row)[kept_entries])
+        if position > 0:  # the root state and −Z_root share the first twelve rows
+            start += rows
+    return np.concatenate(sources).astype(np.int64), np.concatenate(targets).astype(np.int64)
+
+
+def _kept_at(kept: np.ndarray, order: int) -> np.ndarray:
+    """(order,) int64: where each of the full Ū_all's ``order`` rows (or columns) stands among
+    the ``kept`` ones (k,) of the compiled Ū_all, -1 for one released."""
+    position = np.full(order, -1, dtype=np.int64)
+    position[kept] = np.arange(kept.size)
+    return position

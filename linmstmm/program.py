@@ -336,21 +336,22 @@ def _walked(plan: _Planner) -> tuple[list, int]:
 def _assembled(plan: _Planner, rows: list, root: int) -> Program:
     """The program ``plan`` recorded, as arrays (``rows`` and ``root`` as :func:`_walked` gives them)."""
     deduction = plan.deduction
-    sizes = np.array([r * len(c) for r, c in plan.slots], dtype=np.int64)
-    starts = np.cumsum([0] + [len(c) for _, c in plan.slots])
-    places_start = np.cumsum([0] + [p.size for p in plan.places])
+    slot_rows = np.array([r for r, _ in plan.slots], dtype=np.int64)
+    slot_columns = [c for _, c in plan.slots]
+    slot_width = np.array([c.size for c in slot_columns], dtype=np.int64)
+    offsets = _starts(slot_rows * slot_width)
     order = deduction.full_order
     return Program(
-        slot_offset=np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64),
-        slot_rows=np.array([r for r, _ in plan.slots], dtype=np.int64),
-        slot_width=np.array([len(c) for _, c in plan.slots], dtype=np.int64),
-        slot_columns=np.concatenate([c for _, c in plan.slots]).astype(np.int64),
-        slot_columns_start=starts.astype(np.int64),
-        workspace=int(sizes.sum()),
+        slot_offset=offsets[:-1],
+        slot_rows=slot_rows,
+        slot_width=slot_width,
+        slot_columns=np.concatenate(slot_columns, dtype=np.int64),
+        slot_columns_start=_starts(slot_width),
+        workspace=int(offsets[-1]),
         operations=_table(plan.operations, 6),
         terms=_table(plan.terms, 3),
         places=np.concatenate(plan.places).astype(np.int64) if plan.places else np.zeros(0, np.int64),
-        places_start=places_start.astype(np.int64),
+        places_start=_starts(np.array([p.size for p in plan.places], dtype=np.int64)),
         matrices=plan.all_matrices(),
         orthos=_table(plan.orthos, 5),
         ortho_blocks=_table(plan.ortho_blocks, 6),
@@ -364,6 +365,13 @@ def _assembled(plan: _Planner, rows: list, root: int) -> Program:
         kept_columns=_kept(order, deduction.released_columns),
         row_kinds=np.concatenate([_row_kinds(count, forces) for _, count, forces, _ in rows]),
     )
+
+
+def _starts(counts: np.ndarray) -> np.ndarray:
+    """(n + 1,) int64: where each of n consecutive runs of ``counts`` (n,) entries starts, and the total last."""
+    starts = np.zeros(counts.size + 1, dtype=np.int64)
+    np.cumsum(counts, out=starts[1:])
+    return starts
 
 
 def _mask(columns: np.ndarray) -> int:

@@ -84,12 +84,9 @@ class _Planner:
     def columns_of(self, mask: int) -> np.ndarray:
         """The columns whose bits ``mask`` holds, sorted int64 (the same array for the same mask)."""
         if mask not in self._columns_of:
-            columns, rest = [], mask
-            while rest:  # the lowest bit left, one per column (not one per bit below the highest)
-                lowest = rest & -rest
-                columns.append(lowest.bit_length() - 1)
-                rest ^= lowest
-            self._columns_of[mask] = np.array(columns, dtype=np.int64)
+            bits = np.unpackbits(np.frombuffer(mask.to_bytes((mask.bit_length() + 7) // 8, "little"), np.uint8),
+                                 bitorder="little")
+            self._columns_of[mask] = np.flatnonzero(bits).astype(np.int64, copy=False)
         return self._columns_of[mask]
 
     def matrix(self, matrix) -> int:

@@ -61,17 +61,8 @@ def boundary_selection(fixed) -> np.ndarray:
     (row FORCE_INDEX[c]) is the unknown.
     """
     selection = np.zeros((12, 6))
-    selection[boundary_rows(fixed), _SIX] = 1.0
+    selection[np.where(fixed, FORCE_INDEX, np.arange(6)), np.arange(6)] = 1.0
     return selection
-
-
-def boundary_rows(fixed) -> np.ndarray:
-    """(6,) int: the state vector's row of each of a boundary end's six unknowns (component
-    c's displacement row c, or its force's FORCE_INDEX[c] where ``fixed[c]``)."""
-    return np.where(fixed, FORCE_INDEX, _SIX)
-
-
-_SIX = np.arange(6)
 
 
 class Deduction:
@@ -95,7 +86,7 @@ class Deduction:
         names = ["X", "Y", "Z", "Θx", "Θy", "Θz", "Mx", "My", "Mz", "Qx", "Qy", "Qz"]
         for b, boundary in enumerate(topology.boundaries):
             self._boundary_columns[b] = np.arange(len(labels), len(labels) + 6)
-            state_rows += boundary_rows(boundary.fixed).tolist()
+            state_rows += [FORCE_INDEX[c] if boundary.fixed[c] else c for c in range(6)]
             labels += [f"{boundary.label}.{names[row]}" for row in state_rows[-6:]]
         for c, cut in enumerate(topology.cuts):
             self._cut_columns[c] = np.arange(len(labels), len(labels) + 12)
@@ -255,8 +246,7 @@ class Deduction:
                                              + [_row_kinds(("row", row, row[1], row[2])) for row in rows[1:]])
         if not self.released_columns.size:  # nothing released (most models): no copies to make
             return self._row_kinds, self._column_kinds
-        return (np.delete(self._row_kinds, self.released_rows),
-                np.delete(self._column_kinds, self.released_columns))
+        return np.delete(self._row_kinds, self.released_rows), np.delete(self._column_kinds, self.released_columns)
 
     def adopt_row_kinds(self, row_kinds: np.ndarray) -> None:
         """Take the kinds of Ū_all's rows before release (0 a displacement, 1 a rotation,

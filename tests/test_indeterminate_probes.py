@@ -175,10 +175,11 @@ def test_equilibration_is_the_plain_sweeps():
 
 
 def test_the_bound_never_clears_what_the_svd_would_not():
-    """nullspace._well_above (by the Gram matrix, or an inverse above order 93) says a matrix's smallest singular value is at least the
-    threshold times its largest only where the SVD finds none below it: on matrices of
-    singular values spread over 1 to 1e-9 (about the threshold and far from it), and it
-    does say so for well conditioned ones (or the screen's shortcut would never serve)."""
+    """nullspace._well_above (by the Gram matrix, or an inverse above order 93) says a
+    matrix's smallest singular value is at least the threshold times its largest only
+    where the SVD finds none below it: on matrices of singular values spread over 1 to
+    1e-9 (about the threshold and far from it), and it does say so for well conditioned
+    ones (or the screen's shortcut would never serve)."""
     from linmstmm.nullspace import _well_above, nullity
 
     rng = np.random.default_rng(11)

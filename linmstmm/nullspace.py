@@ -274,6 +274,7 @@ BOUND_MARGIN = 2.0
 #: σ_min ≥ √2 threshold s, above the threshold with room for the SVD's n eps (the
 #: probes' threshold 1e-6 up to order 93; the launchers are 60 and 72).
 GRAM_ROUNDING = 2.0
+_EPS = float(np.finfo(float).eps)
 
 
 def _well_above(matrix: np.ndarray, threshold: float) -> bool:
@@ -289,8 +290,9 @@ def _well_above(matrix: np.ndarray, threshold: float) -> bool:
         return False
     margin = BOUND_MARGIN * threshold
     n = matrix.shape[0]
-    if margin ** 2 >= GRAM_ROUNDING * (n + 1) ** 2 * np.finfo(float).eps:
-        return _gram_clears(matrix * power_of_two_scale(bound), margin * bound * power_of_two_scale(bound))
+    if margin ** 2 >= GRAM_ROUNDING * (n + 1) ** 2 * _EPS:
+        unit = power_of_two_scale(bound)  # exact: s of ``matrix * unit`` is about 1
+        return _gram_clears(matrix * unit, margin * bound * unit)
     try:
         inverse = np.linalg.inv(matrix)
     except np.linalg.LinAlgError:

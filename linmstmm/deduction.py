@@ -61,8 +61,7 @@ def boundary_selection(fixed) -> np.ndarray:
     (row FORCE_INDEX[c]) is the unknown.
     """
     selection = np.zeros((12, 6))
-    for c in range(6):
-        selection[FORCE_INDEX[c] if fixed[c] else c, c] = 1.0
+    selection[np.where(fixed, FORCE_INDEX, np.arange(6)), np.arange(6)] = 1.0
     return selection
 
 
@@ -96,7 +95,7 @@ class Deduction:
         #: element -> columns of the jumps across its released directions
         self.jump_columns: dict[int, np.ndarray] = {}
         for e, element in enumerate(topology.elements):
-            if element.kind == "spring" and element.record.released.size:
+            if element.kind == "spring" and element.record.release is not None and element.record.released.size:
                 released = element.record.released
                 self.jump_columns[e] = np.arange(len(labels), len(labels) + released.size)
                 labels += [f"{element.name}.Δ{COMPONENTS[d]}" for d in released]
@@ -245,8 +244,9 @@ class Deduction:
             _, rows, _ = self._carry(np.ones(1), stable=False)
             self._row_kinds = np.concatenate([np.arange(12) // 3]
                                              + [_row_kinds(("row", row, row[1], row[2])) for row in rows[1:]])
-        return (np.delete(self._row_kinds, self.released_rows),
-                np.delete(self._column_kinds, self.released_columns))
+        if not self.released_columns.size:  # nothing released (most models): no copies to make
+            return self._row_kinds, self._column_kinds
+        return np.delete(self._row_kinds, self.released_rows), np.delete(self._column_kinds, self.released_columns)
 
     def adopt_row_kinds(self, row_kinds: np.ndarray) -> None:
         """Take the kinds of Ū_all's rows before release (0 a displacement, 1 a rotation,

@@ -45,8 +45,8 @@ def structure_of(model: Model) -> tuple:
         elif element.kind == "beam":
             elements.append(("beam", element.name, element.ends, bool(element.axial), bool(element.torsion)))
         else:
-            elements.append(("spring", element.name, element.ends, element.released.tobytes(),
-                             np.isinf(element.k).tobytes()))
+            released = b"" if element.release is None else element.released.tobytes()  # the same bytes, not found
+            elements.append(("spring", element.name, element.ends, released, np.isinf(element.k).tobytes()))
     boundary = tuple((point, np.asarray(fixed, bool).tobytes()) for point, fixed in model.boundary.items())
     return tuple(model.points), tuple(elements), boundary
 

@@ -51,7 +51,8 @@ class _Planner:
     def __init__(self, deduction: Deduction):
         self.deduction = deduction
         self.slots: list[tuple[int, np.ndarray]] = []  # (rows, columns)
-        self.column_sets: list[frozenset] = []  # each slot's columns, for the orthonormalisations' unions
+        self.column_masks: list[int] = []  # each slot's columns as bits (column c: 1 << c), for the unions
+        self._columns_of: dict[int, np.ndarray] = {}  # mask -> its columns, one array per set of columns
         self.operations: list[tuple] = []
         self.terms: list[tuple] = []
         self.places: list[np.ndarray] = []
@@ -62,21 +63,31 @@ class _Planner:
         self.constants = Constants()  # where the model's numbers go among the matrices
 
     # -- storage ----------------------------------------------------------------------
-    def slot(self, rows: int, columns: np.ndarray, column_set: frozenset | None = None) -> int:
-        """A new slot of ``rows`` rows on ``columns`` (sorted int64; ``column_set`` the same
-        columns as a set, if the caller has it: slots share both, neither is ever changed)."""
+    def slot(self, rows: int, columns: np.ndarray, mask: int | None = None) -> int:
+        """A new slot of ``rows`` rows on ``columns`` (sorted int64; ``mask`` the same
+        columns as bits, if the caller has it: slots share both, neither is ever changed)."""
         self.slots.append((rows, columns))
-        self.column_sets.append(frozenset(columns.tolist()) if column_set is None else column_set)
+        self.column_masks.append(_mask(columns) if mask is None else mask)
         return len(self.slots) - 1
 
     def slot_like(self, rows: int, slot: int) -> int:
         """A new slot of ``rows`` rows on the columns of ``slot``."""
-        return self.slot(rows, self.slots[slot][1], self.column_sets[slot])
+        return self.slot(rows, self.slots[slot][1], self.column_masks[slot])
 
-    def union(self, slots) -> tuple[np.ndarray, frozenset]:
-        """(sorted int64 array, set) of the columns of all of ``slots``."""
-        union = frozenset().union(*[self.column_sets[s] for s in slots])
-        return np.array(sorted(union), dtype=np.int64), union
+    def union(self, slots) -> tuple[np.ndarray, int]:
+        """(sorted int64 array, bits) of the columns of all of ``slots``."""
+        mask = 0
+        for s in slots:
+            mask |= self.column_masks[s]
+        return self.columns_of(mask), mask
+
+    def columns_of(self, mask: int) -> np.ndarray:
+        """The columns whose bits ``mask`` holds, sorted int64 (the same array for the same mask)."""
+        if mask not in self._columns_of:
+            bits = np.unpackbits(np.frombuffer(mask.to_bytes((mask.bit_length() + 7) // 8, "little"), np.uint8),
+                                 bitorder="little")
+            self._columns_of[mask] = np.flatnonzero(bits).astype(np.int64, copy=False)
+        return self._columns_of[mask]
 
     def matrix(self, matrix) -> int:
         """Index of a new constant: one the topology alone fixes (a selection, a sign)."""
@@ -118,8 +129,8 @@ class _Planner:
 
     def combined(self, sources: list[tuple[int, int]]) -> int:
         """New slot = Σ matrix @ source over the union of the sources' columns."""
-        union, union_set = self.union([s for s, _ in sources])
-        dst = self.slot(12, union, union_set)
+        union, union_mask = self.union([s for s, _ in sources])
+        dst = self.slot(12, union, union_mask)
         first = len(self.terms)
         for src, matrix in sources:
             self.terms.append((src, matrix, self.place(self.columns(src), union)))
@@ -234,29 +245,28 @@ def _walked(plan: _Planner) -> tuple[list, int]:
 
         emit : False to record it without an ORTHO operation (a beam's pieces
         after the first run it themselves)."""
-        sets = plan.column_sets
+        masks = plan.column_masks
         others = rows + list(open_states.values()) + list(waiting.values())
-        columns = set(sets[state])
+        columns = masks[state]
         chosen = [False] * len(others)
         grown = True
         while grown:  # every block that shares a column with those gathered so far
             grown = False
             for i, block in enumerate(others):
-                if not chosen[i] and not sets[block[0]].isdisjoint(columns):
+                if not chosen[i] and masks[block[0]] & columns:
                     chosen[i] = grown = True
-                    columns |= sets[block[0]]
+                    columns |= masks[block[0]]
         blocks = [block for block, taken in zip(others, chosen) if taken] + [_state_block(state)]
-        if sum(block[1] for block in blocks) < len(columns):  # fewer rows than columns: never orthonormalised
+        if sum(block[1] for block in blocks) < columns.bit_count():  # fewer rows than columns: never orthonormalised
             return state
-        union_set = frozenset(columns)
-        union = np.array(sorted(union_set), dtype=np.int64)
+        union = plan.columns_of(columns)
         first = len(plan.ortho_blocks)
         for block in blocks:
             src, count, forces, kind = block
-            if len(sets[src]) == union.size:  # its columns are the union's: in place
+            if masks[src] == columns:  # its columns are the union's: in place
                 dst, place = src, -1
             else:
-                dst, place = plan.slot(count, union, union_set), plan.place(plan.columns(src), union)
+                dst, place = plan.slot(count, union, columns), plan.place(plan.columns(src), union)
             plan.ortho_blocks.append((src, dst, count, kind, place, forces))
             block[0] = dst
         plan.orthos.append((first, len(blocks), len(blocks) - 1, union.size, 0))
@@ -306,8 +316,8 @@ def _walked(plan: _Planner) -> tuple[list, int]:
             plan.constants.other_input.append((e, k, forces, incidence))
             terms.append((other, forces))
             first = inputs[0]
-            union, union_set = plan.union([first, other])
-            row = plan.slot(6, union, union_set)
+            union, union_mask = plan.union([first, other])
+            row = plan.slot(6, union, union_mask)
             plan.emit(GEOMETRIC, row, first, other, incidence, len(plan.places))
             plan.place(plan.columns(first), union)
             plan.place(plan.columns(other), union)
@@ -323,21 +333,22 @@ def _walked(plan: _Planner) -> tuple[list, int]:
 def _assembled(plan: _Planner, rows: list, root: int) -> Program:
     """The program ``plan`` recorded, as arrays (``rows`` and ``root`` as :func:`_walked` gives them)."""
     deduction = plan.deduction
-    sizes = np.array([r * len(c) for r, c in plan.slots], dtype=np.int64)
-    starts = np.cumsum([0] + [len(c) for _, c in plan.slots])
-    places_start = np.cumsum([0] + [p.size for p in plan.places])
+    slot_rows = np.array([r for r, _ in plan.slots], dtype=np.int64)
+    slot_columns = [c for _, c in plan.slots]
+    slot_width = np.array([c.size for c in slot_columns], dtype=np.int64)
+    offsets = _starts(slot_rows * slot_width)
     order = deduction.full_order
     return Program(
-        slot_offset=np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64),
-        slot_rows=np.array([r for r, _ in plan.slots], dtype=np.int64),
-        slot_width=np.array([len(c) for _, c in plan.slots], dtype=np.int64),
-        slot_columns=np.concatenate([c for _, c in plan.slots]).astype(np.int64),
-        slot_columns_start=starts.astype(np.int64),
-        workspace=int(sizes.sum()),
+        slot_offset=offsets[:-1],
+        slot_rows=slot_rows,
+        slot_width=slot_width,
+        slot_columns=np.concatenate(slot_columns, dtype=np.int64),
+        slot_columns_start=_starts(slot_width),
+        workspace=int(offsets[-1]),
         operations=_table(plan.operations, 6),
         terms=_table(plan.terms, 3),
         places=np.concatenate(plan.places).astype(np.int64) if plan.places else np.zeros(0, np.int64),
-        places_start=places_start.astype(np.int64),
+        places_start=_starts(np.array([p.size for p in plan.places], dtype=np.int64)),
         matrices=plan.all_matrices(),
         orthos=_table(plan.orthos, 5),
         ortho_blocks=_table(plan.ortho_blocks, 6),
@@ -351,6 +362,21 @@ def _assembled(plan: _Planner, rows: list, root: int) -> Program:
         kept_columns=_kept(order, deduction.released_columns),
         row_kinds=np.concatenate([_row_kinds(count, forces) for _, count, forces, _ in rows]),
     )
+
+
+def _starts(counts: np.ndarray) -> np.ndarray:
+    """(n + 1,) int64: where each of n consecutive runs of ``counts`` (n,) entries starts, and the total last."""
+    starts = np.zeros(counts.size + 1, dtype=np.int64)
+    np.cumsum(counts, out=starts[1:])
+    return starts
+
+
+def _mask(columns: np.ndarray) -> int:
+    """``columns`` (int) as bits: column c is ``1 << c``."""
+    mask = 0
+    for c in columns.tolist():
+        mask |= 1 << c
+    return mask
 
 
 def _state_block(slot: int) -> list:

@@ -37,6 +37,7 @@ class Constants:
         self.junction: list[int] = []
         self.other_input: list[tuple[int, int, int, int]] = []
         self.joint: list[tuple[int, int, int]] = []
+        self._indices = None  # rigid, spring, other_input as int arrays, made on the first fill
 
     def carry(self, e: int, kind: str, kinematic: int, inertial: int) -> None:
         """Element e's U0 goes to ``matrices[kinematic]``, a rigid body's U2 to ``[inertial]``."""
@@ -50,28 +51,31 @@ class Constants:
     def fill(self, deduction, matrices: np.ndarray) -> None:
         """Write every constant of ``deduction``'s numbers into ``matrices`` (K, 12, 12), in place.
 
+        Every constant is entered (:meth:`carry` and the lists) before the first fill.
+
         Parameters
         ----------
         deduction : Deduction
             The deduced system the walk was made for, or one of the same structure
             (:func:`linmstmm.program._structure`).
         matrices : (K, 12, 12) float64
-            The program's constants; each one written is padded with zeros to 12 × 12.
+            The program's constants: zeros, or a program's constants of the same
+            structure (whose padding is zeros already); each one written is padded with
+            zeros to 12 × 12.
         """
         elements = deduction.topology.elements
+        if self._indices is None:
+            self._indices = tuple(np.array(entries, dtype=np.int64)
+                                  for entries in (self.rigid, self.spring, self.other_input))
+        rigid, spring, other_input = self._indices
         if self.rigid:
-            _fill_rigid(elements, np.array(self.rigid), matrices)
+            _fill_rigid(elements, rigid, matrices)
         if self.spring:
-            index = np.array(self.spring)
-            records = [elements[e].record for e in index[:, 0]]
-            released = np.array([np.zeros(6, bool) if r.release is None else r.release for r in records])
-            matrices[index[:, 1]] = spring_constant_transfer(np.array([r.k for r in records], dtype=float),
-                                                             np.array([r.axes for r in records], dtype=float),
-                                                             released)
+            _fill_springs(elements, spring, matrices)
         if self.junction:
             matrices[self.junction] = np.eye(12)
         if self.other_input:
-            _fill_other_inputs(elements, np.array(self.other_input), matrices)
+            _fill_other_inputs(elements, other_input, matrices)
         for e, force, jump in self.joint:
             record = elements[e].record
             matrices[force] = padded(joint_force(record.axes, record.released))
@@ -80,7 +84,7 @@ class Constants:
 
 def _fill_rigid(elements, index: np.ndarray, matrices: np.ndarray) -> None:
     """U0 and U2 of the rigid bodies ``index[:, 0]`` into ``matrices[index[:, 1]]`` and ``[index[:, 2]]``."""
-    bodies = [elements[e] for e in index[:, 0]]
+    bodies = [elements[e] for e in index[:, 0].tolist()]
     records = [body.record for body in bodies]
     kinematic, inertial = rigid_transfer_parts(
         np.array([r.mass for r in records], dtype=float), np.array([r.com for r in records], dtype=float),
@@ -91,13 +95,28 @@ def _fill_rigid(elements, index: np.ndarray, matrices: np.ndarray) -> None:
     matrices[index[:, 2]] = inertial
 
 
+def _fill_springs(elements, index: np.ndarray, matrices: np.ndarray) -> None:
+    """U0 of the springs ``index[:, 0]`` into ``matrices[index[:, 1]]``."""
+    records = [elements[e].record for e in index[:, 0].tolist()]
+    releases = [record.release for record in records]
+    released = None if all(release is None for release in releases) else np.array(  # None: 1 / k, as nothing released
+        [_NOTHING_RELEASED if release is None else release for release in releases])
+    matrices[index[:, 1]] = spring_constant_transfer(np.array([r.k for r in records], dtype=float),
+                                                     np.array([r.axes for r in records], dtype=float), released)
+
+
+#: A spring's release where nothing is released, among others' (:func:`_fill_springs`).
+_NOTHING_RELEASED = np.zeros(6, dtype=bool)
+
+
 def _fill_other_inputs(elements, index: np.ndarray, matrices: np.ndarray) -> None:
-    """U_{j,Ik} and H_{j,Ik} of input k + 2 of element e, for each (e, k, U index, H index) of ``index``."""
-    bodies = [elements[e] for e in index[:, 0]]
+    """U_{j,Ik} and H_{j,Ik} of input k + 2 of element e, for each (e, k, U index, H index) of
+    ``index`` (H's rows 6: are the zeros ``matrices`` holds there, see :meth:`Constants.fill`)."""
+    bodies = [elements[e] for e in index[:, 0].tolist()]
     position = np.array([[body.ports[body.inputs[0]].position, body.ports[body.inputs[k + 1]].position,
-                          body.ports[body.output].position] for body, k in zip(bodies, index[:, 1])], dtype=float)
+                          body.ports[body.output].position] for body, k in zip(bodies, index[:, 1].tolist())],
+                        dtype=float)
     matrices[index[:, 2]] = force_extraction(position[:, 1], position[:, 2])
-    matrices[index[:, 3]] = 0.0
     matrices[index[:, 3], :6] = position_incidence(position[:, 0], position[:, 1])
 
 

@@ -164,7 +164,7 @@ def _choose_root(model, elements, boundaries, root_point):
                          f"(boundary ends: {names})", key="root")
     if not boundaries:
         return None
-    return max(range(len(boundaries)), key=lambda b: (boundaries[b].fixed.sum(), -b))
+    return max(range(len(boundaries)), key=lambda b: (np.count_nonzero(boundaries[b].fixed), -b))
 
 
 def _grow_tree(elements, start, cuts):

@@ -174,11 +174,12 @@ def test_equilibration_is_the_plain_sweeps():
             assert np.array_equal(ours, theirs)
 
 
-def test_the_bound_from_an_inverse_never_clears_what_the_svd_would_not():
-    """nullspace._well_above says a matrix's smallest singular value is at least the
-    threshold times its largest only where the SVD finds none below it: on matrices of
-    singular values spread over 1 to 1e-9 (about the threshold and far from it), and it
-    does say so for well conditioned ones (or the screen's shortcut would never serve)."""
+def test_the_bound_never_clears_what_the_svd_would_not():
+    """nullspace._well_above (by the Gram matrix, or an inverse above order 93) says a
+    matrix's smallest singular value is at least the threshold times its largest only
+    where the SVD finds none below it: on matrices of singular values spread over 1 to
+    1e-9 (about the threshold and far from it), and it does say so for well conditioned
+    ones (or the screen's shortcut would never serve)."""
     from linmstmm.nullspace import _well_above, nullity
 
     rng = np.random.default_rng(11)
@@ -195,3 +196,29 @@ def test_the_bound_from_an_inverse_never_clears_what_the_svd_would_not():
             assert nullity(matrix, threshold, (np.ones(n), np.ones(n))) == 0
     assert cleared > 100
     assert not _well_above(np.zeros((4, 4)), 1e-6) and not _well_above(np.diag([1.0, 1e-7]), 1e-6)
+
+
+@pytest.mark.parametrize("n", [2, 12, 60, 72, 93])
+def test_the_gram_test_clears_exactly_what_its_bound_says(n):
+    """Up to order 93 at the probes' threshold 1e-6 nullspace._well_above decides by the
+    Gram matrix: it clears every matrix whose smallest singular value is 4 times the
+    threshold times s = √(‖A‖₁ ‖A‖∞) (twice its margin), and none that the SVD finds a
+    singular value below the threshold in, the smallest singular value set at 0.3 to 30
+    times the threshold times the largest, over 1e-200 to 1e200 in scale."""
+    from linmstmm.nullspace import _well_above, nullity
+
+    rng = np.random.default_rng(n)
+    threshold = 1e-6
+    for trial in range(40):
+        u, _ = np.linalg.qr(rng.standard_normal((n, n)))
+        v, _ = np.linalg.qr(rng.standard_normal((n, n)))
+        sigma = np.sort(10.0 ** rng.uniform(-3, 0, n))[::-1]
+        sigma[-1] = sigma[0] * threshold * 10.0 ** rng.uniform(np.log10(0.3), np.log10(30))
+        matrix = (u * sigma) @ v.T * 10.0 ** rng.uniform(-200, 200)
+        size = np.abs(matrix)
+        s = np.sqrt(size.sum(axis=0).max()) * np.sqrt(size.sum(axis=1).max())
+        smallest = np.linalg.svd(matrix, compute_uv=False)[-1]
+        if nullity(matrix, threshold, (np.ones(n), np.ones(n))):
+            assert not _well_above(matrix, threshold)
+        if smallest >= 4 * threshold * s:
+            assert _well_above(matrix, threshold)

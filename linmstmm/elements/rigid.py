@@ -33,16 +33,17 @@ def rigid_transfer_parts(mass, com, inertia, inp, out) -> tuple[np.ndarray, np.n
     """
     mass, inp, out, com, inertia = (np.asarray(p) for p in (mass, inp, out, com, inertia))
     dtype = number_type(mass, com, inertia, inp, out)
+    arms = skew(np.stack([out - inp, inp - out, com - inp, out - com]))  # the four at once: one call, not four
     kinematic = identities(mass.shape, 12, dtype=dtype)
-    kinematic[..., U, R] = -skew(out - inp)
-    kinematic[..., M, Q] = skew(inp - out)
+    kinematic[..., U, R] = -arms[0]
+    kinematic[..., M, Q] = arms[1]
     weighted = np.zeros(mass.shape + (3, 6)).astype(dtype, copy=False)  # u_c = this @ (u_I, θ_I), times m
     weighted[..., :3] = np.eye(3)
-    weighted[..., 3:] = -skew(com - inp)
+    weighted[..., 3:] = -arms[2]
     weighted *= mass[..., None, None]
     inertial = np.zeros(mass.shape + (12, 12), dtype=dtype)
     inertial[..., Q, 0:6] = weighted
-    inertial[..., M, 0:6] = -skew(out - com) @ weighted
+    inertial[..., M, 0:6] = -arms[3] @ weighted
     inertial[..., M, R] += inertia
     return kinematic, inertial
 

@@ -297,7 +297,7 @@ def _length_tol(points):
     if not points:
         return _ABS_TOL
     coords = np.array(list(points.values()))
-    size = np.linalg.norm(coords.max(axis=0) - coords.min(axis=0))
+    size = norm3(coords.max(axis=0) - coords.min(axis=0))
     return max(_REL_TOL * size, _ABS_TOL)
 
 
@@ -325,7 +325,8 @@ def _check_inertia(t):
     whose principal moments are those of a real body."""
     value = t.table["inertia"]
     if isinstance(value, list) and len(value) == 3 and not any(isinstance(v, list) for v in value):
-        return _check_principal_moments(t, np.diag(t.vector("inertia", 3, ">= 0")))
+        tensor = np.diag(t.vector("inertia", 3, ">= 0"))
+        return _check_principal_moments(t, tensor, np.linalg.eigvalsh(tensor))
     tensor = t.matrix("inertia", "[Ixx, Iyy, Izz] or a 3x3 array of arrays")
     scale = np.abs(tensor).max()
     asymmetry = np.abs(tensor - tensor.T)
@@ -334,17 +335,18 @@ def _check_inertia(t):
         raise t.error("inertia", f"tensor is not symmetric: inertia[{i}][{j}] = {tensor[i, j]:g} "
                                  f"but inertia[{j}][{i}] = {tensor[j, i]:g}")
     tensor = (tensor + tensor.T) / 2
-    lowest = np.linalg.eigvalsh(tensor)[0]
-    if lowest < -_PSD_TOL * scale:
+    moments = np.linalg.eigvalsh(tensor)
+    if moments[0] < -_PSD_TOL * scale:
         raise t.error("inertia", f"tensor is not positive semidefinite "
-                                 f"(smallest eigenvalue {lowest:g})")
-    return _check_principal_moments(t, tensor)
+                                 f"(smallest eigenvalue {moments[0]:g})")
+    return _check_principal_moments(t, tensor, moments)
 
 
-def _check_principal_moments(t, tensor):
-    """``tensor`` if its principal moments I1 <= I2 <= I3 keep I3 <= I1 + I2 (every
-    real body does: equality for a flat plate); the tolerance is relative to the trace."""
-    low, middle, high = np.linalg.eigvalsh(tensor)
+def _check_principal_moments(t, tensor, moments):
+    """``tensor`` if its principal moments ``moments`` (its eigenvalues, ascending) keep
+    I3 <= I1 + I2 (every real body does: equality for a flat plate); the tolerance is
+    relative to the trace."""
+    low, middle, high = moments
     if high - (low + middle) > _TRIANGLE_TOL * (low + middle + high):
         raise t.error("inertia", f"principal moments {low:g}, {middle:g}, {high:g} kg m^2 break "
                                  f"the triangle inequality ({high:g} > {low:g} + {middle:g}): "
@@ -365,7 +367,7 @@ def _check_spring(t, points, tol):
     t.check_keys(("name", "ends", "k"), ("axes", "c", "release"))
     name = t.string("name", nonempty=True)
     ends, a, b = _check_ends(t, points)
-    gap = np.linalg.norm(b - a)
+    gap = norm3(b - a)
     if gap > tol:
         raise t.error("ends", f"points {ends[0]!r} and {ends[1]!r} do not coincide "
                               f"(distance {gap:g} m); a spring has no length")
@@ -432,7 +434,8 @@ def _check_beam(t, points, tol):
                  ("Ip", "y_axis", "axial", "torsion"))
     name = t.string("name", nonempty=True)
     ends, a, b = _check_ends(t, points)
-    length = float(np.linalg.norm(b - a))
+    along = b - a
+    length = norm3(along)
     if length <= tol:
         raise t.error("ends", f"zero length: points {ends[0]!r} and {ends[1]!r} coincide")
     fields = {"name": name, "ends": ends, "length": length}
@@ -440,7 +443,7 @@ def _check_beam(t, points, tol):
     fields["rho"] = t.number("rho", ">= 0")
     fields.update({key: t.number(key, "> 0") for key in ("A", "Iy", "Iz", "J")})
     fields["Ip"] = t.number("Ip", "> 0", default=fields["Iy"] + fields["Iz"])
-    fields["axes"] = _beam_axes(t, (b - a) / length)
+    fields["axes"] = _beam_axes(t, along / length)
     fields["axial"] = t.boolean("axial", True)
     fields["torsion"] = t.boolean("torsion", True)
     return fields
@@ -450,16 +453,58 @@ def _beam_axes(t, x):
     """Rows local x, y, z: y from ``y_axis`` projected normal to x, else e_Z × x (e_Y if x ∥ e_Z)."""
     if "y_axis" in t:
         given = t.vector("y_axis", 3)
-        size = np.linalg.norm(given)
+        size = norm3(given)
         y = given - (given @ x) * x
-        if size == 0 or np.linalg.norm(y) <= _PARALLEL_TOL * size:
+        size_y = norm3(y)
+        if size == 0 or size_y <= _PARALLEL_TOL * size:
             raise t.error("y_axis", f"{given.tolist()} is zero or parallel to the beam axis")
     else:
-        y = np.cross(_E_Z, x)
-        if np.linalg.norm(y) <= _PARALLEL_TOL:
+        y = cross3(_E_Z, x)
+        size_y = norm3(y)
+        if size_y <= _PARALLEL_TOL:
             y = _E_Y - (_E_Y @ x) * x
-    y = y / np.linalg.norm(y)
-    return np.array([x, y, np.cross(x, y)])
+            size_y = norm3(y)
+    y = y / size_y
+    return np.array([x, y, cross3(x, y)])
+
+
+def norm3(vector: np.ndarray) -> float:
+    """Euclidean length of a vector: numpy.linalg.norm's own arithmetic, without its overhead.
+
+    Parameters
+    ----------
+    vector : numpy.ndarray, shape (3,)
+        The vector (any unit).
+
+    Returns
+    -------
+    float
+        Its length, same unit. For float64 sqrt(vector · vector): the dot product
+        numpy.linalg.norm forms (``vector.dot(vector)``) and a correctly rounded
+        square root, so the same bits; any other dtype through numpy.linalg.norm.
+    """
+    if vector.dtype != np.float64:
+        return float(np.linalg.norm(vector))
+    return math.sqrt(vector.dot(vector))
+
+
+def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of two vectors: numpy.cross's arithmetic in Python floats, without its overhead.
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray of float, shape (3,)
+        The vectors, one of them float64 at least (numpy.cross then works in float64 too).
+
+    Returns
+    -------
+    numpy.ndarray of float64, shape (3,)
+        a × b, each component a product minus a product, each operation rounded
+        once, as numpy.cross forms them: the same bits.
+    """
+    a0, a1, a2 = a.tolist()
+    b0, b1, b2 = b.tolist()
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
 def _check_boundary(t, points):

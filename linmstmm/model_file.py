@@ -169,15 +169,14 @@ class _Table:
         """A finite number as float (``default`` if absent and not required)."""
         if key not in self.table and default is not _REQUIRED:
             return default
-        return self._float(key, key, self.table[key], sign, allow_inf=False)
+        return self._float(key, self.table[key], sign, allow_inf=False)
 
     def vector(self, key, n, sign=None, allow_inf=False):
         """An array of ``n`` numbers as a float ndarray."""
         value = self.table[key]
         if not isinstance(value, list) or len(value) != n:
             raise self.error(key, f"must be an array of {n} numbers, got {_describe(value)}")
-        return np.array([self._float(key, f"{key}[{i}]", v, sign, allow_inf)
-                         for i, v in enumerate(value)])
+        return np.array([self._float(key, v, sign, allow_inf, (i,)) for i, v in enumerate(value)])
 
     def matrix(self, key, form):
         """A 3x3 nested array of finite numbers as a float ndarray; ``form`` names what is expected."""
@@ -185,8 +184,8 @@ class _Table:
         if not (isinstance(value, list) and len(value) == 3
                 and all(isinstance(row, list) and len(row) == 3 for row in value)):
             raise self.error(key, f"must be {form}, got {_describe(value)}")
-        return np.array([[self._float(key, f"{key}[{i}][{j}]", v, None, allow_inf=False)
-                          for j, v in enumerate(row)] for i, row in enumerate(value)])
+        return np.array([[self._float(key, v, None, False, (i, j)) for j, v in enumerate(row)]
+                         for i, row in enumerate(value)])
 
     def point_names(self, key, points, count=None):
         """A tuple of known point names: exactly ``count`` of them, or one or more."""
@@ -215,15 +214,22 @@ class _Table:
             raise self.error(key, f"must be an array of tables [[{key}]], got {_describe(value)}")
         return value
 
-    def _float(self, key, label, value, sign, allow_inf):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise self.error(key, f"{label} must be a number, got {_describe(value)}")
-        value = float(value)
-        if math.isnan(value) or (math.isinf(value) and not allow_inf):
-            raise self.error(key, f"{label} must be finite, got {value}")
-        if sign == "> 0" and not value > 0 or sign == ">= 0" and not value >= 0:
-            raise self.error(key, f"{label} must be {sign}, got {value:g}")
+    def _float(self, key, value, sign, allow_inf, index=()):
+        """``value`` of ``key`` as a float, checked; ``index`` places it in an array (messages)."""
+        if type(value) is not float:
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise self.error(key, f"{_label(key, index)} must be a number, got {_describe(value)}")
+            value = float(value)
+        if not math.isfinite(value) and (math.isnan(value) or not allow_inf):
+            raise self.error(key, f"{_label(key, index)} must be finite, got {value}")
+        if sign is not None and (sign == "> 0" and not value > 0 or sign == ">= 0" and not value >= 0):
+            raise self.error(key, f"{_label(key, index)} must be {sign}, got {value:g}")
         return value
+
+
+def _label(key, index):
+    """``key`` with the array indices ``index``, as messages name a number: ``k[2]``."""
+    return key + "".join(f"[{i}]" for i in index)
 
 
 def _validate(data, file):

@@ -372,17 +372,39 @@ def _check_spring(t, points, tol):
     """Fields of a Spring."""
     t.check_keys(("name", "ends", "k"), ("axes", "c", "release"))
     name = t.string("name", nonempty=True)
-    ends, a, b = _check_ends(t, points)
-    gap = norm3(b - a)
-    if gap > tol:
-        raise t.error("ends", f"points {ends[0]!r} and {ends[1]!r} do not coincide "
-                              f"(distance {gap:g} m); a spring has no length")
+    ends = _check_ends(t, points)[0]
+    check_coinciding(t, ends, points, tol)
     release = _check_release(t)
     k = _check_joint_stiffness(t, release)
     axes = _check_rotation(t, "axes") if "axes" in t else np.eye(3)
     c = t.vector("c", 6, ">= 0") if "c" in t else None
     return {"name": name, "ends": ends, "k": k, "axes": axes, "c": c,
             "release": release if release.any() else None}
+
+
+def check_coinciding(t, ends, points, tol) -> None:
+    """Raise unless a spring's two ends coincide (a spring has no length).
+
+    Parameters
+    ----------
+    t : _Table
+        The spring's table (names the file and the spring in the message).
+    ends : tuple of str
+        Its two end point names.
+    points : dict of str to numpy.ndarray
+        Point name -> (3,) position, m.
+    tol : float
+        Distance within which points coincide, m (:func:`_length_tol`).
+
+    Raises
+    ------
+    ModelError
+        About key ``ends``, with the distance.
+    """
+    gap = norm3(points[ends[1]] - points[ends[0]])
+    if gap > tol:
+        raise t.error("ends", f"points {ends[0]!r} and {ends[1]!r} do not coincide "
+                              f"(distance {gap:g} m); a spring has no length")
 
 
 def _check_release(t):

@@ -161,6 +161,12 @@ class Model:
         """All elements: rigid bodies, then beams, then springs, each in file order."""
         return self.rigids + self.beams + self.springs
 
+    @cached_property
+    def _length_tol(self) -> float:
+        """Distance within which two of its points coincide, m (found once: every edit
+        of the model compares its own with the edited model's)."""
+        return _length_tol(self.points)
+
     def element(self, name: str):
         """The element called ``name``.
 
@@ -292,9 +298,10 @@ def with_numbers(model: Model, points: dict, records: dict, damping) -> Model:
         the moved points, the changed records, the beams on a moved point (or
         all of them where the model's size, and so its length tolerance,
         changed), that the ends of a spring whose record did not change still
-        coincide where one moved (or the tolerance changed), the damping and the
-        total mass. Names, ports, ends, boundary and connectivity cannot change,
-        so are not checked again.
+        coincide where one of them moved (or the tolerance shrank: they
+        coincided within the model's), the damping and the total mass. Names,
+        ports, ends, boundary and connectivity cannot change, so are not checked
+        again.
     """
     file = model_file(model)
     moved = {name for name, position in points.items() if position is not model.points[name]}
@@ -302,20 +309,20 @@ def with_numbers(model: Model, points: dict, records: dict, damping) -> Model:
     for name in point_table.table:
         point_table.vector(name, 3)
     tol = _length_tol(points)
-    resized = tol != _length_tol(model.points)
     edited = {attribute: tuple(records.get(r.name, r) for r in getattr(model, attribute))
               for attribute in _RECORD_KINDS}
     frames = []
     for attribute, (kind, _) in _RECORD_KINDS.items():
         for index, record in enumerate(edited[attribute]):
-            placed = kind != "rigid" and (resized or not moved.isdisjoint(record.ends))
-            if record.name in records or (placed and kind == "beam"):
+            on_moved = kind != "rigid" and not moved.isdisjoint(record.ends)
+            if record.name in records or (kind == "beam" and (on_moved or tol != model._length_tol)):
                 table = _element_table(file, kind, index, _plain(_record_table(record, file)))
                 fields = ELEMENT_CHECKS[kind](table, points, tol)
                 if kind == "beam":
                     frames.append((table, record, fields))
-            elif placed:  # a spring's other checks read neither points nor tolerance
-                check_coinciding(_element_table(file, kind, index, {"name": record.name}), record.ends, points, tol)
+            elif kind == "spring" and (on_moved or tol < model._length_tol):
+                # a spring's other checks read neither points nor tolerance
+                check_coinciding(_Table(file, {}, f"spring {record.name!r}"), record.ends, points, tol)
     if damping is not None and damping != model.damping:
         _check_damping(_Table(file, _plain(dict(zip(("alpha", "beta"), damping))), "[damping]"))
     check_mass(file, [r.mass for r in edited["rigids"]], [b.rho * b.A * b.length for b in edited["beams"]])
@@ -326,8 +333,8 @@ def with_numbers(model: Model, points: dict, records: dict, damping) -> Model:
         object.__setattr__(new, name, getattr(model, name))
     for name, value in dict(edited, damping=damping).items():
         object.__setattr__(new, name, value)
-    # the records and boundary not edited are the model's own, frozen already
-    object.__setattr__(new, "points", _frozen_table(points))
+    # the records, points and boundary not edited are the model's own, frozen already
+    object.__setattr__(new, "points", FrozenDict(points | {name: _read_only(points[name]) for name in moved}))
     for record in records.values():
         _freeze_record(record)
     return new

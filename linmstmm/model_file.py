@@ -39,6 +39,7 @@ import tomllib
 import numpy as np
 
 from linmstmm.connected import unreached
+from linmstmm.geometry import cross3, length_tolerance, norm3
 
 #: Names of the six displacement components, in state-vector order.
 COMPONENTS = ("x", "y", "z", "rx", "ry", "rz")
@@ -64,10 +65,6 @@ class ModelError(ValueError):
         super().__init__(": ".join(parts + [message]))
 
 
-#: Spring ends coincide / a beam has length: relative to the model's size ...
-_REL_TOL = 1e-9
-#: ... with this absolute floor, m.
-_ABS_TOL = 1e-12
 #: Spring axes: max |R R^T - I|; inertia: max asymmetry relative to max |I_ij|.
 _ORTHO_TOL = 1e-9
 #: Inertia eigenvalues must be >= -_PSD_TOL * max |I_ij|.
@@ -214,8 +211,7 @@ class _Table:
             raise self.error(key, f"must be an array of tables [[{key}]], got {_describe(value)}")
         return value
 
-    def _float(self, key, value, sign, allow_inf, index=()):
-        """``value`` of ``key`` as a float, checked; ``index`` places it in an array (messages)."""
+    def _float(self, key, value, sign, allow_inf, index=()):  # index: its place in an array
         if type(value) is not float:
             if isinstance(value, bool) or not isinstance(value, (int, float)):
                 raise self.error(key, f"{_label(key, index)} must be a number, got {_describe(value)}")
@@ -241,7 +237,7 @@ def _validate(data, file):
     description = top.string("description", default="")
     points_table = top.section("points")
     points = {p: points_table.vector(p, 3) for p in points_table.table}
-    tol = _length_tol(points)
+    tol = length_tolerance(points)
 
     elements = {"rigid": [], "beam": [], "spring": []}
     owners = {}
@@ -298,15 +294,6 @@ def _check_connected(file, elements, labels):
                          key="ports" if labels[name].startswith("rigid") else "ends")
 
 
-def _length_tol(points):
-    """Distance below which two points coincide: relative to the model's size, with a floor."""
-    if not points:
-        return _ABS_TOL
-    coords = np.array(list(points.values()))
-    size = norm3(coords.max(axis=0) - coords.min(axis=0))
-    return max(_REL_TOL * size, _ABS_TOL)
-
-
 def _element_table(file, kind, index, table):
     """The element's table, labelled "kind 'name'" (or "kind #n" while the name is unusable)."""
     name = table.get("name")
@@ -349,9 +336,8 @@ def _check_inertia(t):
 
 
 def _check_principal_moments(t, tensor, moments):
-    """``tensor`` if its principal moments ``moments`` (its eigenvalues, ascending) keep
-    I3 <= I1 + I2 (every real body does: equality for a flat plate); the tolerance is
-    relative to the trace."""
+    """``tensor`` if its principal moments (``moments``, ascending) keep I3 <= I1 + I2 (every
+    real body does: equality for a flat plate); the tolerance is relative to the trace."""
     low, middle, high = moments
     if high - (low + middle) > _TRIANGLE_TOL * (low + middle + high):
         raise t.error("inertia", f"principal moments {low:g}, {middle:g}, {high:g} kg m^2 break "
@@ -373,7 +359,7 @@ def _check_spring(t, points, tol):
     t.check_keys(("name", "ends", "k"), ("axes", "c", "release"))
     name = t.string("name", nonempty=True)
     ends = _check_ends(t, points)[0]
-    check_coinciding(t, ends, points, tol)
+    _check_gap(t, ends, points, tol)
     release = _check_release(t)
     k = _check_joint_stiffness(t, release)
     axes = _check_rotation(t, "axes") if "axes" in t else np.eye(3)
@@ -382,25 +368,8 @@ def _check_spring(t, points, tol):
             "release": release if release.any() else None}
 
 
-def check_coinciding(t, ends, points, tol) -> None:
-    """Raise unless a spring's two ends coincide (a spring has no length).
-
-    Parameters
-    ----------
-    t : _Table
-        The spring's table (names the file and the spring in the message).
-    ends : tuple of str
-        Its two end point names.
-    points : dict of str to numpy.ndarray
-        Point name -> (3,) position, m.
-    tol : float
-        Distance within which points coincide, m (:func:`_length_tol`).
-
-    Raises
-    ------
-    ModelError
-        About key ``ends``, with the distance.
-    """
+def _check_gap(t, ends, points, tol):
+    """ModelError unless a spring's ends (two point names) coincide within ``tol``, m."""
     gap = norm3(points[ends[1]] - points[ends[0]])
     if gap > tol:
         raise t.error("ends", f"points {ends[0]!r} and {ends[1]!r} do not coincide "
@@ -483,56 +452,14 @@ def _beam_axes(t, x):
         given = t.vector("y_axis", 3)
         size = norm3(given)
         y = given - (given @ x) * x
-        size_y = norm3(y)
-        if size == 0 or size_y <= _PARALLEL_TOL * size:
+        if size == 0 or norm3(y) <= _PARALLEL_TOL * size:
             raise t.error("y_axis", f"{given.tolist()} is zero or parallel to the beam axis")
     else:
         y = cross3(_E_Z, x)
-        size_y = norm3(y)
-        if size_y <= _PARALLEL_TOL:
+        if norm3(y) <= _PARALLEL_TOL:
             y = _E_Y - (_E_Y @ x) * x
-            size_y = norm3(y)
-    y = y / size_y
+    y = y / norm3(y)
     return np.array([x, y, cross3(x, y)])
-
-
-def norm3(vector: np.ndarray) -> float:
-    """Euclidean length of a vector: numpy.linalg.norm's own arithmetic, without its overhead.
-
-    Parameters
-    ----------
-    vector : numpy.ndarray, shape (3,)
-        The vector (any unit).
-
-    Returns
-    -------
-    float
-        Its length, same unit. For float64 sqrt(vector · vector): the dot product
-        numpy.linalg.norm forms (``vector.dot(vector)``) and a correctly rounded
-        square root, so the same bits; any other dtype through numpy.linalg.norm.
-    """
-    if vector.dtype != np.float64:
-        return float(np.linalg.norm(vector))
-    return math.sqrt(vector.dot(vector))
-
-
-def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product of two vectors: numpy.cross's arithmetic in Python floats, without its overhead.
-
-    Parameters
-    ----------
-    a, b : numpy.ndarray of float, shape (3,)
-        The vectors, one of them float64 at least (numpy.cross then works in float64 too).
-
-    Returns
-    -------
-    numpy.ndarray of float64, shape (3,)
-        a × b, each component a product minus a product, each operation rounded
-        once, as numpy.cross forms them: the same bits.
-    """
-    a0, a1, a2 = a.tolist()
-    b0, b1, b2 = b.tolist()
-    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
 def _check_boundary(t, points):

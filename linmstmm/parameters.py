@@ -29,7 +29,7 @@ import re
 import numpy as np
 
 from linmstmm.model import Model, ModelError, model_file, with_numbers
-from linmstmm.model_file import cross3, norm3
+from linmstmm.geometry import cross3, norm3
 
 #: Element section of a key -> the Model attribute holding its records.
 SECTIONS = {"rigid": "rigids", "spring": "springs", "beam": "beams"}

@@ -1,11 +1,11 @@
-"""The model checks' 3-vector arithmetic in Python floats (linmstmm.model_file.cross3 and
-norm3) gives numpy.cross's and numpy.linalg.norm's bits, on vectors whose components span
+"""The 3-vector arithmetic of a model's checks and edits (linmstmm.geometry: cross3, norm3)
+gives numpy.cross's and numpy.linalg.norm's bits, on vectors whose components span
 the whole float64 range: subnormals, signed zeros, overflow to inf, and every sign."""
 from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.model_file import cross3, norm3
+from linmstmm.geometry import cross3, norm3
 
 
 def _vectors(rng, count: int) -> np.ndarray:

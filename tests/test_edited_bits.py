@@ -23,6 +23,7 @@ from linmstmm.model import Beam, ModelError, Rigid, Spring, load_model
 from linmstmm.parameters import get_value, parameter_keys, parse_key, with_values
 from linmstmm.scenes import bundle_beside, salvo, scene_values
 from random_models import KINDS, random_model, to_toml
+from test_model import edit
 from test_sweep import dump_toml
 
 MODELS = Path(__file__).resolve().parents[1] / "models"
@@ -178,46 +179,16 @@ def test_every_launcher_scene_is_its_edited_file_bit_for_bit(fired, tmp_path):
         assert _check(model, document, edits, tmp_path) == "ok", tube
 
 
-SPRING_APART = """
-name = "a spring apart within the length tolerance"
-[points]
-p0 = [0.0, 0.0, 0.0]
-p1 = [10.0, 0.0, 0.0]
-p2 = [10.0, 0.0, 5e-9]
-[[beam]]
-name = "b"
-ends = ["p0", "p1"]
-E = 2.0e11
-G = 8.0e10
-rho = 7800.0
-A = 1e-3
-Iy = 1e-6
-Iz = 1e-6
-J = 2e-6
-[[spring]]
-name = "s"
-ends = ["p1", "p2"]
-k = [1e6, 1e6, 1e6, 1e4, 1e4, 1e4]
-[[rigid]]
-name = "m"
-ports = ["p2"]
-mass = 5.0
-com = [10.0, 0.0, 0.0]
-inertia = [1.0, 1.0, 1.0]
-[boundary]
-p0 = "fixed"
-"""
-
-
-@pytest.mark.parametrize("x, outcome", [(9.99999, "refused"), (-10.0, "ok"), (5.0, "ok")])
+@pytest.mark.parametrize("x, outcome", [(1.0, "refused"), (-2.0, "ok"), (0.1, "ok")])
 def test_a_spring_none_of_whose_ends_moved_is_refused_once_the_model_shrinks(x, outcome, tmp_path):
-    """The spring's ends, 5e-9 m apart, coincide within the tolerance of a 10 m model
-    (1e-8 m), not within that of a 1e-5 m one: moving the beam's other end, not the
-    spring's, changes the verdict."""
+    """The spring's ends, 2e-9 m apart, coincide within the tolerance of the 2.24 m model
+    (2.24e-9 m), not within that of a 1.41 m one: moving the far end of a beam, not an
+    end of the spring, changes the verdict."""
+    text = edit(("hinge = [2.0, 0.0, 0.0]", "hinge = [2.0, 0.0, 2e-9]"))
     path = tmp_path / "apart.toml"
-    path.write_text(SPRING_APART)
-    model, document = load_model(path), tomllib.loads(SPRING_APART)
-    assert _check(model, document, {"points.p0[0]": x}, tmp_path) == outcome
+    path.write_text(text)
+    model, document = load_model(path), tomllib.loads(text)
+    assert _check(model, document, {"points.root[0]": x}, tmp_path) == outcome
     if outcome == "refused":
-        with pytest.raises(ModelError, match="spring 's': key 'ends': points 'p1' and 'p2' do not coincide"):
-            with_values(model, {parse_key(model, "points.p0[0]"): x})
+        with pytest.raises(ModelError, match="spring 'k1': key 'ends': points 'tip' and 'hinge' do not coincide"):
+            with_values(model, {parse_key(model, "points.root[0]"): x})

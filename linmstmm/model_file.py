@@ -39,6 +39,7 @@ import tomllib
 import numpy as np
 
 from linmstmm.connected import unreached
+from linmstmm.geometry import cross3, length_tolerance, norm3
 
 #: Names of the six displacement components, in state-vector order.
 COMPONENTS = ("x", "y", "z", "rx", "ry", "rz")
@@ -64,10 +65,6 @@ class ModelError(ValueError):
         super().__init__(": ".join(parts + [message]))
 
 
-#: Spring ends coincide / a beam has length: relative to the model's size ...
-_REL_TOL = 1e-9
-#: ... with this absolute floor, m.
-_ABS_TOL = 1e-12
 #: Spring axes: max |R R^T - I|; inertia: max asymmetry relative to max |I_ij|.
 _ORTHO_TOL = 1e-9
 #: Inertia eigenvalues must be >= -_PSD_TOL * max |I_ij|.
@@ -169,15 +166,14 @@ class _Table:
         """A finite number as float (``default`` if absent and not required)."""
         if key not in self.table and default is not _REQUIRED:
             return default
-        return self._float(key, key, self.table[key], sign, allow_inf=False)
+        return self._float(key, self.table[key], sign, allow_inf=False)
 
     def vector(self, key, n, sign=None, allow_inf=False):
         """An array of ``n`` numbers as a float ndarray."""
         value = self.table[key]
         if not isinstance(value, list) or len(value) != n:
             raise self.error(key, f"must be an array of {n} numbers, got {_describe(value)}")
-        return np.array([self._float(key, f"{key}[{i}]", v, sign, allow_inf)
-                         for i, v in enumerate(value)])
+        return np.array([self._float(key, v, sign, allow_inf, (i,)) for i, v in enumerate(value)])
 
     def matrix(self, key, form):
         """A 3x3 nested array of finite numbers as a float ndarray; ``form`` names what is expected."""
@@ -185,8 +181,8 @@ class _Table:
         if not (isinstance(value, list) and len(value) == 3
                 and all(isinstance(row, list) and len(row) == 3 for row in value)):
             raise self.error(key, f"must be {form}, got {_describe(value)}")
-        return np.array([[self._float(key, f"{key}[{i}][{j}]", v, None, allow_inf=False)
-                          for j, v in enumerate(row)] for i, row in enumerate(value)])
+        return np.array([[self._float(key, v, None, False, (i, j)) for j, v in enumerate(row)]
+                         for i, row in enumerate(value)])
 
     def point_names(self, key, points, count=None):
         """A tuple of known point names: exactly ``count`` of them, or one or more."""
@@ -215,15 +211,21 @@ class _Table:
             raise self.error(key, f"must be an array of tables [[{key}]], got {_describe(value)}")
         return value
 
-    def _float(self, key, label, value, sign, allow_inf):
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise self.error(key, f"{label} must be a number, got {_describe(value)}")
-        value = float(value)
-        if math.isnan(value) or (math.isinf(value) and not allow_inf):
-            raise self.error(key, f"{label} must be finite, got {value}")
-        if sign == "> 0" and not value > 0 or sign == ">= 0" and not value >= 0:
-            raise self.error(key, f"{label} must be {sign}, got {value:g}")
+    def _float(self, key, value, sign, allow_inf, index=()):  # index: its place in an array
+        if type(value) is not float:
+            if isinstance(value, bool) or not isinstance(value, (int, float)):
+                raise self.error(key, f"{_label(key, index)} must be a number, got {_describe(value)}")
+            value = float(value)
+        if not math.isfinite(value) and (math.isnan(value) or not allow_inf):
+            raise self.error(key, f"{_label(key, index)} must be finite, got {value}")
+        if sign is not None and (sign == "> 0" and not value > 0 or sign == ">= 0" and not value >= 0):
+            raise self.error(key, f"{_label(key, index)} must be {sign}, got {value:g}")
         return value
+
+
+def _label(key, index):
+    """``key`` with the array indices ``index``, as messages name a number: ``k[2]``."""
+    return key + "".join(f"[{i}]" for i in index)
 
 
 def _validate(data, file):
@@ -235,7 +237,7 @@ def _validate(data, file):
     description = top.string("description", default="")
     points_table = top.section("points")
     points = {p: points_table.vector(p, 3) for p in points_table.table}
-    tol = _length_tol(points)
+    tol = length_tolerance(points)
 
     elements = {"rigid": [], "beam": [], "spring": []}
     owners = {}
@@ -292,15 +294,6 @@ def _check_connected(file, elements, labels):
                          key="ports" if labels[name].startswith("rigid") else "ends")
 
 
-def _length_tol(points):
-    """Distance below which two points coincide: relative to the model's size, with a floor."""
-    if not points:
-        return _ABS_TOL
-    coords = np.array(list(points.values()))
-    size = np.linalg.norm(coords.max(axis=0) - coords.min(axis=0))
-    return max(_REL_TOL * size, _ABS_TOL)
-
-
 def _element_table(file, kind, index, table):
     """The element's table, labelled "kind 'name'" (or "kind #n" while the name is unusable)."""
     name = table.get("name")
@@ -325,7 +318,8 @@ def _check_inertia(t):
     whose principal moments are those of a real body."""
     value = t.table["inertia"]
     if isinstance(value, list) and len(value) == 3 and not any(isinstance(v, list) for v in value):
-        return _check_principal_moments(t, np.diag(t.vector("inertia", 3, ">= 0")))
+        tensor = np.diag(t.vector("inertia", 3, ">= 0"))
+        return _check_principal_moments(t, tensor, np.linalg.eigvalsh(tensor))
     tensor = t.matrix("inertia", "[Ixx, Iyy, Izz] or a 3x3 array of arrays")
     scale = np.abs(tensor).max()
     asymmetry = np.abs(tensor - tensor.T)
@@ -334,17 +328,17 @@ def _check_inertia(t):
         raise t.error("inertia", f"tensor is not symmetric: inertia[{i}][{j}] = {tensor[i, j]:g} "
                                  f"but inertia[{j}][{i}] = {tensor[j, i]:g}")
     tensor = (tensor + tensor.T) / 2
-    lowest = np.linalg.eigvalsh(tensor)[0]
-    if lowest < -_PSD_TOL * scale:
+    moments = np.linalg.eigvalsh(tensor)
+    if moments[0] < -_PSD_TOL * scale:
         raise t.error("inertia", f"tensor is not positive semidefinite "
-                                 f"(smallest eigenvalue {lowest:g})")
-    return _check_principal_moments(t, tensor)
+                                 f"(smallest eigenvalue {moments[0]:g})")
+    return _check_principal_moments(t, tensor, moments)
 
 
-def _check_principal_moments(t, tensor):
-    """``tensor`` if its principal moments I1 <= I2 <= I3 keep I3 <= I1 + I2 (every
+def _check_principal_moments(t, tensor, moments):
+    """``tensor`` if its principal moments (``moments``, ascending) keep I3 <= I1 + I2 (every
     real body does: equality for a flat plate); the tolerance is relative to the trace."""
-    low, middle, high = np.linalg.eigvalsh(tensor)
+    low, middle, high = moments
     if high - (low + middle) > _TRIANGLE_TOL * (low + middle + high):
         raise t.error("inertia", f"principal moments {low:g}, {middle:g}, {high:g} kg m^2 break "
                                  f"the triangle inequality ({high:g} > {low:g} + {middle:g}): "
@@ -364,17 +358,22 @@ def _check_spring(t, points, tol):
     """Fields of a Spring."""
     t.check_keys(("name", "ends", "k"), ("axes", "c", "release"))
     name = t.string("name", nonempty=True)
-    ends, a, b = _check_ends(t, points)
-    gap = np.linalg.norm(b - a)
-    if gap > tol:
-        raise t.error("ends", f"points {ends[0]!r} and {ends[1]!r} do not coincide "
-                              f"(distance {gap:g} m); a spring has no length")
+    ends = _check_ends(t, points)[0]
+    _check_gap(t, ends, points, tol)
     release = _check_release(t)
     k = _check_joint_stiffness(t, release)
     axes = _check_rotation(t, "axes") if "axes" in t else np.eye(3)
     c = t.vector("c", 6, ">= 0") if "c" in t else None
     return {"name": name, "ends": ends, "k": k, "axes": axes, "c": c,
             "release": release if release.any() else None}
+
+
+def _check_gap(t, ends, points, tol):
+    """ModelError unless a spring's ends (two point names) coincide within ``tol``, m."""
+    gap = norm3(points[ends[1]] - points[ends[0]])
+    if gap > tol:
+        raise t.error("ends", f"points {ends[0]!r} and {ends[1]!r} do not coincide "
+                              f"(distance {gap:g} m); a spring has no length")
 
 
 def _check_release(t):
@@ -432,7 +431,8 @@ def _check_beam(t, points, tol):
                  ("Ip", "y_axis", "axial", "torsion"))
     name = t.string("name", nonempty=True)
     ends, a, b = _check_ends(t, points)
-    length = float(np.linalg.norm(b - a))
+    along = b - a
+    length = norm3(along)
     if length <= tol:
         raise t.error("ends", f"zero length: points {ends[0]!r} and {ends[1]!r} coincide")
     fields = {"name": name, "ends": ends, "length": length}
@@ -440,7 +440,7 @@ def _check_beam(t, points, tol):
     fields["rho"] = t.number("rho", ">= 0")
     fields.update({key: t.number(key, "> 0") for key in ("A", "Iy", "Iz", "J")})
     fields["Ip"] = t.number("Ip", "> 0", default=fields["Iy"] + fields["Iz"])
-    fields["axes"] = _beam_axes(t, (b - a) / length)
+    fields["axes"] = _beam_axes(t, along / length)
     fields["axial"] = t.boolean("axial", True)
     fields["torsion"] = t.boolean("torsion", True)
     return fields
@@ -450,16 +450,16 @@ def _beam_axes(t, x):
     """Rows local x, y, z: y from ``y_axis`` projected normal to x, else e_Z × x (e_Y if x ∥ e_Z)."""
     if "y_axis" in t:
         given = t.vector("y_axis", 3)
-        size = np.linalg.norm(given)
+        size = norm3(given)
         y = given - (given @ x) * x
-        if size == 0 or np.linalg.norm(y) <= _PARALLEL_TOL * size:
+        if size == 0 or norm3(y) <= _PARALLEL_TOL * size:
             raise t.error("y_axis", f"{given.tolist()} is zero or parallel to the beam axis")
     else:
-        y = np.cross(_E_Z, x)
-        if np.linalg.norm(y) <= _PARALLEL_TOL:
+        y = cross3(_E_Z, x)
+        if norm3(y) <= _PARALLEL_TOL:
             y = _E_Y - (_E_Y @ x) * x
-    y = y / np.linalg.norm(y)
-    return np.array([x, y, np.cross(x, y)])
+    y = y / norm3(y)
+    return np.array([x, y, cross3(x, y)])
 
 
 def _check_boundary(t, points):

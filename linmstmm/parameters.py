@@ -29,6 +29,7 @@ import re
 import numpy as np
 
 from linmstmm.model import Model, ModelError, model_file, with_numbers
+from linmstmm.geometry import cross3, norm3
 
 #: Element section of a key -> the Model attribute holding its records.
 SECTIONS = {"rigid": "rigids", "spring": "springs", "beam": "beams"}
@@ -292,12 +293,14 @@ def _beam_on(beam, points):
     """``beam`` with the length and axes its (moved) end points give; local y is the old
     local y made normal to the new axis (as the loader treats a file's ``y_axis``)."""
     a, b = (np.asarray(points[p], float) for p in beam.ends)
-    length = float(np.linalg.norm(b - a))
-    x = (b - a) / length if 0 < length < np.inf else beam.axes[0]
+    along = b - a
+    length = norm3(along)
+    x = along / length if 0 < length < np.inf else beam.axes[0]
     y = beam.axes[1] - (beam.axes[1] @ x) * x
-    if not np.linalg.norm(y) > _PARALLEL:  # the model's own check names the breach
+    size_y = norm3(y)
+    if not size_y > _PARALLEL:  # the model's own check names the breach
         return dataclasses.replace(beam, length=length)
-    y = y / np.linalg.norm(y)
-    axes = np.array([x, y, np.cross(x, y)])
+    y = y / size_y
+    axes = np.array([x, y, cross3(x, y)])
     axes.flags.writeable = False
     return dataclasses.replace(beam, length=length, axes=axes)

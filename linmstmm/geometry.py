@@ -1,0 +1,79 @@
+"""The geometry a model's checks and edits read: the distance within which two of its
+points coincide, and the length and cross product of 3-vectors.
+
+Lengths and cross products are formed in numpy's own arithmetic, operation for
+operation, so every result is the one numpy gives bit for bit
+(tests/test_vector_arithmetic.py checks it over the whole float64 range),
+without numpy's per-call overhead: a model's checks and edits form a few dozen
+of them per model, where numpy.linalg.norm and numpy.cross cost microseconds
+each in argument handling.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+#: Spring ends coincide / a beam has length: relative to the model's size ...
+_REL_TOL = 1e-9
+#: ... with this absolute floor, m.
+_ABS_TOL = 1e-12
+
+
+def length_tolerance(points: dict) -> float:
+    """Distance below which two points of a model coincide.
+
+    Parameters
+    ----------
+    points : dict of str to numpy.ndarray
+        Point name -> (3,) position, m.
+
+    Returns
+    -------
+    float
+        m: 1e-9 of the diagonal of the points' bounding box, at least 1e-12.
+    """
+    if not points:
+        return _ABS_TOL
+    coords = np.array(list(points.values()))
+    size = norm3(coords.max(axis=0) - coords.min(axis=0))
+    return max(_REL_TOL * size, _ABS_TOL)
+
+
+def norm3(vector: np.ndarray) -> float:
+    """Euclidean length of a vector, as numpy.linalg.norm finds it.
+
+    Parameters
+    ----------
+    vector : numpy.ndarray, shape (3,)
+        The vector (any unit).
+
+    Returns
+    -------
+    float
+        Its length, same unit: for float64 sqrt(vector · vector) from the dot
+        product numpy.linalg.norm forms (``vector.dot(vector)``) and a correctly
+        rounded square root; any other dtype through numpy.linalg.norm itself.
+    """
+    if vector.dtype != np.float64:
+        return float(np.linalg.norm(vector))
+    return math.sqrt(vector.dot(vector))
+
+
+def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of two vectors, as numpy.cross forms it.
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray of float, shape (3,)
+        The vectors, one of them float64 at least (numpy.cross then works in float64).
+
+    Returns
+    -------
+    numpy.ndarray of float64, shape (3,)
+        a × b: per component a product minus a product, each operation rounded
+        once, as numpy.cross computes them (here in Python floats).
+    """
+    a0, a1, a2 = a.tolist()
+    b0, b1, b2 = b.tolist()
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])

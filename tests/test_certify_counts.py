@@ -42,6 +42,28 @@ def test_a_root_is_certified_to_the_finders_rtol_and_no_closer():
     assert default.last_step[off] == 1e-6
 
 
+def test_a_pair_each_on_the_end_of_the_others_count_is_decided_by_a_narrower_count():
+    """At rtol 1e-4 a pair 1.05e-4 apart (relative): the count across each at ±rtol has
+    the other within a tenth of its width of an end, where it says nothing (the second
+    launcher's pair at 5109 rad/s, which the argument principle then had to decide, 124
+    evaluations). A count at half the gap, narrower than rtol and so certifying more,
+    decides for each: both roots stand, and a value between them that is no root does not."""
+    pair = [5109.38, 5109.38 * (1 + 1.05e-4)]
+    finder = KnownSpectrum([1000.0, *pair, 9000.0], rtol=1e-4)
+    assert certify._on_an_end(sorted(pair), pair[0], 1e-4)
+    assert certify.stiffness_other_zeros(finder, [1000.0, *pair, 9000.0], None, 9500.0) == 0
+    assert not finder.last_step
+    between = 5109.38 * (1 + 0.5e-4)
+    assert certify.stiffness_other_zeros(finder, [1000.0, pair[0], between, 9000.0], None, 9500.0) != 0
+
+
+def test_a_narrower_count_is_not_offered_to_a_root_known_less_closely():
+    """A root whose last step is 1e-4 (float64 could not certify it to rtol 1e-6) is
+    counted no narrower than four times that step, whatever its neighbours."""
+    assert certify._clear_of_neighbours([10.0, 10.0 * (1 + 4e-4)], 10.0, [4e-4], 4e-4) == [4e-4]
+    assert certify._clear_of_neighbours([10.0, 10.0 * (1 + 4e-4)], 10.0, [4e-4], 0.0) == pytest.approx([2e-4, 4e-4])
+
+
 def test_a_missing_member_of_a_double_root_is_seen_and_added():
     finder = KnownSpectrum([10.0, 20.0, 20.0, 30.0])
     known = [10.0, 20.0, 30.0]

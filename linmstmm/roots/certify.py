@@ -214,7 +214,8 @@ def _counted_widths(finder, ordered: list[float], roots: list[float]) -> tuple[d
     each width's counts for all the roots are made together
     (:meth:`~linmstmm.wittrick_williams.ModeCounter.prefetch`, shared among the cores)."""
     counter, near = finder.counter, near_widths(finder.rtol)
-    pending = [(root, _widths(finder, root, near)) for root in roots]
+    pending = [(root, _clear_of_neighbours(ordered, root, _widths(finder, root, near), _least_width(finder, root)))
+               for root in roots]
     first, held, level = {}, {}, 0
     prefetch = getattr(counter, "prefetch", None)
     while pending:
@@ -235,6 +236,22 @@ def _counted_widths(finder, ordered: list[float], roots: list[float]) -> tuple[d
                 unheld.append((root, widths))
         pending, level = unheld, level + 1
     return first, held
+
+
+def _clear_of_neighbours(ordered: list[float], root: float, widths: list[float], least: float) -> list[float]:
+    """``widths`` (relative, narrowest first, as :func:`_widths` gives them) and, before
+    them, half the relative gap from ``root`` to the nearest other of the known roots
+    ``ordered`` (rad/s, ascending) where that root sits on an end of the narrowest
+    count (:func:`_on_an_end`: that count then says nothing, and without a narrower
+    one no count decides). A narrower count certifies more, not less; it is not
+    offered below ``least`` (:func:`_least_width`: a root known less closely; the second
+    launcher's pair 1.1e-4 apart at rtol 1e-4: each on the end of the other's ±rtol
+    count, so that the argument principle decided, for 124 evaluations)."""
+    if not _on_an_end(ordered, root, widths[0]):
+        return widths
+    below, above = bisect_left(ordered, root) - 1, bisect_right(ordered, root)
+    gap = min(abs(ordered[k] - root) for k in (below, above) if 0 <= k < len(ordered)) / root
+    return [0.5 * gap, *widths] if least <= 0.5 * gap < widths[0] else widths
 
 
 def _on_an_end(ordered: list[float], root: float, width: float) -> bool:
@@ -321,9 +338,16 @@ def _counts_near(finder, root: float):
 def _widths(finder, root: float, near: list[float] | None = None) -> list[float]:
     """The relative half-widths :func:`_counts_near` counts across ``root`` at, narrowest
     first: of ``near`` (:func:`near_widths` of the finder's rtol where None)."""
-    step = finder.last_step.get(root, 0.0)
-    least = 4 * step if step > finder.rtol else 0.0   # a certified root is held to the narrowest
+    least = _least_width(finder, root)
     return [w for w in (near_widths(finder.rtol) if near is None else near) if w >= least] or [least]
+
+
+def _least_width(finder, root: float) -> float:
+    """The narrowest relative half-width a count across ``root`` may have: four times
+    its last step where float64 could not certify it (above the finder's rtol), else 0
+    (a certified root is held to the narrowest)."""
+    step = finder.last_step.get(root, 0.0)
+    return 4 * step if step > finder.rtol else 0.0
 
 
 def near_widths(rtol: float) -> list[float]:

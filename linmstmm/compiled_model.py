@@ -26,16 +26,12 @@ from linmstmm.counting import count_in_disc
 from linmstmm.deduction import Deduction
 from linmstmm.determinant import determinant, kernels_loaded, resolved_engine
 from linmstmm.model import Model
-from linmstmm.model_structure import forget_structures
+from linmstmm.model_structure import MODELS_KEPT, forget_structures
 from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
 from linmstmm.rigid_motion import rigid_body_mode_count
 from linmstmm.roots.settings import FLOOR_RATIO
 from linmstmm.topology import build_topology
 from linmstmm.wittrick_williams import ModeCounter, mode_counter
-
-#: Model objects whose compiled systems are kept (least recently used dropped first).
-MODELS_KEPT = 8
-
 
 @dataclass(frozen=True, eq=False)
 class CompiledSystem:

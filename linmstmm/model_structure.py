@@ -16,7 +16,8 @@ import numpy as np
 
 from linmstmm.model import Model
 
-#: Model objects whose structure is kept (:func:`structure_of`), least recently used dropped first.
+#: Model objects whose structure is kept (:func:`structure_of`), and what is kept by the structures of
+#: as many (compiled systems, rigid parts, eliminations), least recently used dropped first.
 MODELS_KEPT = 8
 
 

@@ -26,7 +26,7 @@ import numpy as np
 import scipy.linalg as la
 
 from linmstmm.model import Model
-from linmstmm.model_structure import KeptByStructure
+from linmstmm.model_structure import MODELS_KEPT, KeptByStructure
 
 #: A boundary row of the geometry matrix is independent of the others above
 #: this fraction of the largest singular value (entries are direction cosines
@@ -200,7 +200,7 @@ def _parts_that_may_move(model: Model) -> tuple[np.ndarray, list[np.ndarray]]:
 
 
 #: :func:`_parts_that_may_move` of the last structures seen (a parameter study's models share one).
-_free_parts = KeptByStructure(8)
+_free_parts = KeptByStructure(MODELS_KEPT)
 
 
 def _part_motions(model: Model, part: list, segment_of: dict) -> np.ndarray | None:

@@ -8,7 +8,7 @@ the test oracle (tests/test_wittrick_williams.py compares them):
   :meth:`linmstmm.wittrick_williams.ModeCounter.matrices` (at one ω): J₀(ω) and the reduced
   exact dynamic stiffness D(ω) with the scale of its terms;
 * :func:`block_inertia` — :func:`linmstmm.wittrick_williams._block_inertia`;
-* :func:`count` — :meth:`linmstmm.wittrick_williams.ModeCounter._numpy`: the
+* :func:`count` — :meth:`linmstmm.wittrick_williams.ModeCounter._numpy_at`: the
   whole count J(ω) in one call (J₀, D(ω), its equilibration, and LDLᵀ
   factorisations by LAPACK's ``dsytrf`` of it shifted up and down), compiled
   ``nogil``, so that counts at several frequencies can run on threads side by
@@ -23,6 +23,9 @@ the test oracle (tests/test_wittrick_williams.py compares them):
   frequency at a time: :func:`ordered_count` at each of many frequencies, and
   :func:`count` where it refuses, in one call (the dispatch of fifteen
   arguments per frequency was 2.5 of the 10 µs a count took on the launcher).
+
+* :func:`touched_rows` — each beam's rows of T as
+  :func:`linmstmm.wittrick_williams._beam_maps` picks them in numpy.
 
 The plan of that factorisation is made by :mod:`linmstmm._ordering_kernels`.
 """

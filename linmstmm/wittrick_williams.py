@@ -184,8 +184,9 @@ class ModeCounter:
 
     def prefetch(self, omegas) -> None:
         """Count now at each of ``omegas`` (rad/s) not counted yet, for :meth:`__call__`
-        to answer from: with the compiled engine shared among the cores
-        (:func:`linmstmm.spread.spread`; each piece with buffers of its own), with
+        to answer from: with the compiled engine in one kernel call, shared among the
+        cores from COUNT_BATCH frequencies up (:func:`linmstmm.spread.spread`; each
+        piece with buffers of its own), with
         numpy D(ω) formed for NUMPY_BATCH of them at a time; the same answers as one
         by one.
 
@@ -225,8 +226,7 @@ class ModeCounter:
         """Buffers the compiled kernel writes into: D(ω) and |D|(ω) ((n_dof + 1)², a row
         for padding) and dsytrf's workspace for the dense count, and the sparse
         count's own (:func:`linmstmm._stiffness_kernels.ordered_count`)."""
-        from linmstmm import _stiffness_kernels as kernels
-
+        kernels = _stiffness_kernels()
         size, slots = self.n_dof + 1, self._plan[1].shape[1]
         return (np.empty((size, size)), np.empty((size, size)), np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN),
                 (np.empty(slots), np.empty(2 * slots), np.empty(slots), np.empty(self.n_dof)))
@@ -286,8 +286,9 @@ def sparse_plan(static: np.ndarray, mass: np.ndarray, maps: np.ndarray, columns:
     terms : (4, slots) float64
         ``static`` and ``mass`` at the slots in the lower triangle, then in the upper.
     """
-    from linmstmm import _stiffness_kernels as kernels  # numba: imported where a count is compiled
     from linmstmm._ordering_kernels import slot_terms
+
+    kernels = _stiffness_kernels()
 
     pattern = (static != 0) | (mass != 0)
     # where a beam's map.T @ local @ map may be nonzero: any other entry is a sum of zeros
@@ -354,9 +355,7 @@ def _beam_maps(parts, engine: str) -> tuple[np.ndarray, np.ndarray]:
     T, n = parts.T, parts.T.shape[1]
     dofs, to_local = (part[:, 0] for part in parts.beam_maps)           # (n_beams, 12), (n_beams, 12, 12)
     if engine == "compiled":
-        from linmstmm import _stiffness_kernels as kernels  # numba: imported where a count is compiled
-
-        columns, picked = kernels.touched_rows(T.indptr, T.indices, T.data, dofs, n)
+        columns, picked = _stiffness_kernels().touched_rows(T.indptr, T.indices, T.data, dofs, n)
         present = columns < n
     else:
         rows = dense_rows(T, dofs)                                       # (n_beams, 12, n_dof)

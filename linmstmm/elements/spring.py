@@ -94,7 +94,7 @@ def damped_spring_transfer(k, c, axes, rate, release=None) -> np.ndarray:
         compliance = 1.0 / (np.asarray(k, dtype=float) + rate * np.asarray(c, dtype=float))  # (n, 6)
     if release is not None:
         compliance[:, np.asarray(release, bool)] = 0.0
-    stack = np.broadcast_to(np.eye(12, dtype=complex), (rate.shape[0], 12, 12)).copy()
+    stack = identities((rate.shape[0],), 12, dtype=complex)
     stack[:, U, Q] = -np.einsum("ji,nj,jk->nik", axes, compliance[:, :3], axes)
     stack[:, R, M] = -np.einsum("ji,nj,jk->nik", axes, compliance[:, 3:], axes)
     return stack

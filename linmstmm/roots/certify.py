@@ -5,6 +5,7 @@ out), and the recovery of those a count says are missing."""
 from __future__ import annotations
 
 from bisect import bisect_left, bisect_right
+from collections import Counter
 
 import numpy as np
 
@@ -214,8 +215,8 @@ def _counted_widths(finder, ordered: list[float], roots: list[float]) -> tuple[d
     each width's counts for all the roots are made together
     (:meth:`~linmstmm.wittrick_williams.ModeCounter.prefetch`, shared among the cores)."""
     counter, near = finder.counter, near_widths(finder.rtol)
-    pending = [(root, _clear_of_neighbours(ordered, root, _widths(finder, root, near), _least_width(finder, root)))
-               for root in roots]
+    pending = [(root, _clear_of_neighbours(ordered, root, _widths(finder, root, near, least), least))
+               for root, least in ((root, _least_width(finder, root)) for root in roots)]
     first, held, level = {}, {}, 0
     prefetch = getattr(counter, "prefetch", None)
     while pending:
@@ -335,10 +336,11 @@ def _counts_near(finder, root: float):
         yield (None if below is None or above is None else above - below), width
 
 
-def _widths(finder, root: float, near: list[float] | None = None) -> list[float]:
+def _widths(finder, root: float, near: list[float] | None = None, least: float | None = None) -> list[float]:
     """The relative half-widths :func:`_counts_near` counts across ``root`` at, narrowest
-    first: of ``near`` (:func:`near_widths` of the finder's rtol where None)."""
-    least = _least_width(finder, root)
+    first: of ``near`` (:func:`near_widths` of the finder's rtol where None), none
+    below ``least`` (:func:`_least_width` where None)."""
+    least = _least_width(finder, root) if least is None else least
     return [w for w in (near_widths(finder.rtol) if near is None else near) if w >= least] or [least]
 
 
@@ -369,9 +371,9 @@ def placed_by_counts(finder, found: list[float]) -> list[float]:
     takes six counts (0.2 ms) so."""
     if finder.counter is None:
         return found
-    placed = list(found)
-    for root in sorted(set(found)):
-        if finder.last_step.get(root, 0.0) > finder.rtol and found.count(root) == 1:
+    placed, tally = list(found), Counter(found)
+    for root in sorted(tally):
+        if finder.last_step.get(root, 0.0) > finder.rtol and tally[root] == 1:
             bisected = _bisected(finder, root, finder.last_step[root])
             if bisected is not None:
                 value, step = bisected

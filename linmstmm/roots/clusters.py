@@ -191,15 +191,15 @@ def separated(finder, roots: list[float]) -> list[float]:
         tight[i] = count
     separated = list(roots)
     for r, radius, count in zip(multiple, radii, tight):
-        m = finder._counted.get(r, roots.count(r))  # (``roots`` may end inside a multiple root)
-        if count == m or (r == distinct[-1] and count > roots.count(r)):
+        m = finder._counted.get(r, tally[r])  # (``roots`` may end inside a multiple root)
+        if count == m or (r == distinct[-1] and count > tally[r]):
             continue
         try:
             members = finder._isolate(r - radius, r + radius, m, [r])
         except RuntimeError:
             finder.unseparated[r] = (m, radius)
             continue
-        separated = [x for x in separated if x != r] + members[:roots.count(r)]
+        separated = [x for x in separated if x != r] + members[:tally[r]]
     return sorted(separated)
 
 

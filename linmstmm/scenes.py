@@ -372,7 +372,7 @@ def scene_study(base, count: int = 6, tubes=range(1, 19), fired=None, bundle: Bu
     ----------
     base : Model or path
         The launcher model or its file; read and validated once, each scene
-        only moves the tube and rebuilds the cradle (:func:`scene_values`).
+        only moves the tube and rebuilds the cradle (:meth:`SceneMaker.values`).
     count : int
         Elastic frequencies per scene.
     tubes : iterable of int

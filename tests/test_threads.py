@@ -40,3 +40,23 @@ def test_the_decorated_solve_runs_on_one_thread_and_restores_on_error():
             pass
         assert seen and all(threads == 1 for threads in seen)
         assert blas_threads() == before
+
+
+def test_the_fe_route_solves_on_one_thread(monkeypatch):
+    """fe_frequencies (the ``fe`` command's route) sets BLAS to one thread for its
+    eigensolves as the transfer-matrix solve does: OpenBLAS's second thread made the
+    launcher's ten lowest 16 times slower on a busy two-core machine."""
+    import linmstmm.fe.frequencies as frequencies
+    from linmstmm.builders import spring_chain
+
+    seen = []
+    solve = frequencies.fe_modes
+
+    def watched(*args, **kwargs):
+        seen.extend(blas_threads())
+        return solve(*args, **kwargs)
+
+    monkeypatch.setattr(frequencies, "fe_modes", watched)
+    with threadpool_limits(limits=2, user_api="blas"):
+        frequencies.fe_frequencies(spring_chain(4), 2)
+    assert seen and all(threads == 1 for threads in seen)

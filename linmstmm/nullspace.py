@@ -26,8 +26,8 @@ def equilibration(matrix: np.ndarray, sweeps: int = 4, start=None):
     with ``rows[..., :, None] * matrix * cols[..., None, :]`` balanced.
     Keeps the null space (up to column scaling) and makes singular values
     comparable across the mixed units of Ū_all (m, rad, N, N m).
-    start : (rows (N,), cols (M,)) to balance from, default ones (then the
-    scales are powers of two, exact). The balance reached depends on where it
+    start : (rows (N,), cols (M,)) to balance from, positive, default ones (then
+    the scales are powers of two, exact). The balance reached depends on where it
     starts: from Ū_all in the model's own units (:func:`own_units_start`) it is
     the same whatever units the model is written in.
     """
@@ -38,13 +38,20 @@ def equilibration(matrix: np.ndarray, sweeps: int = 4, start=None):
         rows, cols = rows * start[0], cols * start[1]
     weighted = rows[..., :, None] * size  # the rows' part of the scaled |a|, formed once per change of rows
     scaled = np.empty_like(weighted)
+    peaks = None  # each column's largest weighted |a|, found once per change of rows
     for _ in range(sweeps):
         row_factors = power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-1))
-        rows *= row_factors
-        weighted = rows[..., :, None] * size
-        column_factors = power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-2))
+        rows_kept = bool((row_factors == 1.0).all())
+        if not rows_kept:
+            rows *= row_factors
+            np.multiply(rows[..., :, None], size, out=weighted)
+        if peaks is None or not rows_kept:
+            peaks = weighted.max(axis=-2)
+        # a column's largest scaled |a| is its largest weighted |a| times its scale: rounding a
+        # product with the same positive factor keeps the order, so the same number, bit for bit
+        column_factors = power_of_two_scale(peaks * cols)
         cols *= column_factors
-        if np.all(row_factors == 1.0) and np.all(column_factors == 1.0):
+        if rows_kept and (column_factors == 1.0).all():
             break  # a sweep that changed nothing: so would every one after it (Ū_all of a launcher's probe: the second)
     return rows, cols
 

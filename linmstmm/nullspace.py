@@ -144,14 +144,14 @@ def characteristic_frequencies(topology) -> list[float]:
     records = [element.record for element in topology.elements if element.record is not None]
     mass = sum(record.mass for record in records if record.kind in ("rigid", "beam"))
     beams = [record for record in records if record.kind == "beam" and record.rho > 0]
-    springs = [np.sqrt(k / mass) for k in _softest_finite([record.k[:3] for record in records
-                                                         if record.kind == "spring"]) if mass > 0]
+    springs = [math.sqrt(k / mass) for k in _softest_finite([record.k[:3] for record in records
+                                                           if record.kind == "spring"]) if mass > 0]
     span = sum(beam.length for beam in beams)
     candidates = []
     for length in ([beam.length for beam in beams], [span] * len(beams)):
-        scales = springs + [np.sqrt(beam.E * min(beam.Iy, beam.Iz) / (beam.rho * beam.A)) / L ** 2
+        scales = springs + [math.sqrt(beam.E * min(beam.Iy, beam.Iz) / (beam.rho * beam.A)) / L ** 2
                             for beam, L in zip(beams, length)]
-        scales += [np.sqrt(beam.G * beam.J / (beam.rho * beam.Ip)) / L
+        scales += [math.sqrt(beam.G * beam.J / (beam.rho * beam.Ip)) / L
                    for beam, L in zip(beams, length) if beam.torsion and beam.Ip > 0]
         candidates.append(float(min(scales or _torsion_scales(topology, records, mass) or [1.0])))
     return list(dict.fromkeys(candidates))
@@ -165,7 +165,7 @@ def _torsion_scales(topology, records, mass) -> list[float]:
     size = extent(topology)
     if not (mass > 0 and size > 0):
         return []
-    return [np.sqrt(k / (mass * size ** 2))
+    return [math.sqrt(k / (mass * size ** 2))
             for k in _softest_finite([record.k[3:] for record in records if record.kind == "spring"])]
 
 

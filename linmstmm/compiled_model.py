@@ -28,7 +28,7 @@ from linmstmm.determinant import determinant, kernels_loaded, resolved_engine
 from linmstmm.model import Model
 from linmstmm.model_structure import MODELS_KEPT, forget_structures
 from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
-from linmstmm.rigid_motion import rigid_body_mode_count
+from linmstmm.rigid_motion import held_still, rigid_body_mode_count
 from linmstmm.roots.settings import FLOOR_RATIO
 from linmstmm.topology import build_topology
 from linmstmm.wittrick_williams import ModeCounter, mode_counter
@@ -107,7 +107,7 @@ def _compiled_now(model: Model, root: str | None, cut_at: tuple, engine: str) ->
     released = release_indeterminate(deduction, screen=evaluator.plain_matrix, scales=scales)
     if released:  # the program carries the unknowns it was compiled for
         evaluator = determinant(deduction, engine)
-    rigid = rigid_body_mode_count(model)
+    rigid = 0 if held_still(deduction) else rigid_body_mode_count(model)
     scale = min(scales)
     confirmed = bool(rigid) and count_in_disc(evaluator.log_det, FLOOR_RATIO * scale) == 2 * rigid
     return CompiledSystem(deduction, evaluator, released, rigid, confirmed, scale, mode_counter(model, engine))

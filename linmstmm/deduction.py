@@ -31,6 +31,8 @@ point loads of a forced carry enter as jumps of the state
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
@@ -39,10 +41,10 @@ from linmstmm.elements.rigid import force_extraction, position_incidence, rigid_
 from linmstmm.elements.spring import joint_force, joint_jump, spring_constant_transfer
 from linmstmm.godunov import PortState, _Orthonormaliser, _row_kinds
 from linmstmm.load_jumps import _Loads
-from linmstmm.model import COMPONENTS
 from linmstmm.numeric import constant_times, frequencies, is_mp, numbers, zeros_like_stack
 from linmstmm.periodic import carry_run, find_runs
 from linmstmm.topology import Topology
+from linmstmm.unknowns import boundary_state_rows, column_labels
 
 #: Largest βL of one beam piece in the stable evaluation: the piece's own
 #: closed form is exact to rounding, and growth e^4 ≈ 55 between
@@ -80,36 +82,35 @@ class Deduction:
         self._runs = None
         self._tips: dict[tuple, tuple] = {}  # link -> (columns, selection (12, k)), less released ones
         self._layouts: dict[tuple, tuple] = {}  # see _combined
-        self._boundary_columns = {}
+        self._boundary_columns = {b: np.arange(6 * b, 6 * b + 6) for b in range(len(topology.boundaries))}
         self._cut_columns = {}
-        labels, state_rows = [], []  # state_rows: the state vector's row each unknown stands in
-        names = ["X", "Y", "Z", "Θx", "Θy", "Θz", "Mx", "My", "Mz", "Qx", "Qy", "Qz"]
-        for b, boundary in enumerate(topology.boundaries):
-            self._boundary_columns[b] = np.arange(len(labels), len(labels) + 6)
-            state_rows += [FORCE_INDEX[c] if boundary.fixed[c] else c for c in range(6)]
-            labels += [f"{boundary.label}.{names[row]}" for row in state_rows[-6:]]
-        for c, cut in enumerate(topology.cuts):
-            self._cut_columns[c] = np.arange(len(labels), len(labels) + 12)
-            state_rows += list(range(12))
-            labels += [f"cut {cut.point}.{name}" for name in names]
+        self._boundary_rows = boundary_state_rows(topology.boundaries)
+        state_rows = [row for rows in self._boundary_rows for row in rows]  # the state vector's row of each unknown
+        for c in range(len(topology.cuts)):
+            self._cut_columns[c] = np.arange(len(state_rows), len(state_rows) + 12)
+            state_rows += range(12)
         #: element -> columns of the jumps across its released directions
         self.jump_columns: dict[int, np.ndarray] = {}
         for e, element in enumerate(topology.elements):
             if element.kind == "spring" and element.record.release is not None and element.record.released.size:
                 released = element.record.released
-                self.jump_columns[e] = np.arange(len(labels), len(labels) + released.size)
-                labels += [f"{element.name}.Δ{COMPONENTS[d]}" for d in released]
+                self.jump_columns[e] = np.arange(len(state_rows), len(state_rows) + released.size)
                 state_rows += list(released)  # a jump is a displacement (m) or a rotation (rad)
-        self.columns = labels
         self._column_kinds = np.array(state_rows, dtype=int) // 3
         self._row_kinds = None
-        self.full_order = self.order = len(labels)
+        self.full_order = self.order = len(state_rows)
         self.released_columns = self.released_rows = np.zeros(0, dtype=int)
-        n_geometric = sum(max(len(el.inputs) - 1, 0) for el in topology.elements)
+        n_geometric = sum(len(el.inputs) - 1 for el in topology.elements if el.inputs)
         n_jumps = sum(columns.size for columns in self.jump_columns.values())
         if 12 + 6 * n_geometric + n_jumps != self.full_order:
             raise AssertionError(f"U_all is not square: {12 + 6 * n_geometric + n_jumps} rows, "
                                  f"{self.order} unknowns")
+
+    @functools.cached_property
+    def columns(self) -> list[str]:
+        """A label per unknown before any release, e.g. ``"tyre1.Qz"`` (made on first use:
+        a solve reads none; :func:`~linmstmm.unknowns.column_labels`)."""
+        return column_labels(self.topology, self._boundary_rows, self.jump_columns)
 
     # -- element transfer matrices ------------------------------------------------
     def carried(self, e: int, omega, matrix) -> np.ndarray:

@@ -9,8 +9,12 @@ root is sought (:func:`release_indeterminate`).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import scipy.linalg
+import scipy.linalg.blas
+import scipy.linalg.lapack
 
 from linmstmm.numeric import power_of_two_scale
 from linmstmm.own_units import extent, unit_sizes
@@ -26,8 +30,8 @@ def equilibration(matrix: np.ndarray, sweeps: int = 4, start=None):
     with ``rows[..., :, None] * matrix * cols[..., None, :]`` balanced.
     Keeps the null space (up to column scaling) and makes singular values
     comparable across the mixed units of Ū_all (m, rad, N, N m).
-    start : (rows (N,), cols (M,)) to balance from, default ones (then the
-    scales are powers of two, exact). The balance reached depends on where it
+    start : (rows (N,), cols (M,)) to balance from, positive, default ones (then
+    the scales are powers of two, exact). The balance reached depends on where it
     starts: from Ū_all in the model's own units (:func:`own_units_start`) it is
     the same whatever units the model is written in.
     """
@@ -38,13 +42,20 @@ def equilibration(matrix: np.ndarray, sweeps: int = 4, start=None):
         rows, cols = rows * start[0], cols * start[1]
     weighted = rows[..., :, None] * size  # the rows' part of the scaled |a|, formed once per change of rows
     scaled = np.empty_like(weighted)
+    peaks = None  # each column's largest weighted |a|, found once per change of rows
     for _ in range(sweeps):
         row_factors = power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-1))
-        rows *= row_factors
-        weighted = rows[..., :, None] * size
-        column_factors = power_of_two_scale(np.multiply(weighted, cols[..., None, :], out=scaled).max(axis=-2))
+        rows_kept = bool((row_factors == 1.0).all())
+        if not rows_kept:
+            rows *= row_factors
+            np.multiply(rows[..., :, None], size, out=weighted)
+        if peaks is None or not rows_kept:
+            peaks = weighted.max(axis=-2)
+        # a column's largest scaled |a| is its largest weighted |a| times its scale: rounding a
+        # product with the same positive factor keeps the order, so the same number, bit for bit
+        column_factors = power_of_two_scale(peaks * cols)
         cols *= column_factors
-        if np.all(row_factors == 1.0) and np.all(column_factors == 1.0):
+        if rows_kept and (column_factors == 1.0).all():
             break  # a sweep that changed nothing: so would every one after it (Ū_all of a launcher's probe: the second)
     return rows, cols
 
@@ -93,7 +104,12 @@ def nullity(matrix: np.ndarray, tolerance: float = NULL_TOLERANCE, scales=None) 
     and hide the singularity.
     """
     rows, cols = equilibration(matrix) if scales is None else scales
-    sigma = np.linalg.svd(rows[:, None] * matrix * cols, compute_uv=False)
+    return _small_singular_values(rows[:, None] * matrix * cols, tolerance)
+
+
+def _small_singular_values(balanced: np.ndarray, tolerance: float) -> int:
+    """Number of singular values of ``balanced`` (N, M) below ``tolerance`` × the largest."""
+    sigma = np.linalg.svd(balanced, compute_uv=False)
     return int(np.sum(sigma < tolerance * sigma[0]))
 
 
@@ -128,14 +144,14 @@ def characteristic_frequencies(topology) -> list[float]:
     records = [element.record for element in topology.elements if element.record is not None]
     mass = sum(record.mass for record in records if record.kind in ("rigid", "beam"))
     beams = [record for record in records if record.kind == "beam" and record.rho > 0]
-    springs = [np.sqrt(k / mass) for k in _softest_finite([record.k[:3] for record in records
-                                                         if record.kind == "spring"]) if mass > 0]
+    springs = [math.sqrt(k / mass) for k in _softest_finite([record.k[:3] for record in records
+                                                           if record.kind == "spring"]) if mass > 0]
     span = sum(beam.length for beam in beams)
     candidates = []
     for length in ([beam.length for beam in beams], [span] * len(beams)):
-        scales = springs + [np.sqrt(beam.E * min(beam.Iy, beam.Iz) / (beam.rho * beam.A)) / L ** 2
+        scales = springs + [math.sqrt(beam.E * min(beam.Iy, beam.Iz) / (beam.rho * beam.A)) / L ** 2
                             for beam, L in zip(beams, length)]
-        scales += [np.sqrt(beam.G * beam.J / (beam.rho * beam.Ip)) / L
+        scales += [math.sqrt(beam.G * beam.J / (beam.rho * beam.Ip)) / L
                    for beam, L in zip(beams, length) if beam.torsion and beam.Ip > 0]
         candidates.append(float(min(scales or _torsion_scales(topology, records, mass) or [1.0])))
     return list(dict.fromkeys(candidates))
@@ -149,7 +165,7 @@ def _torsion_scales(topology, records, mass) -> list[float]:
     size = extent(topology)
     if not (mass > 0 and size > 0):
         return []
-    return [np.sqrt(k / (mass * size ** 2))
+    return [math.sqrt(k / (mass * size ** 2))
             for k in _softest_finite([record.k[3:] for record in records if record.kind == "spring"])]
 
 
@@ -202,11 +218,12 @@ def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINAT
     screen : None, or a callable giving Ū_all (n, N, N) as the unknowns stand
     (not orthonormalised) at frequencies (n,) rad/s faster than
     ``deduction.matrix``, the same to rounding: a compiled determinant's
-    :meth:`~linmstmm.determinant.CompiledDeterminant.plain_matrix`. Where its
-    probes are finite and the first is regular by SCREEN_MARGIN times the
-    tolerance, nothing is released without the numpy carry; anything else is
-    decided on ``deduction.matrix`` as without it, so that the unknowns released
-    (chosen among equal weights by rounding) are the same.
+    :meth:`~linmstmm.determinant.CompiledDeterminant.plain_matrix`. It is asked for
+    the first probe alone: where that is finite and regular by SCREEN_MARGIN times
+    the tolerance, nothing is released without the numpy carry; anything else is
+    decided on ``deduction.matrix`` at every probe as without it, so that the
+    unknowns released (chosen among equal weights by rounding) are the same
+    (:func:`_screened_probe` says why the later probes need not be looked at).
     scales : the :func:`characteristic_frequencies` of ``deduction.topology`` (rad/s)
     where the caller has them already; found here otherwise.
     """
@@ -228,7 +245,7 @@ def release_indeterminate(deduction, probe=None, tolerance: float = INDETERMINAT
 def _released_at(deduction, probe: np.ndarray, tolerance: float, screen, start) -> int:
     """:func:`release_indeterminate` at the frequencies ``probe`` (rad/s), balancing from
     ``start`` (:func:`own_units_start`)."""
-    if screen is not None and _clearly_regular(screen(probe), SCREEN_MARGIN * tolerance, start):
+    if screen is not None and _clearly_regular(_screened_probe(screen, probe), SCREEN_MARGIN * tolerance, start):
         return 0
     samples = deduction.matrix(probe)
     rows, cols = equilibration(samples[0], start=start)
@@ -252,15 +269,36 @@ def _released_at(deduction, probe: np.ndarray, tolerance: float, screen, start) 
     return r
 
 
-def _clearly_regular(samples: np.ndarray, threshold: float, start) -> bool:
-    """True where every one of ``samples`` (n, N, N) is finite and the first, balanced
-    from ``start`` (:func:`equilibration`), has no singular value below ``threshold``
-    times its largest (:func:`nullity`; decided by :func:`_well_above` where that can)."""
-    if not np.all(np.isfinite(samples)):
+def _screened_probe(screen, probe: np.ndarray) -> np.ndarray:
+    """Ū_all (N, N) by ``screen`` at the first of ``probe`` (rad/s), the one probe the screen
+    decides on.
+
+    The numpy carry reads its probes first to last and stops at the first with no null
+    space (:func:`_common_nullity`); so where the first is clearly regular
+    (:func:`_clearly_regular`) the later ones can change nothing, as long as they are
+    finite. They entered the screen only so: a later probe that overflows (a non-finite
+    Ū_all) sent the probes to the numpy carry, which took the scale for unreadable and
+    went on to the next. From the first probe to the last (7.25 times its frequency) a
+    beam's waves grow by e^(1.7 βL) and a rigid body's inertia by 53: Ū_all overflows at
+    the last but not at the first only after a run of hundreds of beams (e^260 at the
+    first already), whose growing and decaying waves leave the first probe far from
+    clearly regular, or with entries within a factor 1e4 of overflow at the first
+    (tests: no random model has a clearly regular first probe and a later one that
+    overflows). The first alone costs a third of the three (the launchers: 40 µs a probe).
+    """
+    return screen(probe[:1])[0]
+
+
+def _clearly_regular(sample: np.ndarray, threshold: float, start) -> bool:
+    """True where ``sample`` (N, N) is finite and, balanced from ``start``
+    (:func:`equilibration`), has no singular value below ``threshold`` times its largest
+    (:func:`nullity`; decided by :func:`_well_above` where that can, on the one balanced
+    matrix both read)."""
+    if not np.isfinite(sample).all():
         return False
-    scales = equilibration(samples[0], start=start)
-    return _well_above(scales[0][:, None] * samples[0] * scales[1], threshold) or nullity(
-        samples[0], threshold, scales) == 0
+    rows, cols = equilibration(sample, start=start)
+    balanced = rows[:, None] * sample * cols
+    return _well_above(balanced, threshold) or _small_singular_values(balanced, threshold) == 0
 
 
 #: :func:`_well_above` answers True only where its bound clears the threshold this many
@@ -278,20 +316,20 @@ _EPS = float(np.finfo(float).eps)
 
 
 def _well_above(matrix: np.ndarray, threshold: float) -> bool:
-    """True where the square ``matrix``'s smallest singular value is surely at least
+    """True where the real square ``matrix``'s smallest singular value is surely at least
     ``threshold`` times its largest, decided against BOUND_MARGIN times the threshold
     and σ_max ≤ s = √(‖A‖₁ ‖A‖∞): by the Gram matrix where that is exact enough
     (:func:`_gram_clears`), else by one inverse (a third of an SVD's cost):
     1 / σ_min = ‖A⁻¹‖₂ ≤ √(‖A⁻¹‖₁ ‖A⁻¹‖∞). False says nothing (a matrix that is nearly
     singular, or whose bounds are loose)."""
     size = np.abs(matrix)
-    bound = np.sqrt(size.sum(axis=0).max()) * np.sqrt(size.sum(axis=1).max())  # the product may underflow
-    if not 0 < bound < np.inf:
+    bound = math.sqrt(size.sum(axis=0).max()) * math.sqrt(size.sum(axis=1).max())  # the product may underflow
+    if not 0 < bound < math.inf:
         return False
     margin = BOUND_MARGIN * threshold
     n = matrix.shape[0]
     if margin ** 2 >= GRAM_ROUNDING * (n + 1) ** 2 * _EPS:
-        unit = power_of_two_scale(bound)  # exact: s of ``matrix * unit`` is about 1
+        unit = math.ldexp(1.0, -math.frexp(bound)[1])  # exact: s of ``matrix * unit`` is about 1
         return _gram_clears(matrix * unit, margin * bound * unit)
     try:
         inverse = np.linalg.inv(matrix)
@@ -302,17 +340,14 @@ def _well_above(matrix: np.ndarray, threshold: float) -> bool:
 
 
 def _gram_clears(matrix: np.ndarray, floor: float) -> bool:
-    """True where AᵀA − floor² I of the square ``matrix`` A has a Cholesky factor, that
+    """True where AᵀA − floor² I of the real square ``matrix`` A has a Cholesky factor, that
     is where σ_min(A) ≥ ``floor`` (to the rounding GRAM_ROUNDING leaves out): a product
     and a Cholesky factorisation, a quarter of an inverse's cost (on the launcher 20 µs
-    against 85)."""
-    gram = matrix.T @ matrix
-    gram.flat[::gram.shape[0] + 1] -= floor ** 2
-    try:
-        np.linalg.cholesky(gram)
-    except np.linalg.LinAlgError:
-        return False
-    return True
+    against 85), by scipy's BLAS syrk and LAPACK potrf (a model's first potrf: 22 µs,
+    numpy's cholesky 42)."""
+    gram = scipy.linalg.blas.dsyrk(1.0, matrix, trans=1)  # the upper triangle, which the factorisation reads
+    np.einsum("ii->i", gram)[:] -= floor ** 2
+    return scipy.linalg.lapack.dpotrf(gram, clean=0, overwrite_a=1)[1] == 0
 
 
 def _common_nullity(samples: np.ndarray, tolerance: float) -> int:

@@ -255,6 +255,29 @@ def _held_motions(model: Model, part: list, index: dict, field: np.ndarray, size
     return np.concatenate(rows) if rows else np.zeros((0, field.shape[2]))
 
 
+def held_still(deduction) -> bool:
+    """True where the deduced model surely has no zero-frequency mode, read off its deduction.
+
+    Without a joint (no jump unknowns: no spring with a released direction) each
+    connected part is one segment; the model's elements are connected (its topology
+    was built, :func:`linmstmm.topology.build_topology`), so where one boundary end is
+    held in all six directions they are one segment held, with no motion, and points
+    that no element uses move no mass: :func:`rigid_body_mode_count` is 0, found
+    without the graph of points (both launchers: 80 µs on a first solve).
+
+    Parameters
+    ----------
+    deduction : linmstmm.deduction.Deduction
+        The model's deduction.
+
+    Returns
+    -------
+    bool
+        False says nothing: count the modes.
+    """
+    return not deduction.jump_columns and any(boundary.fixed.all() for boundary in deduction.topology.boundaries)
+
+
 def rigid_body_mode_count(model: Model) -> int:
     """Number of zero-frequency (rigid-body) modes of ``model``: see the module text."""
     return _motions(model).shape[2]

@@ -143,3 +143,31 @@ def test_a_free_ring_has_six_zero_frequency_shapes_that_are_the_rigid_motions(se
     coefficients = np.linalg.lstsq(basis, motions, rcond=None)[0]
     assert np.linalg.norm(basis @ coefficients - motions) <= 1e-8 * np.linalg.norm(motions)
     assert np.linalg.matrix_rank(coefficients, tol=1e-8 * np.abs(coefficients).max()) == 6
+
+
+def test_a_model_held_still_has_no_rigid_body_mode():
+    """rigid_motion.held_still reads a model with no joint and an end held in all six
+    directions off its deduction, and the solve then skips the count: every model it says
+    so of must have none by the full kinematic count, over random models of every kind
+    (grounded and floating, with and without joints) and the bundled ones, and it must
+    say so of the grounded ones without joints (both launchers among them)."""
+    from builders import BUNDLED_MODELS
+    from random_models import KINDS, random_model
+    from test_joints import with_random_joints
+
+    from linmstmm.deduction import Deduction
+    from linmstmm.model import load_model
+    from linmstmm.rigid_motion import held_still
+    from linmstmm.topology import build_topology
+
+    models = [random_model(kind, seed) for kind in KINDS for seed in range(20)]
+    models += [with_random_joints(random_model(kind, seed), np.random.default_rng(3000 + seed))
+               for kind in KINDS for seed in range(6)]
+    models += [load_model(path) for path in BUNDLED_MODELS]
+    still = []
+    for model in models:
+        if held_still(Deduction(build_topology(model))):
+            assert rigid_body_mode_count(model) == 0, model.name
+            still.append(model.name)
+    assert {"MLRS-style launcher", "Light 4x4 rocket launcher"} <= set(still)
+    assert 20 <= len(still) < len(models)

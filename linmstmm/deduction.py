@@ -95,7 +95,7 @@ class Deduction:
         #: element -> columns of the jumps across its released directions
         self.jump_columns: dict[int, np.ndarray] = {}
         for e, element in enumerate(topology.elements):
-            if element.kind == "spring" and element.record.release is not None and element.record.released.size:
+            if element.kind == "spring" and element.record.released.size:
                 released = element.record.released
                 self.jump_columns[e] = np.arange(len(labels), len(labels) + released.size)
                 labels += [f"{element.name}.Δ{COMPONENTS[d]}" for d in released]

@@ -100,6 +100,14 @@ def test_scenes_sharing_their_sums_are_the_scenes_made_alone(model, bundle):
     assert shared  # some scenes took sums made for others
 
 
+def test_a_scene_lumps_only_the_tubes_its_cradle_sums(model, bundle):
+    """One scene asked of a new SceneMaker lumps the other tubes as that scene has them,
+    loaded or fired, and no more (its values are checked bit for bit above)."""
+    maker = SceneMaker(model, bundle)
+    maker.values(7, {2, 3})
+    assert sorted(maker._lumped) == sorted((slot, slot in {2, 3}) for slot in bundle.slots if slot != 7)
+
+
 def test_smeared_rocket_leaves_steel(model, bundle):
     """The tube beams' density is steel plus the bundle's rocket smeared over them."""
     beams = [model.element(name) for name in ("tube_aft", "tube_fore")]

@@ -771,3 +771,4 @@ def test_released_directions_of_a_spring():
     for indices in (none, pinned):
         with pytest.raises(ValueError):
             indices[...] = 0
+    assert springs[2].released is pinned  # found once per spring

@@ -391,8 +391,11 @@ def scene_study(base, count: int = 6, tubes=range(1, 19), fired=None, bundle: Bu
         Default the ``bundle.toml`` beside the model file.
     warm_start : bool
         Start each scene's root search from the previous scene's frequencies
-        (certified by a root count as a cold search is). Scenes differ only in
-        one tube's position and the cradle's inertia, so the roots move little.
+        (certified by a root count as a cold search is) while the scenes move less
+        than the coarse predictions' error allows (:func:`linmstmm.warm_starts.warm_starts`),
+        else from the scene's predictions: with every other tube loaded the roots
+        move 40 ppm a scene and every scene starts warm; in a salvo, whose scenes
+        move 1-1.4 %, the scenes after the second start from their predictions.
     engine : str
         How det Ū_all is evaluated (default "auto": the compiled kernels if
         this process has loaded them, as ``natural_frequencies`` does).

@@ -92,7 +92,7 @@ class Deduction:
         #: element -> columns of the jumps across its released directions
         self.jump_columns: dict[int, np.ndarray] = {}
         for e, element in enumerate(topology.elements):
-            if element.kind == "spring" and element.record.release is not None and element.record.released.size:
+            if element.kind == "spring" and element.record.released.size:
                 released = element.record.released
                 self.jump_columns[e] = np.arange(len(state_rows), len(state_rows) + released.size)
                 state_rows += list(released)  # a jump is a displacement (m) or a rotation (rad)

@@ -29,6 +29,7 @@ from linmstmm.model_file import (
     _check_gap,
     check_mass,
 )
+from linmstmm.elements.spring import released_directions
 from linmstmm.geometry import length_tolerance
 
 __all__ = ["COMPONENTS", "Beam", "Model", "ModelError", "Rigid", "Spring", "load_model"]
@@ -72,15 +73,7 @@ class Spring:
     c: np.ndarray | None = None
     release: np.ndarray | None = None
     kind: str = field(default="spring", init=False)
-
-    @cached_property
-    def released(self) -> np.ndarray:
-        """Indices (0..5: x, y, z, rx, ry, rz) of the released directions, ascending
-        (read-only; found once per spring: the kinematics of a 10,000-body chain
-        asked 40,000 times)."""
-        indices = np.flatnonzero(np.zeros(6, bool) if self.release is None else self.release)
-        indices.setflags(write=False)
-        return indices
+    released = property(released_directions)
 
 
 @dataclass(frozen=True, eq=False)

@@ -46,7 +46,7 @@ def structure_of(model: Model) -> tuple:
         elif element.kind == "beam":
             elements.append(("beam", element.name, element.ends, bool(element.axial), bool(element.torsion)))
         else:
-            released = b"" if element.release is None else element.released.tobytes()  # the same bytes, not found
+            released = element.released.tobytes()
             elements.append(("spring", element.name, element.ends, released, np.isinf(element.k).tobytes()))
     boundary = tuple((point, np.asarray(fixed, bool).tobytes()) for point, fixed in model.boundary.items())
     return tuple(model.points), tuple(elements), boundary

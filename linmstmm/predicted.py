@@ -156,12 +156,13 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
     stand where counts certify them to a loose rtol (if ``stand``), else by the secant, then the
     pencil, then the segment search around those both left troubled. None where a
     count of that search cannot be made (the full search decides)."""
-    standing, indices = (_counted_predictions(finder, predictions, start, stop) if stand
+    in_cluster = _in_cluster(predictions)  # the same for the counts and the secant
+    standing, indices = (_counted_predictions(finder, predictions, in_cluster, start, stop) if stand
                          else ([], np.arange(start, stop)))
     leaders, followers = _coincident(predictions, indices)
     coincident = {*leaders.tolist(), *followers.tolist()}
     alone = np.array([i for i in indices.tolist() if i not in coincident], dtype=np.int64)
-    found, unsettled = _secant_polished(finder, predictions, alone, list(roots) + standing)
+    found, unsettled = _secant_polished(finder, predictions, in_cluster, alone, list(roots) + standing)
     found, troubled = _pencil_polished(finder, list(roots) + standing + found,
                                        unsettled + [float(p) for p in predictions[leaders]])
     found, troubled = _deflated_polished(finder, found, troubled, predictions)
@@ -198,9 +199,11 @@ def _coincident(predictions: np.ndarray, indices: np.ndarray) -> tuple[np.ndarra
     return indices[leads], indices[follows]
 
 
-def _counted_predictions(finder, predictions: np.ndarray, start: int, stop: int) -> tuple[list[float], np.ndarray]:
+def _counted_predictions(finder, predictions: np.ndarray, in_cluster: list[bool], start: int,
+                         stop: int) -> tuple[list[float], np.ndarray]:
     """(predictions certified as they stand, rad/s; indices of the others, ascending):
-    those of ``predictions[start:stop]`` alone (no other prediction within CLUSTER)
+    those of ``predictions[start:stop]`` alone (no other prediction within CLUSTER:
+    False in ``in_cluster``, :func:`_in_cluster` of ``predictions``)
     across which the Wittrick–Williams counts at ±rtol find one natural frequency (so
     a root lies within rtol of it), where the finder certifies to COUNTED_PREDICTION
     or looser; none otherwise. A prediction taken so has the finder's rtol as its
@@ -218,7 +221,7 @@ def _counted_predictions(finder, predictions: np.ndarray, start: int, stop: int)
     counter = finder.counter
     if counter is None or finder.rtol < COUNTED_PREDICTION or start >= stop:
         return [], np.arange(start, stop)
-    in_cluster, values, width = _in_cluster(predictions), predictions.tolist(), finder.rtol
+    values, width = predictions.tolist(), finder.rtol
     tried = [i for i in range(start, stop) if not in_cluster[i]]
     prefetch = getattr(counter, "prefetch", None)
     if prefetch is not None:
@@ -233,11 +236,11 @@ def _counted_predictions(finder, predictions: np.ndarray, start: int, stop: int)
             np.array([i for i in range(start, stop) if i not in stands], dtype=np.int64))
 
 
-def _secant_polished(finder, predictions: np.ndarray, indices: np.ndarray,
+def _secant_polished(finder, predictions: np.ndarray, in_cluster: list[bool], indices: np.ndarray,
                      known: list[float]) -> tuple[list[float], list[float]]:
     """(roots, unsettled predictions): ``predictions[indices]`` by the secant on det
-    (the others are their neighbours only); one that lands on a ``known`` root (rad/s)
-    is unsettled.
+    (the others are their neighbours only; ``in_cluster``: :func:`_in_cluster` of
+    ``predictions``); one that lands on a ``known`` root (rad/s) is unsettled.
 
     Cluster members too: the launcher's pairs 1e-4 apart at 5.7-21 krad/s are
     predicted to 2e-5, where Newton on the pencil does not converge. A result
@@ -250,7 +253,7 @@ def _secant_polished(finder, predictions: np.ndarray, indices: np.ndarray,
     if not indices.size:  # every prediction stood, or went to the pencil
         return [], []
     found, steps = secant_roots(finder.log_det, predictions[indices], finder.xtol, finder.UNCERTAIN)
-    in_cluster, values, same = _in_cluster(predictions), predictions.tolist(), _same_root(finder)
+    values, same = predictions.tolist(), _same_root(finder)
     roots = found.tolist()
     settled = [not math.isnan(root) and abs(root - values[i]) <= 0.5 * _gap(values, i)
                and step <= (finder.xtol if in_cluster[i] else finder.rtol) and not _known(root, known, same)

@@ -62,7 +62,7 @@ def _point_labels(model: Model) -> tuple[np.ndarray, np.ndarray]:
     edges, joint = [], []
     for element in model.elements:
         ends = element.ports if element.kind == "rigid" else element.ends
-        released = element.kind == "spring" and element.release is not None and element.released.size > 0
+        released = element.kind == "spring" and element.released.size > 0
         for other in ends[1:]:
             edges.append((number[ends[0]], number[other]))
             joint.append(released)

@@ -234,11 +234,12 @@ def scene_values(model: Model, tube: int, rockets_fired=frozenset(),
 
 class SceneMaker:
     """The scenes of one launcher model and bundle: what every scene shares (the tube
-    frame, the loaded and the emptied tube lumped in each slot, the keys) made
-    once, and the cradle's running sums over the slots kept, so that scenes whose
-    slots agree up to some slot add those up once (scene l and scene l + 1 share
-    the sum over slots 1 … l − 1). Every number is formed by the same operations
-    in the same order as for one scene alone: the same bits.
+    frame, the loaded and the emptied tube, the keys) made once, each tube lumped in
+    its slot made when a scene first asks for it (a caller of one scene builds the
+    tubes it sums: 17 of the launcher's 36), and the cradle's running sums over the slots kept, so
+    that scenes whose slots agree up to some slot add those up once (scene l and
+    scene l + 1 share the sum over slots 1 … l − 1). Every number is formed by the
+    same operations in the same order as for one scene alone: the same bits.
 
     Parameters
     ----------
@@ -252,11 +253,9 @@ class SceneMaker:
         self.model, self.bundle = model, bundle
         self.axes = tube_axes(model, bundle)
         loaded, rocket = loaded_tube(model, bundle)
-        emptied = loaded - rocket
-        offsets = {slot: bundle.offset(slot, self.axes) for slot in bundle.slots}
-        #: (slot, fired) -> that tube lumped in its slot
-        self._lumped = {(slot, fired): (emptied if fired else loaded).shifted(offsets[slot])
-                        for slot in bundle.slots for fired in (False, True)}
+        self._tubes = {False: loaded, True: loaded - rocket}  # fired -> the tube in the base slot
+        self._lumped: dict[tuple[int, bool], MassProps] = {}  # (slot, fired) -> :meth:`_lumped_tube`
+        self._offsets: dict[int, np.ndarray] = {}  # slot -> its offset from the base slot, m
         self._sums = {(): bundle.frame(self.axes)}  # slots added so far -> frame + those tubes
         moving = set()
         for element in map(model.element, bundle.tube):
@@ -284,9 +283,18 @@ class SceneMaker:
             if slot != tube:
                 added += ((slot, slot in fired),)
                 if added not in self._sums:
-                    self._sums[added] = total + self._lumped[added[-1]]
+                    self._sums[added] = total + self._lumped_tube(*added[-1])
                 total = self._sums[added]
         return total
+
+    def _lumped_tube(self, slot: int, fired: bool) -> MassProps:
+        """The tube of ``slot`` as a rigid mass there (kg, m, kg m²), loaded or, where
+        ``fired``, without its rocket; made once, when a scene first sums it."""
+        if (slot, fired) not in self._lumped:
+            if slot not in self._offsets:
+                self._offsets[slot] = self.bundle.offset(slot, self.axes)
+            self._lumped[slot, fired] = self._tubes[fired].shifted(self._offsets[slot])
+        return self._lumped[slot, fired]
 
     def values(self, tube: int, rockets_fired=frozenset()) -> dict[str, float]:
         """The scene where tube ``tube`` fires, as edits of the model.
@@ -383,8 +391,11 @@ def scene_study(base, count: int = 6, tubes=range(1, 19), fired=None, bundle: Bu
         Default the ``bundle.toml`` beside the model file.
     warm_start : bool
         Start each scene's root search from the previous scene's frequencies
-        (certified by a root count as a cold search is). Scenes differ only in
-        one tube's position and the cradle's inertia, so the roots move little.
+        (certified by a root count as a cold search is) while the scenes move less
+        than the coarse predictions' error allows (:func:`linmstmm.warm_starts.warm_starts`),
+        else from the scene's predictions: with every other tube loaded the roots
+        move 40 ppm a scene and every scene starts warm; in a salvo, whose scenes
+        move 1-1.4 %, the scenes after the second start from their predictions.
     engine : str
         How det Ū_all is evaluated (default "auto": the compiled kernels if
         this process has loaded them, as ``natural_frequencies`` does).

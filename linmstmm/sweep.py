@@ -15,9 +15,10 @@ Options that trade those bits (the roots agree to rounding) for speed:
 ``engine="compiled"`` evaluates det Ū_all by the compiled kernels in every
 process that runs steps ("auto" is resolved once, in the calling process, so
 every runner uses the same engine); ``warm_start`` starts each step's root
-search from the frequencies of its neighbour in the grid (below), so a step
-waits for its neighbour and the parallelism is that of the grid's tracking
-tree (a single line runs in order).
+search from the frequencies of its neighbour in the grid (below) where they
+are the better starts, else from the step's own coarse predictions
+(:mod:`linmstmm.warm_starts`), so a step waits for its neighbour and the
+parallelism is that of the grid's tracking tree (a single line runs in order).
 
 Tracking (:mod:`linmstmm.tracking`): each step is compared by MAC with its
 neighbour in the grid (the step one before it along the last range that is
@@ -32,7 +33,7 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
 
 import numpy as np
@@ -43,6 +44,7 @@ from linmstmm.parameters import get_value, parse_key, with_values
 from linmstmm.results import Result, decode_array, decode_arrays
 from linmstmm.sweep_runners import run_steps
 from linmstmm.tracking import SAME_MODE_MAC, length_scale, track
+from linmstmm.warm_starts import largest_difference, prediction_error, warm_starts
 
 #: How every step evaluates det Ū_all unless told: the engine ``linmstmm freqs`` uses in a
 #: new process. Not "auto" (which follows what this process has loaded), so that a step
@@ -170,6 +172,12 @@ class StepSolution:
     shapes : (m, p, 6) mass-normalised mode shapes at the model's p points
     (m/√kg, rad/√kg). sensitivities : key -> (m,) ∂f/∂value, Hz per SI unit.
     note : what the solve had to say ("" if nothing).
+    moved : largest relative change of the frequencies from those of the step it
+    started from (nan without one). prediction_error : largest relative error of the
+    coarse predictions (:func:`~linmstmm.coarse_prediction.predict_frequencies`) at
+    the frequencies of the first step of its chain of warm starts (nan where not
+    measured). The next step chooses its starts by both
+    (:func:`~linmstmm.warm_starts.warm_starts`).
     """
 
     frequencies_hz: np.ndarray
@@ -177,10 +185,13 @@ class StepSolution:
     shapes: np.ndarray
     sensitivities: dict = field(default_factory=dict)
     note: str = ""
+    moved: float = math.nan
+    prediction_error: float = math.nan
 
 
 def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGINE,
-               start: StepSolution | None = None, with_shapes: bool = True) -> StepSolution:
+               start: StepSolution | None = None, with_shapes: bool = True,
+               chained: bool = False) -> StepSolution:
     """Frequencies, mode shapes and sensitivities of one step, from one solve.
 
     Parameters
@@ -194,22 +205,38 @@ def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGI
     engine : str
         How det Ū_all is evaluated, as for :func:`~linmstmm.solve.natural_frequencies`.
     start : StepSolution or None
-        A neighbouring step whose frequencies start the root search (None: a cold start).
+        A neighbouring step whose frequencies start the root search where they are
+        the better starts (:func:`~linmstmm.warm_starts.warm_starts`; None: a cold start).
     with_shapes : bool
         False: the frequencies alone (by :func:`~linmstmm.solve.natural_frequencies`,
         the same roots), shapes (m, 0, 6); not with ``sensitivity_keys``.
+    chained : bool
+        The step is one of a sweep with warm starts: the first of its chain (no
+        ``start``) measures the coarse predictions' error at its roots for the steps
+        that follow (:attr:`StepSolution.prediction_error`).
 
     Returns
     -------
     StepSolution
         The frequencies as :func:`~linmstmm.solve.natural_frequencies` with
-        ``engine`` (and ``guess_hz`` the frequencies of ``start``) gives them,
-        the mass-normalised shapes at the points and the sensitivities.
+        ``engine`` (and ``guess_hz`` the frequencies of ``start`` where they are
+        taken) gives them, the mass-normalised shapes at the points and the
+        sensitivities.
     """
+    solution = _solved_step(model, count, sensitivity_keys, engine, warm_starts(start), with_shapes)
+    found = solution.frequencies_hz
+    if start is not None:
+        return replace(solution, moved=largest_difference(start.frequencies_hz, found),
+                       prediction_error=start.prediction_error)
+    return replace(solution, prediction_error=prediction_error(model, count, found)) if chained else solution
+
+
+def _solved_step(model: Model, count: int, sensitivity_keys, engine: str, guess_hz,
+                 with_shapes: bool) -> StepSolution:
+    """:func:`solve_step` from the starts ``guess_hz`` (Hz, or None: cold)."""
     from linmstmm.modes import mode_shapes
     from linmstmm.solve import natural_frequencies
 
-    guess_hz = None if start is None else start.frequencies_hz
     if not with_shapes and not sensitivity_keys:  # the shapes cost a launcher step as much as its roots
         result = natural_frequencies(model, count, engine=engine, guess_hz=guess_hz)
         found = result.frequencies_hz
@@ -353,7 +380,9 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
         the runners all use that engine).
     warm_start : bool
         Start each step's root search from the frequencies of its neighbour
-        (:func:`neighbours`; found, then certified by a count as from a cold start).
+        (:func:`neighbours`; found, then certified by a count as from a cold start),
+        unless the last move seen between neighbours outran the coarse predictions'
+        error (:func:`~linmstmm.warm_starts.warm_starts`: the step then starts from those).
     track_modes : bool
         False: no mode shapes (about half of a launcher step's cost) and no
         tracking: every column follows the rank (``order`` the ranks, ``tracking_mac``
@@ -380,7 +409,7 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
     if sensitivity and not track_modes:
         raise ValueError("sensitivities need the mode shapes: track_modes must be True")
     solve = partial(solve_step, count=count, sensitivity_keys=names if sensitivity else (), engine=engine,
-                    with_shapes=track_modes)
+                    with_shapes=track_modes, chained=warm_start)
     solutions, label = run_steps(models, solve, previous if warm_start else [None] * len(models),
                                  workers, dask, progress)
     if track_modes:

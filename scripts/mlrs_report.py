@@ -652,8 +652,10 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
     add(f"Time of one sweep of 18 scenes, six frequencies each (best of {SWEEP_REPEATS}; the model "
         "and bundle are read once, each scene rebuilds only the tube's points and the cradle). "
         "Warm start: each scene's roots are polished from the previous scene's frequencies and "
-        "confirmed by one root count (`scene_sweep(..., warm_start=True)`, the default); cold: "
-        "the full root search in every scene (`warm_start=False`).")
+        "confirmed by one root count (`scene_sweep(..., warm_start=True)`, the default), while "
+        "the last move seen between scenes is within the square root of the coarse predictions' "
+        "error, else from the scene's own predictions; cold: the search from the predictions in "
+        "every scene (`warm_start=False`).")
     add("")
     add("| sweep | engine | cold (warm_start=False) | warm start | per scene, warm | saving | "
         "largest relative difference warm vs cold |")
@@ -667,7 +669,8 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
     step = np.max(np.abs(np.diff(fired, axis=0) / fired[:-1]))
     add(f"Between neighbouring scenes the frequencies move by at most {1e6 * spread.max():.0f} ppm "
         f"with the other tubes loaded and by up to {100 * step:.1f} % in the salvo, so the "
-        "previous scene's roots are better starting points in the loaded sweep than in the salvo.")
+        "previous scene's roots are better starting points in the loaded sweep than in the salvo, "
+        "where every scene after the second starts from its predictions.")
     add("")
 
     # ---- timing

@@ -57,6 +57,18 @@ def test_a_pair_each_on_the_end_of_the_others_count_is_decided_by_a_narrower_cou
     assert certify.stiffness_other_zeros(finder, [1000.0, pair[0], between, 9000.0], None, 9500.0) != 0
 
 
+def test_multiplicities_of_a_pair_each_on_the_end_of_the_others_count_are_counted_narrower():
+    """The same pair at rtol 1e-4, its upper member listed twice: the counts of the
+    multiplicities take the same narrower width as the certificate, half the gap, and
+    drop the copy there (at ±rtol alone no count decides and the copy stood, for the
+    certificate to catch later at a higher price)."""
+    pair = [5109.38, 5109.38 * (1 + 1.05e-4)]
+    finder = KnownSpectrum([1000.0, *pair, 9000.0], rtol=1e-4)
+    listed = [1000.0, pair[0], pair[1], pair[1], 9000.0]
+    assert certify.counted_multiplicities(finder, listed, None, 9500.0) == [1000.0, *pair, 9000.0]
+    assert not finder.last_step
+
+
 def test_a_narrower_count_is_not_offered_to_a_root_known_less_closely():
     """A root whose last step is 1e-4 (float64 could not certify it to rtol 1e-6) is
     counted no narrower than four times that step, whatever its neighbours."""

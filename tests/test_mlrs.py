@@ -100,6 +100,14 @@ def test_scenes_sharing_their_sums_are_the_scenes_made_alone(model, bundle):
     assert shared  # some scenes took sums made for others
 
 
+def test_a_scene_lumps_only_the_tubes_its_cradle_sums(model, bundle):
+    """One scene asked of a new SceneMaker lumps the other tubes as that scene has them,
+    loaded or fired, and no more (its values are checked bit for bit above)."""
+    maker = SceneMaker(model, bundle)
+    maker.values(7, {2, 3})
+    assert sorted(maker._lumped) == sorted((slot, slot in {2, 3}) for slot in bundle.slots if slot != 7)
+
+
 def test_smeared_rocket_leaves_steel(model, bundle):
     """The tube beams' density is steel plus the bundle's rocket smeared over them."""
     beams = [model.element(name) for name in ("tube_aft", "tube_fore")]
@@ -285,3 +293,33 @@ def test_scenes_through_the_sweep_are_freqs_on_the_edited_files(model, bundle, t
         reference = natural_frequencies(edited, count=6, engine="numpy").frequencies_hz
         np.testing.assert_allclose(row, reference, rtol=1e-10, err_msg=f"tube {tube}")
     assert np.all(serial.tracking_mac[1] > 0.9)  # each column keeps its shape from scene 7 to 12
+
+
+def test_a_salvo_sweep_starts_from_predictions_once_its_scenes_move_farther_than_they_err(model, bundle,
+                                                                                        monkeypatch):
+    """In the salvo the frequencies move 1-1.4 % a scene, the coarse predictions are 1e-6
+    off: the second scene starts from the first's roots (no move seen yet), every later
+    one from its own predictions; with every other tube loaded (moves of 40 ppm) every
+    scene after the first starts from the previous one's roots. Each scene's roots are
+    natural_frequencies' from a cold start, to rounding (1e-10, as warm against cold above)."""
+    import linmstmm.solve
+    from linmstmm.scenes import scene_study
+
+    started = []
+    solve = linmstmm.solve.natural_frequencies
+
+    def recorded(*args, guess_hz=None, **options):
+        started.append(guess_hz is not None)
+        return solve(*args, guess_hz=guess_hz, **options)
+
+    monkeypatch.setattr(linmstmm.solve, "natural_frequencies", recorded)
+    tubes = [3, 4, 5, 6]
+    scene_study(model, count=6, tubes=tubes, bundle=bundle, engine="compiled", track_modes=False)
+    assert started == [False, True, True, True]
+    started.clear()
+    fired = scene_study(model, count=6, tubes=tubes, fired=salvo, bundle=bundle, engine="compiled",
+                        track_modes=False)
+    assert started == [False, True, False, False]
+    for tube, row in zip(tubes, fired.frequencies_hz_by_rank):
+        cold = solve(scene_model(model, tube, salvo(tube), bundle), count=6, engine="compiled").frequencies_hz
+        np.testing.assert_allclose(row, cold, rtol=1e-10, err_msg=f"tube {tube}")

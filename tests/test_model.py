@@ -756,3 +756,19 @@ def test_cli_reports_too_deep_nesting_in_one_line(tmp_path):
     assert done.returncode == 2 and done.stdout == "", done.stderr
     assert done.stderr.splitlines() == [f"linmstmm: error: {path}: invalid TOML: arrays or tables "
                                         f"nested too deeply for the TOML reader"]
+
+
+def test_released_directions_of_a_spring():
+    """The released directions as indices: those of the release, ascending; none for a
+    spring with no release, as for one whose release is all False (the same empty,
+    read-only indices, so that a spring's kind of joint reads alike either way)."""
+    pin = np.array([False, False, False, False, False, True])
+    springs = [Spring("s", ("a", "a"), np.ones(6), np.eye(3), release=release)
+               for release in (None, np.zeros(6, bool), pin, ~pin)]
+    none, unreleased, pinned, all_but = (spring.released for spring in springs)
+    assert none.size == 0 and none.dtype == unreleased.dtype and none.tobytes() == unreleased.tobytes()
+    assert pinned.tolist() == [5] and all_but.tolist() == [0, 1, 2, 3, 4]
+    for indices in (none, pinned):
+        with pytest.raises(ValueError):
+            indices[...] = 0
+    assert springs[2].released is pinned  # found once per spring

@@ -340,3 +340,22 @@ def test_a_column_whose_mode_leaves_the_lowest_count_is_marked(tmp_path):
     header, *lines = (tmp_path / "sweep.csv").read_text().splitlines()
     column = header.split(",").index("mode 4 MAC")
     assert [float(line.split(",")[column]) < 0.5 for line in lines] == [False, False, False, True, False, False]
+
+
+def test_a_step_starts_from_its_neighbour_unless_the_last_move_outran_the_predictions():
+    """A neighbour's roots start the next step while the last move seen between
+    neighbours is within the square root of the coarse predictions' error (half their
+    digits), or either is not known yet; beyond it the step starts cold."""
+    from linmstmm.sweep import StepSolution
+    from linmstmm.warm_starts import warm_starts
+
+    roots = np.array([3.0, 4.0])
+
+    def neighbour(moved, error):
+        return StepSolution(roots, 0, np.zeros((2, 0, 6)), moved=moved, prediction_error=error)
+
+    assert warm_starts(None) is None
+    for moved, error in ((math.nan, 1e-6), (1e-2, math.nan), (math.nan, math.nan), (9e-4, 1e-6)):
+        assert warm_starts(neighbour(moved, error)) is roots
+    assert warm_starts(neighbour(1.1e-3, 1e-6)) is None
+    assert warm_starts(neighbour(1e-2, 1e-3)) is roots and warm_starts(neighbour(4e-2, 1e-3)) is None

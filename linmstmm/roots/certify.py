@@ -215,8 +215,7 @@ def _counted_widths(finder, ordered: list[float], roots: list[float]) -> tuple[d
     each width's counts for all the roots are made together
     (:meth:`~linmstmm.wittrick_williams.ModeCounter.prefetch`, shared among the cores)."""
     counter, near = finder.counter, near_widths(finder.rtol)
-    pending = [(root, _clear_of_neighbours(ordered, root, _widths(finder, root, near, least), least))
-               for root, least in ((root, _least_width(finder, root)) for root in roots)]
+    pending = [(root, _widths(finder, root, ordered, near)) for root in roots]
     first, held, level = {}, {}, 0
     prefetch = getattr(counter, "prefetch", None)
     while pending:
@@ -240,7 +239,7 @@ def _counted_widths(finder, ordered: list[float], roots: list[float]) -> tuple[d
 
 
 def _clear_of_neighbours(ordered: list[float], root: float, widths: list[float], least: float) -> list[float]:
-    """``widths`` (relative, narrowest first, as :func:`_widths` gives them) and, before
+    """``widths`` (relative, narrowest first: the near widths :func:`_widths` keeps) and, before
     them, half the relative gap from ``root`` to the nearest other of the known roots
     ``ordered`` (rad/s, ascending) where that root sits on an end of the narrowest
     count (:func:`_on_an_end`: that count then says nothing, and without a narrower
@@ -291,7 +290,9 @@ def stiffness_count(finder, known: list[float], lo: float | None, hi: float) -> 
 def counted_multiplicities(finder, roots: list[float], lo: float | None, hi: float) -> list[float]:
     """``roots`` (rad/s, repeated per multiplicity) with each distinct one in (lo, hi)
     repeated as often as the Wittrick–Williams count finds natural frequencies
-    within a relative NEAR_WIDTHS of it (:func:`_count_near`): a member of a
+    within the narrowest of its widths that decides (:func:`_count_near`, over the
+    same :func:`_widths` as the certificate's, half the gap to a neighbour on a
+    count's end first): a member of a
     multiple root the pencil did not see is added, a value that is no root
     dropped. Roots where the count cannot decide stay as they are; so do all
     without a counter. A member added at a width above the finder's rtol is known
@@ -320,28 +321,33 @@ def _count_near(finder, root: float, ordered: list[float]) -> tuple[int, float] 
     narrowest width of :func:`_counts_near` where the count decides and no root of
     ``ordered`` (rad/s, ascending) lies on an end (:func:`_on_an_end`); None where
     none does."""
-    return next(((count, width) for count, width in _counts_near(finder, root)
+    return next(((count, width) for count, width in _counts_near(finder, root, ordered)
                  if count is not None and not _on_an_end(ordered, root, width)), None)
 
 
-def _counts_near(finder, root: float):
+def _counts_near(finder, root: float, ordered: list[float]):
     """(natural frequencies within ±width of ``root`` or None where the count cannot
-    decide, width) for each of :func:`near_widths`, narrowest first; for a root float64
-    could not certify (last step above the finder's rtol, :attr:`RootFinder.last_step`:
-    it is refined in mpmath later), none narrower than four times that step, so it
-    is counted where it may lie. A certified root is held to the narrowest (the
-    second launcher's root at 4.90 krad/s, last step 7.3e-10, was 2.5e-9 off)."""
-    for width in _widths(finder, root):
+    decide, width) for each of its :func:`_widths` among the known roots ``ordered``
+    (rad/s, ascending), narrowest first."""
+    for width in _widths(finder, root, ordered):
         below, above = finder.counter(root * (1 - width)), finder.counter(root * (1 + width))
         yield (None if below is None or above is None else above - below), width
 
 
-def _widths(finder, root: float, near: list[float] | None = None, least: float | None = None) -> list[float]:
-    """The relative half-widths :func:`_counts_near` counts across ``root`` at, narrowest
-    first: of ``near`` (:func:`near_widths` of the finder's rtol where None), none
-    below ``least`` (:func:`_least_width` where None)."""
-    least = _least_width(finder, root) if least is None else least
-    return [w for w in (near_widths(finder.rtol) if near is None else near) if w >= least] or [least]
+def _widths(finder, root: float, ordered: list[float], near: list[float] | None = None) -> list[float]:
+    """The relative half-widths of the counts across ``root`` (rad/s), narrowest first,
+    for both the certificate (:func:`_counted_widths`) and the multiplicities
+    (:func:`_count_near`): those of ``near`` (:func:`near_widths` of the finder's rtol
+    where None) no narrower than :func:`_least_width` (for a root float64 could not
+    certify, last step above the finder's rtol, :attr:`RootFinder.last_step`: four
+    times that step, so it is counted where it may lie and refined in mpmath later;
+    a certified root is held to the narrowest: the second launcher's root at
+    4.90 krad/s, last step 7.3e-10, was 2.5e-9 off), and before them half the gap to
+    a neighbour among the known roots ``ordered`` (rad/s, ascending, with repeats)
+    that sits on an end of the narrowest (:func:`_clear_of_neighbours`)."""
+    least = _least_width(finder, root)
+    widths = [w for w in (near_widths(finder.rtol) if near is None else near) if w >= least] or [least]
+    return _clear_of_neighbours(ordered, root, widths, least)
 
 
 def _least_width(finder, root: float) -> float:

@@ -1,0 +1,136 @@
+"""The constraint elimination of a model whose only constraints are fixed components
+of points no rigid body owns: every port follows its body's mass centre, every
+fixed component is dropped, every other DOF is kept as it is.
+
+Where each entry of that elimination T sits, and which number it takes, is fixed
+by the model's structure (its points, bodies, ports and boundary); only the
+numbers, the ports' lever arms, come from where the nodes sit. A
+:class:`PortFollowing` holds the first and puts the second into it: the node
+constraints (:func:`linmstmm.fe.node_constraints.node_constraints`) make T with
+it, and the Wittrick–Williams counter's parts (:mod:`linmstmm.counter_parts`)
+keep one per structure and make the next model's T with it, the same arrays.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from linmstmm.fe.sparse import Compressed, index_type
+from linmstmm.model import Model
+
+
+@dataclass(frozen=True, eq=False)
+class PortFollowing:
+    """Where each possible entry of the elimination T sits and where its number comes from.
+
+    Attributes
+    ----------
+    ports, centres : numpy.ndarray, shape (p,)
+        The node of each rigid body's port and of its body's mass centre (bodies and
+        ports in model order).
+    rows, cols : numpy.ndarray, shape (e,)
+        Row (full DOF) and column (reduced DOF) of each possible entry: rows ascending,
+        within a port's row the columns descending (the order scipy's product of the
+        general elimination stores them in).
+    source : numpy.ndarray, shape (e,)
+        Where each entry's number comes from: 0 a unit entry, 1 + k the k-th entry of
+        the ports' lever-arm blocks (p, 6, 6) flattened (:func:`port_kinematics`).
+    masters : numpy.ndarray, shape (n_dof,)
+        The full DOFs kept as the reduced ones, ascending.
+    shape : tuple
+        (n_full, n_dof).
+    """
+
+    ports: np.ndarray
+    centres: np.ndarray
+    rows: np.ndarray
+    cols: np.ndarray
+    source: np.ndarray
+    masters: np.ndarray
+    shape: tuple
+
+    def T(self, positions: np.ndarray) -> Compressed:
+        """The elimination of a model whose nodes sit at ``positions``.
+
+        Parameters
+        ----------
+        positions : numpy.ndarray, shape (n_nodes, 3)
+            m, the points then the mass centres (:class:`~linmstmm.fe.layout._Layout`).
+
+        Returns
+        -------
+        Compressed
+            (n_full, n_dof) CSR: the arrays scipy's product T0 T1 of the general
+            elimination stores (exact zeros left out, a fixed component's row
+            empty), indices of the type scipy gives them
+            (:func:`~linmstmm.fe.sparse.index_type`).
+        """
+        arms = port_kinematics(positions[self.ports], positions[self.centres]).ravel()
+        values = np.concatenate([np.ones(1), arms])[self.source]
+        stored = values != 0
+        data = values[stored]
+        index = index_type(self.shape[1], len(data))
+        indptr = np.zeros(self.shape[0] + 1, index)
+        np.cumsum(np.bincount(self.rows[stored], minlength=self.shape[0]), out=indptr[1:])
+        return Compressed("csr", indptr, self.cols[stored].astype(index, copy=False), data, self.shape)
+
+
+def port_following(model: Model, layout) -> PortFollowing:
+    """The :class:`PortFollowing` of ``model`` laid out on ``layout`` (its points and
+    mass centres, :func:`~linmstmm.fe.layout._layout` with one element per beam).
+
+    Parameters
+    ----------
+    model : Model
+        A model whose every constraint is a fixed component of a point no body owns
+        (:func:`~linmstmm.fe.node_constraints.held_at_free_points`).
+    layout : linmstmm.fe.layout._Layout
+
+    Returns
+    -------
+    PortFollowing
+    """
+    index, n_full = layout.index, 6 * layout.n_nodes
+    port_nodes = np.array([index.points[port] for body in model.rigids for port in body.ports], int)
+    centre_nodes = np.array([index.rigids[body.name] for body in model.rigids for _ in body.ports], int)
+    ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
+    fixed = np.array([components for components in model.boundary.values()], bool).reshape(-1, 6)
+    dropped = np.zeros(n_full, bool)
+    dropped[ports] = True
+    dropped[(6 * np.array([index.points[point] for point in model.boundary], int).reshape(-1, 1)
+             + np.arange(6))[fixed]] = True
+    masters = np.flatnonzero(~dropped)
+    # each row's possible entries: a master's its unit entry, a port's its body's six
+    # centre columns descending, their numbers the lever-arm block's row reversed
+    possible, cols, source = np.zeros((n_full, 6), bool), np.zeros((n_full, 6), int), np.zeros((n_full, 6), int)
+    possible[masters, 0] = True
+    cols[masters, 0] = np.arange(len(masters))
+    possible[ports] = True
+    cols[ports] = (np.cumsum(~dropped) - 1)[centres][:, None, ::-1]
+    source[ports] = 1 + np.arange(36 * len(port_nodes)).reshape(-1, 6, 6)[:, :, ::-1]
+    rows = np.nonzero(possible)[0]
+    return PortFollowing(port_nodes, centre_nodes, rows, cols[possible], source[possible], masters,
+                         (n_full, len(masters)))
+
+
+def port_kinematics(ports: np.ndarray, centres: np.ndarray) -> np.ndarray:
+    """(p, 6, 6) maps body-centre DOFs -> port DOFs: u_p = u_c + θ × (p − c), θ_p = θ.
+
+    Parameters
+    ----------
+    ports, centres : numpy.ndarray, shape (p, 3)
+        Positions of the ports and of their bodies' mass centres, m.
+
+    Returns
+    -------
+    numpy.ndarray, shape (p, 6, 6)
+        Unit diagonal; the lever arms (m) in the translations' rows, rotation columns.
+    """
+    r = ports - centres
+    block = np.zeros((len(r), 6, 6))
+    block[:, np.arange(6), np.arange(6)] = 1.0
+    # −[r]ₓ, whose zero diagonal stays +0.0 (a −0.0 there would be dropped as any zero is)
+    block[:, [0, 0, 1, 1, 2, 2], [4, 5, 3, 5, 3, 4]] = np.stack([r[:, 2], -r[:, 1], -r[:, 2], r[:, 0],
+                                                                r[:, 1], -r[:, 0]], axis=1)
+    return block

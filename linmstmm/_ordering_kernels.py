@@ -47,7 +47,7 @@ def minimum_degree(pattern):
         live[i, i] = 0
         for j in range(n):
             degree[i] += live[i, j]
-    order = np.empty(n, dtype=np.int64)
+    order, near = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
     for step in range(n):
         k = 0
         for i in range(n):
@@ -55,17 +55,23 @@ def minimum_degree(pattern):
                 k = i
         order[step] = k
         degree[k] = n + 1  # eliminated: above any degree
+        count = 0
         for i in range(n):
-            joined[k, i] = live[k, i]
-        for i in range(n):
-            if joined[k, i]:
-                live[i, k] = 0
-                for j in range(n):
-                    if joined[k, j] and j != i:
-                        live[i, j] = 1
-                degree[i] = 0
-                for j in range(n):
-                    degree[i] += live[i, j]
+            if live[k, i]:
+                joined[k, i] = 1
+                near[count] = i
+                count += 1
+        # each unknown joined to k loses k and gains the others joined to it (the
+        # degrees kept up to date entry by entry: the counts a recount would give)
+        for a in range(count):
+            i = near[a]
+            live[i, k] = 0
+            degree[i] -= 1
+            for b in range(count):
+                j = near[b]
+                if j != i and not live[i, j]:
+                    live[i, j] = 1
+                    degree[i] += 1
     return order, joined
 
 

@@ -57,6 +57,37 @@ def reference_inertia(matrix, order, singular, most_growth):
     return negatives
 
 
+def reference_minimum_degree(pattern):
+    """(order, joined) of minimum-degree elimination in numpy, every degree counted
+    afresh: at each step the unknown joined to the fewest others left (the lowest
+    index among equals) is eliminated, and the others it was joined to are joined."""
+    n = len(pattern)
+    live = pattern & ~np.eye(n, dtype=bool)
+    left = np.ones(n, bool)
+    order, joined = [], np.zeros((n, n), np.int64)
+    for _ in range(n):
+        k = int(np.argmin(np.where(left, live.sum(axis=1), n + 1)))
+        near = np.flatnonzero(live[k])
+        order.append(k)
+        joined[k, near] = 1
+        left[k] = False
+        live[k, :] = live[:, k] = False
+        live[np.ix_(near, near)] = True
+        live[near, near] = False
+    return np.array(order, np.int64), joined
+
+
+def test_minimum_degree_is_the_numpy_derivation():
+    rng = np.random.default_rng(5)
+    patterns = [random_sparse(rng, n, density)[1] for n in (1, 2, 5, 20, 60, 120) for density in (0.02, 0.1, 0.5)]
+    for path in LAUNCHERS:
+        counter = ModeCounter(load_model(path), "compiled")
+        patterns.append((counter._static != 0) | (counter._mass != 0) | np.eye(counter.n_dof, dtype=bool))
+    for pattern in patterns:
+        for ours, theirs in zip(minimum_degree(pattern.astype(np.int64)), reference_minimum_degree(pattern)):
+            assert ours.dtype == np.int64 and np.array_equal(ours, theirs)
+
+
 def reference_plan(pattern):
     """(starts, rows, high, low, updates, targets) of the elimination plan of ``pattern``
     derived in numpy from its minimum-degree order: slots step by step (the diagonal,

@@ -215,10 +215,13 @@ def _add_springs(model, layout, strains, stiffness, constraints):
     owners, components, cols, values = spring_rows(model.springs, layout.index, kept_only=True)
     k = np.array([spring.k for spring in model.springs], float).reshape(-1, 6)[owners, components]
     rigid = np.isinf(k)
+    if not rigid.any():  # every direction a strain, taken as it is
+        strains.add(strains.new_rows(len(k))[:, None], cols, values)
+        stiffness.append(k)
+        return
     strains.add(strains.new_rows(np.count_nonzero(~rigid))[:, None], cols[~rigid], values[~rigid])
     stiffness.append(k[~rigid])
-    if rigid.any():
-        constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None], cols[rigid], values[rigid])
+    constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None], cols[rigid], values[rigid])
 
 
 def _add_rigid_masses(model, layout, mass):

@@ -34,8 +34,9 @@ class PortFollowing:
         within a port's row the columns descending (the order scipy's product of the
         general elimination stores them in).
     source : numpy.ndarray, shape (e,)
-        Where each entry's number comes from: 0 a unit entry, 1 + k the k-th entry of
-        the ports' lever-arm blocks (p, 6, 6) flattened (:func:`port_kinematics`).
+        Where each entry's number comes from in the values :func:`_entry_values`
+        lists: 0 a unit entry, 1 a zero one, 2 + 6 i + j the j-th lever-arm entry of
+        port i (:data:`ARM_SLOTS`).
     masters : numpy.ndarray, shape (n_dof,)
         The full DOFs kept as the reduced ones, ascending.
     shape : tuple
@@ -66,8 +67,7 @@ class PortFollowing:
             empty), indices of the type scipy gives them
             (:func:`~linmstmm.fe.sparse.index_type`).
         """
-        arms = port_kinematics(positions[self.ports], positions[self.centres]).ravel()
-        values = np.concatenate([np.ones(1), arms])[self.source]
+        values = _entry_values(positions[self.ports] - positions[self.centres])[self.source]
         stored = values != 0
         data = values[stored]
         index = index_type(self.shape[1], len(data))
@@ -108,10 +108,27 @@ def port_following(model: Model, layout) -> PortFollowing:
     cols[masters, 0] = np.arange(len(masters))
     possible[ports] = True
     cols[ports] = (np.cumsum(~dropped) - 1)[centres][:, None, ::-1]
-    source[ports] = 1 + np.arange(36 * len(port_nodes)).reshape(-1, 6, 6)[:, :, ::-1]
+    block = np.ones(36, int)                                    # a lever-arm block's entries: 0 off the arms
+    block[np.arange(0, 36, 7)] = 0                                # unit diagonal
+    block[ARM_SLOTS] = 2 + np.arange(len(ARM_SLOTS))
+    arms = np.where(block < 2, block, block + 6 * np.arange(len(port_nodes))[:, None])   # (p, 36)
+    source[ports] = arms.reshape(-1, 6, 6)[:, :, ::-1]
     rows = np.nonzero(possible)[0]
     return PortFollowing(port_nodes, centre_nodes, rows, cols[possible], source[possible], masters,
                          (n_full, len(masters)))
+
+
+#: Where −[r]ₓ puts a port's lever arm r (m) in its 6 × 6 block, flattened
+#: (translation rows, rotation columns), and which component of r, of which sign.
+ARM_SLOTS = np.array([4, 5, 9, 11, 15, 16])
+ARM_AXES = np.array([2, 1, 2, 0, 1, 0])
+ARM_SIGNS = np.array([1.0, -1.0, -1.0, 1.0, 1.0, -1.0])
+
+
+def _entry_values(arms: np.ndarray) -> np.ndarray:
+    """The numbers T's entries take (:attr:`PortFollowing.source`): 1, 0, then each
+    port's six lever-arm entries; ``arms`` (p, 3) m, each port less its body's mass centre."""
+    return np.concatenate([[1.0, 0.0], (arms[:, ARM_AXES] * ARM_SIGNS).ravel()])
 
 
 def port_kinematics(ports: np.ndarray, centres: np.ndarray) -> np.ndarray:
@@ -127,10 +144,8 @@ def port_kinematics(ports: np.ndarray, centres: np.ndarray) -> np.ndarray:
     numpy.ndarray, shape (p, 6, 6)
         Unit diagonal; the lever arms (m) in the translations' rows, rotation columns.
     """
-    r = ports - centres
-    block = np.zeros((len(r), 6, 6))
-    block[:, np.arange(6), np.arange(6)] = 1.0
+    block = np.zeros((len(ports), 36))
+    block[:, ::7] = 1.0
     # −[r]ₓ, whose zero diagonal stays +0.0 (a −0.0 there would be dropped as any zero is)
-    block[:, [0, 0, 1, 1, 2, 2], [4, 5, 3, 5, 3, 4]] = np.stack([r[:, 2], -r[:, 1], -r[:, 2], r[:, 0],
-                                                                r[:, 1], -r[:, 0]], axis=1)
-    return block
+    block[:, ARM_SLOTS] = _entry_values(ports - centres)[2:].reshape(-1, 6)
+    return block.reshape(-1, 6, 6)

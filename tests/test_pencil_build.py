@@ -32,8 +32,8 @@ from builders import BUNDLED_MODELS, fixed, make_beam, make_rigid
 from random_models import KINDS, random_model, random_rotation
 from varied_models import varied_model
 
-from linmstmm._product_kernels import pencil_forms
-from linmstmm.coarse_prediction import coarse_pencil
+from linmstmm._product_kernels import pencil_forms, unit_scaled
+from linmstmm.coarse_prediction import _unit_scaled, coarse_pencil
 from linmstmm.fe import products
 from linmstmm.fe.assembly import assemble, assembled
 from linmstmm.fe.masses import (
@@ -94,6 +94,24 @@ def test_compiled_products_are_the_numpy_route_s(name):
     for ours, theirs in zip(_reduced_terms(parts, "compiled") + _beam_maps(parts, "compiled"),
                             _reduced_terms(parts, "numpy") + _beam_maps(parts, "numpy")):
         assert ours.shape == theirs.shape and np.array_equal(ours, theirs)
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_compiled_scaling_is_the_numpy_route_s(name):
+    """The coarse pencil scaled to unit mass per unknown by the compiled kernel, against
+    numpy's scaling, bit for bit: on each model's assembled pencil at one and two
+    elements per beam, and with some unknowns' mass (and stiffness) made zero."""
+    model = MODELS[name]()
+    for n in (1, 2):
+        fe = assembled(model, n)
+        K, M = (matrix if isinstance(matrix, np.ndarray) else matrix.toarray() for matrix in (fe.K, fe.M))
+        bare, loose = np.arange(K.shape[0]) % 3 == 0, np.arange(K.shape[0]) % 6 == 0
+        light, stiff = M.copy(), K.copy()
+        light[bare], light[:, bare] = 0.0, 0.0
+        stiff[loose], stiff[:, loose] = 0.0, 0.0
+        for pencil in ((K, M), (K, light), (stiff, light)):
+            for ours, theirs in zip(unit_scaled(*pencil), _unit_scaled(*pencil)):
+                assert np.array_equal(ours, theirs)
 
 
 def test_three_elements_at_a_node_leave_the_mass_to_the_numpy_route():

@@ -27,7 +27,7 @@ from linmstmm import _stiffness_kernels as kernels
 from linmstmm.dynamic_stiffness import BeamTable, clamped_counts
 from linmstmm.fe import fe_frequencies
 from linmstmm.model import load_model
-from linmstmm._ordering_kernels import minimum_degree, pattern_with_beams, slot_terms
+from linmstmm._ordering_kernels import count_patterns, minimum_degree, pattern_with_beams, slot_terms
 from linmstmm.ordered_ldlt import elimination_plan
 from linmstmm.wittrick_williams import MOST_GROWTH, SINGULAR_PIVOT, ModeCounter, _block_inertia, _plan_of
 from random_models import KINDS, random_model
@@ -86,6 +86,28 @@ def test_minimum_degree_is_the_numpy_derivation():
     for pattern in patterns:
         for ours, theirs in zip(minimum_degree(pattern.astype(np.int64)), reference_minimum_degree(pattern)):
             assert ours.dtype == np.int64 and np.array_equal(ours, theirs)
+
+
+def test_count_patterns_are_the_numpy_derivation():
+    """Where D(ω) may be nonzero, compiled, against numpy's masks and products of them,
+    on the launchers' counters and on random maps with zeros, ±0.0 and tiny entries."""
+    rng = np.random.default_rng(8)
+    cases = []
+    for path in LAUNCHERS:
+        counter = ModeCounter(load_model(path), "compiled")
+        cases.append((counter._static, counter._mass, counter._maps))
+    for n_beams, k in ((1, 3), (4, 9), (3, 14)):
+        maps = rng.standard_normal((n_beams, 12, k)) * (rng.random((n_beams, 12, k)) < 0.3)
+        maps[0, 0, 0], maps[-1, -1, -1] = -0.0, 1e-300
+        static = np.where(rng.random((k, k)) < 0.2, rng.standard_normal((k, k)), 0.0)
+        mass = np.where(rng.random((k, k)) < 0.1, rng.standard_normal((k, k)), -0.0)
+        cases.append((static, mass, maps))
+    local = kernels.LOCAL_PATTERN
+    for static, mass, maps in cases:
+        pattern, beam_pattern = count_patterns(static, mass, maps, local)
+        reach = np.abs(maps) > 0
+        assert np.array_equal(pattern, (static != 0) | (mass != 0))
+        assert np.array_equal(beam_pattern, np.swapaxes(reach, 1, 2).astype(float) @ local @ reach > 0)
 
 
 def reference_plan(pattern):

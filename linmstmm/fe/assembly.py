@@ -231,8 +231,8 @@ def assembled(model: Model, elements_per_beam: int, constraints_of=node_constrai
     the same numbers required (the coarse predictions pass compiled ones), and G is
     then not formed.
     """
-    light = _negligible_mass_removed(model)
     nodes = constraints_of(model)       # the model's own (kept ones shared with its counter)
+    light = _negligible_mass_removed(model, nodes.layout.positions)
     if light is not model:
         model, nodes = light, nodes.with_masses_of(light)
     parts = constrained_parts(model, elements_per_beam, nodes)

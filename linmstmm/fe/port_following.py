@@ -103,18 +103,14 @@ def port_following(model: Model, layout) -> PortFollowing:
     masters = np.flatnonzero(~dropped)
     # each row's possible entries: a master's its unit entry, a port's its body's six
     # centre columns descending, their numbers the lever-arm block's row reversed
-    possible, cols, source = np.zeros((n_full, 6), bool), np.zeros((n_full, 6), int), np.zeros((n_full, 6), int)
-    possible[masters, 0] = True
-    cols[masters, 0] = np.arange(len(masters))
-    possible[ports] = True
-    cols[ports] = (np.cumsum(~dropped) - 1)[centres][:, None, ::-1]
-    block = np.ones(36, int)                                    # a lever-arm block's entries: 0 off the arms
-    block[np.arange(0, 36, 7)] = 0                                # unit diagonal
-    block[ARM_SLOTS] = 2 + np.arange(len(ARM_SLOTS))
-    arms = np.where(block < 2, block, block + 6 * np.arange(len(port_nodes))[:, None])   # (p, 36)
-    source[ports] = arms.reshape(-1, 6, 6)[:, :, ::-1]
-    rows = np.nonzero(possible)[0]
-    return PortFollowing(port_nodes, centre_nodes, rows, cols[possible], source[possible], masters,
+    column = np.cumsum(~dropped) - 1
+    p = len(port_nodes)
+    rows = np.concatenate([masters, np.repeat(ports.ravel(), 6)])
+    cols = np.concatenate([np.arange(len(masters)), np.broadcast_to(column[centres][:, None, ::-1], (p, 6, 6)).ravel()])
+    source = np.concatenate([np.zeros(len(masters), int),
+                             (_BLOCK_SOURCE + 6 * np.arange(p)[:, None, None] * _ON_ARM).ravel()])
+    order = np.argsort(rows, kind="stable")             # rows ascending, each row's entries in their order
+    return PortFollowing(port_nodes, centre_nodes, rows[order], cols[order], source[order], masters,
                          (n_full, len(masters)))
 
 
@@ -125,10 +121,24 @@ ARM_AXES = np.array([2, 1, 2, 0, 1, 0])
 ARM_SIGNS = np.array([1.0, -1.0, -1.0, 1.0, 1.0, -1.0])
 
 
+def _block_source() -> tuple[np.ndarray, np.ndarray]:
+    """(6, 6) where each entry of the first port's lever-arm block takes its number from
+    (:attr:`PortFollowing.source`), each row's columns reversed as T stores them, and
+    (6, 6) 1 on the lever arms (a further port's are 6 further on), else 0."""
+    block = np.ones(36, int)                                   # a zero entry
+    block[::7] = 0                                             # the unit diagonal
+    block[ARM_SLOTS] = 2 + np.arange(len(ARM_SLOTS))
+    block = block.reshape(6, 6)[:, ::-1]
+    return block, (block >= 2).astype(int)
+
+
 def _entry_values(arms: np.ndarray) -> np.ndarray:
     """The numbers T's entries take (:attr:`PortFollowing.source`): 1, 0, then each
     port's six lever-arm entries; ``arms`` (p, 3) m, each port less its body's mass centre."""
     return np.concatenate([[1.0, 0.0], (arms[:, ARM_AXES] * ARM_SIGNS).ravel()])
+
+
+_BLOCK_SOURCE, _ON_ARM = _block_source()
 
 
 def port_kinematics(ports: np.ndarray, centres: np.ndarray) -> np.ndarray:

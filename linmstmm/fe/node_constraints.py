@@ -213,7 +213,8 @@ def _add_springs(model, layout, strains, stiffness, constraints):
     """Finite spring directions become strains, ``inf`` ones constraints, released ones nothing
     (each kind written as one block of rows, in the springs' order)."""
     owners, components, cols, values = spring_rows(model.springs, layout.index, kept_only=True)
-    k = np.array([spring.k for spring in model.springs], float).reshape(-1, 6)[owners, components]
+    k = np.array([spring.k for spring in model.springs], float).reshape(-1, 6)
+    k = k.ravel() if len(owners) == k.size else k[owners, components]   # every direction kept: all, in order
     rigid = np.isinf(k)
     if not rigid.any():  # every direction a strain, taken as it is
         strains.add(strains.new_rows(len(k))[:, None], cols, values)
@@ -227,10 +228,14 @@ def _add_springs(model, layout, strains, stiffness, constraints):
 def _add_rigid_masses(model, layout, mass):
     """Each body's mass and inertia on the DOFs of its mass centre."""
     dofs = 6 * np.array([layout.index.rigids[body.name] for body in model.rigids], int)[:, None] + np.arange(6)
-    blocks = np.zeros((len(dofs), 6, 6))
-    blocks[:, [0, 1, 2], [0, 1, 2]] = np.array([body.mass for body in model.rigids], float)[:, None]
-    blocks[:, 3:, 3:] = np.array([body.inertia for body in model.rigids], float).reshape(-1, 3, 3)
-    mass.add(dofs[:, :, None], dofs[:, None, :], blocks)
+    blocks = np.zeros((len(dofs), 36))                                    # each body's 6 × 6 block, row-major
+    blocks[:, :15:7] = np.array([body.mass for body in model.rigids], float)[:, None]
+    blocks[:, _INERTIA_PLACES] = np.array([body.inertia for body in model.rigids], float).reshape(-1, 9)
+    mass.add(np.repeat(dofs, 6, axis=1).ravel(), np.tile(dofs, 6).ravel(), blocks.ravel())
+
+
+#: Where a body's inertia tensor (3 × 3, row-major) sits in its 6 × 6 mass block, flattened.
+_INERTIA_PLACES = (6 * np.arange(3, 6)[:, None] + np.arange(3, 6)).ravel()
 
 
 def _add_boundaries(model, layout, constraints):

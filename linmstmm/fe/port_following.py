@@ -26,25 +26,27 @@ class PortFollowing:
 
     Attributes
     ----------
-    ports, centres : numpy.ndarray, shape (p,)
-        The node of each rigid body's port and of its body's mass centre (bodies and
-        ports in model order).
+    arm_ends, arm_starts, arm_signs : numpy.ndarray, shape (6 p,)
+        Each port's six lever-arm entries (:data:`ARM_SLOTS`, bodies and ports in model
+        order): where the port's and its body's mass centre's coordinate sit in the
+        flattened positions, and the sign the difference takes.
     rows, cols : numpy.ndarray, shape (e,)
         Row (full DOF) and column (reduced DOF) of each possible entry: rows ascending,
         within a port's row the columns descending (the order scipy's product of the
         general elimination stores them in).
     source : numpy.ndarray, shape (e,)
-        Where each entry's number comes from in the values :func:`_entry_values`
-        lists: 0 a unit entry, 1 a zero one, 2 + 6 i + j the j-th lever-arm entry of
-        port i (:data:`ARM_SLOTS`).
+        Where each entry's number comes from among 1, 0 and then the ports' lever-arm
+        entries (``arm_ends``): 0 a unit entry, 1 a zero one, 2 + 6 i + j the j-th
+        lever-arm entry of port i (:data:`ARM_SLOTS`).
     masters : numpy.ndarray, shape (n_dof,)
         The full DOFs kept as the reduced ones, ascending.
     shape : tuple
         (n_full, n_dof).
     """
 
-    ports: np.ndarray
-    centres: np.ndarray
+    arm_ends: np.ndarray
+    arm_starts: np.ndarray
+    arm_signs: np.ndarray
     rows: np.ndarray
     cols: np.ndarray
     source: np.ndarray
@@ -67,7 +69,9 @@ class PortFollowing:
             empty), indices of the type scipy gives them
             (:func:`~linmstmm.fe.sparse.index_type`).
         """
-        values = _entry_values(positions[self.ports] - positions[self.centres])[self.source]
+        flat = positions.ravel()
+        arms = (flat[self.arm_ends] - flat[self.arm_starts]) * self.arm_signs
+        values = np.concatenate([[1.0, 0.0], arms])[self.source]
         stored = values != 0
         data = values[stored]
         index = index_type(self.shape[1], len(data))
@@ -110,8 +114,9 @@ def port_following(model: Model, layout) -> PortFollowing:
     source = np.concatenate([np.zeros(len(masters), int),
                              (_BLOCK_SOURCE + 6 * np.arange(p)[:, None, None] * _ON_ARM).ravel()])
     order = np.argsort(rows, kind="stable")             # rows ascending, each row's entries in their order
-    return PortFollowing(port_nodes, centre_nodes, rows[order], cols[order], source[order], masters,
-                         (n_full, len(masters)))
+    arm_ends, arm_starts = ((3 * nodes[:, None] + ARM_AXES).ravel() for nodes in (port_nodes, centre_nodes))
+    return PortFollowing(arm_ends, arm_starts, np.tile(ARM_SIGNS, p), rows[order], cols[order], source[order],
+                         masters, (n_full, len(masters)))
 
 
 #: Where −[r]ₓ puts a port's lever arm r (m) in its 6 × 6 block, flattened
@@ -130,12 +135,6 @@ def _block_source() -> tuple[np.ndarray, np.ndarray]:
     block[ARM_SLOTS] = 2 + np.arange(len(ARM_SLOTS))
     block = block.reshape(6, 6)[:, ::-1]
     return block, (block >= 2).astype(int)
-
-
-def _entry_values(arms: np.ndarray) -> np.ndarray:
-    """The numbers T's entries take (:attr:`PortFollowing.source`): 1, 0, then each
-    port's six lever-arm entries; ``arms`` (p, 3) m, each port less its body's mass centre."""
-    return np.concatenate([[1.0, 0.0], (arms[:, ARM_AXES] * ARM_SIGNS).ravel()])
 
 
 _BLOCK_SOURCE, _ON_ARM = _block_source()
@@ -157,5 +156,5 @@ def port_kinematics(ports: np.ndarray, centres: np.ndarray) -> np.ndarray:
     block = np.zeros((len(ports), 36))
     block[:, ::7] = 1.0
     # −[r]ₓ, whose zero diagonal stays +0.0 (a −0.0 there would be dropped as any zero is)
-    block[:, ARM_SLOTS] = _entry_values(ports - centres)[2:].reshape(-1, 6)
+    block[:, ARM_SLOTS] = (ports - centres)[:, ARM_AXES] * ARM_SIGNS
     return block.reshape(-1, 6, 6)

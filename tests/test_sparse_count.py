@@ -6,9 +6,12 @@ References:
 
 * a dense LDLᵀ without pivoting written out in numpy, in the plan's order, for
   the kernel's factorisation (the same numbers, refusals included);
+* the minimum-degree order and joins derived in numpy, every degree counted
+  afresh (:func:`reference_minimum_degree`), for the compiled order;
 * the plan's slots and updates derived in numpy from the minimum-degree order
   (:func:`reference_plan`), for the compiled plan, array for array, and so the
-  beams' slots and the springs' and bodies' terms there;
+  beams' slots and the springs' and bodies' terms there, and the patterns of
+  D(ω) (numpy's masks and products) for the compiled ones;
 * LAPACK's symmetric eigenvalues (dsyevd) for every count decided;
 * the dense count (:func:`linmstmm._stiffness_kernels.count`, LAPACK's dsytrf,
   itself compared with the numpy reference in test_wittrick_williams.py) at
@@ -77,13 +80,18 @@ def reference_minimum_degree(pattern):
     return np.array(order, np.int64), joined
 
 
-def test_minimum_degree_is_the_numpy_derivation():
-    rng = np.random.default_rng(5)
-    patterns = [random_sparse(rng, n, density)[1] for n in (1, 2, 5, 20, 60, 120) for density in (0.02, 0.1, 0.5)]
+def patterns_to_plan(seed: int, densities: tuple) -> list:
+    """Random patterns of 1 to 120 unknowns at each of ``densities``, and the launchers' counters'."""
+    rng = np.random.default_rng(seed)
+    patterns = [random_sparse(rng, n, density)[1] for n in (1, 2, 5, 20, 60, 120) for density in densities]
     for path in LAUNCHERS:
         counter = ModeCounter(load_model(path), "compiled")
         patterns.append((counter._static != 0) | (counter._mass != 0) | np.eye(counter.n_dof, dtype=bool))
-    for pattern in patterns:
+    return patterns
+
+
+def test_minimum_degree_is_the_numpy_derivation():
+    for pattern in patterns_to_plan(5, (0.02, 0.1, 0.5)):
         for ours, theirs in zip(minimum_degree(pattern.astype(np.int64)), reference_minimum_degree(pattern)):
             assert ours.dtype == np.int64 and np.array_equal(ours, theirs)
 
@@ -131,12 +139,7 @@ def reference_plan(pattern):
 
 
 def test_compiled_plan_is_the_numpy_derivation():
-    rng = np.random.default_rng(11)
-    patterns = [random_sparse(rng, n, density)[1] for n in (1, 2, 5, 20, 60, 120) for density in (0.02, 0.2, 0.9)]
-    for path in LAUNCHERS:
-        counter = ModeCounter(load_model(path), "compiled")
-        patterns.append((counter._static != 0) | (counter._mass != 0) | np.eye(counter.n_dof, dtype=bool))
-    for pattern in patterns:
+    for pattern in patterns_to_plan(11, (0.02, 0.2, 0.9)):
         plan = elimination_plan(pattern)
         ours = (plan.starts, plan.rows, plan.high, plan.low, plan.updates, plan.targets)
         for mine, theirs in zip(ours, reference_plan(pattern)):

@@ -7,9 +7,10 @@ Wittrick–Williams counter of a new pattern:
 * :func:`plan_slots` — the slots of L's pattern in that order and the updates of
   each elimination step, in one pass where numpy took a dozen calls on (n, n)
   arrays (60-90 µs of the launchers' first counter build);
-* :func:`pattern_with_beams`, :func:`beam_slots` and :func:`slot_terms` — D(ω)'s
-  pattern with the entries the beams reach, where each beam's entries go among
-  the slots, and the springs' and bodies' terms there
+* :func:`count_patterns`, :func:`pattern_with_beams`, :func:`beam_slots` and
+  :func:`slot_terms` — where D(ω) may be nonzero, its pattern with the entries
+  the beams reach, where each beam's entries go among the slots, and the
+  springs' and bodies' terms there
   (:func:`linmstmm.wittrick_williams.sparse_plan`).
 
 tests/test_sparse_count.py derives each in numpy and compares.
@@ -47,7 +48,7 @@ def minimum_degree(pattern):
         live[i, i] = 0
         for j in range(n):
             degree[i] += live[i, j]
-    order = np.empty(n, dtype=np.int64)
+    order, near = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
     for step in range(n):
         k = 0
         for i in range(n):
@@ -55,17 +56,23 @@ def minimum_degree(pattern):
                 k = i
         order[step] = k
         degree[k] = n + 1  # eliminated: above any degree
+        count = 0
         for i in range(n):
-            joined[k, i] = live[k, i]
-        for i in range(n):
-            if joined[k, i]:
-                live[i, k] = 0
-                for j in range(n):
-                    if joined[k, j] and j != i:
-                        live[i, j] = 1
-                degree[i] = 0
-                for j in range(n):
-                    degree[i] += live[i, j]
+            if live[k, i]:
+                joined[k, i] = 1
+                near[count] = i
+                count += 1
+        # each unknown joined to k loses k and gains the others joined to it (the
+        # degrees kept up to date entry by entry: the counts a recount would give)
+        for a in range(count):
+            i = near[a]
+            live[i, k] = 0
+            degree[i] -= 1
+            for b in range(count):
+                j = near[b]
+                if j != i and not live[i, j]:
+                    live[i, j] = 1
+                    degree[i] += 1
     return order, joined
 
 
@@ -87,22 +94,34 @@ def plan_slots(order, joined):
     updates : (n + 1,) int64. targets : (pairs,) int64.
     """
     n = order.size
+    step_of = np.empty(n, dtype=np.int64)
+    step_of[order] = np.arange(n)
+    # each step's own slot and those of the steps joined to it (read along the joins'
+    # rows, then put in ascending order)
     starts = np.zeros(n + 1, dtype=np.int64)
     for a in range(n):
-        starts[a + 1] = starts[a]
-        for b in range(n):
-            if b == a or joined[order[a], order[b]] > 0:
-                starts[a + 1] += 1
+        count = 1
+        for u in range(n):
+            if u != order[a] and joined[order[a], u] > 0:
+                count += 1
+        starts[a + 1] = starts[a] + count
     slots = starts[n]
     rows, steps = np.empty(slots, dtype=np.int64), np.empty(slots, dtype=np.int64)
     lookup = np.full((n, n), -1, dtype=np.int64)
-    s = 0
+    met = np.empty(n, dtype=np.int64)
     for a in range(n):
-        for b in range(n):
-            if b == a or joined[order[a], order[b]] > 0:
-                rows[s], steps[s] = b, a
-                lookup[b, a] = s
-                s += 1
+        met[0], count = a, 1
+        for u in range(n):
+            if u != order[a] and joined[order[a], u] > 0:
+                place = count  # insertion: the steps ascending
+                while place > 0 and met[place - 1] > step_of[u]:
+                    met[place] = met[place - 1]
+                    place -= 1
+                met[place] = step_of[u]
+                count += 1
+        for q in range(count):
+            rows[starts[a] + q], steps[starts[a] + q] = met[q], a
+            lookup[met[q], a] = starts[a] + q
     updates = np.zeros(n + 1, dtype=np.int64)
     for k in range(n):
         pairs = 0
@@ -123,6 +142,47 @@ def plan_slots(order, joined):
         first, second = order[rows[s]], order[steps[s]]
         high[s], low[s] = max(first, second), min(first, second)
     return starts, rows, high, low, updates, targets
+
+
+@njit(cache=True)
+def count_patterns(static, mass, maps, local_pattern):
+    """Where D(ω) may be nonzero, in two parts: the springs' and bodies' entries, and
+    each beam's (:func:`linmstmm.wittrick_williams.sparse_plan`).
+
+    Parameters
+    ----------
+    static, mass : (n, n) float64
+        The springs' stiffness and the bodies' mass, reduced.
+    maps : (n_beams, 12, k) float64
+        Each beam's map from the reduced DOFs it touches to its local ones.
+    local_pattern : (12, 12) float64
+        1.0 where a beam's local dynamic stiffness may be nonzero, else 0.0.
+
+    Returns
+    -------
+    pattern : (n, n) bool
+        ``static != 0 or mass != 0``.
+    beam_pattern : (n_beams, k, k) bool
+        Where ``map.T @ local @ map`` may be nonzero: some term |map[a, i]| > 0,
+        local_pattern[a, c] > 0, |map[c, j]| > 0 (any other entry is a sum of zeros).
+    """
+    n = static.shape[0]
+    pattern = np.empty((n, n), dtype=np.bool_)
+    for i in range(n):
+        for j in range(n):
+            pattern[i, j] = static[i, j] != 0 or mass[i, j] != 0
+    n_beams, local, k = maps.shape
+    beam_pattern = np.zeros((n_beams, k, k), dtype=np.bool_)
+    for b in range(n_beams):
+        for a in range(local):
+            for c in range(local):
+                if local_pattern[a, c] > 0:
+                    for i in range(k):
+                        if np.abs(maps[b, a, i]) > 0:
+                            for j in range(k):
+                                if np.abs(maps[b, c, j]) > 0:
+                                    beam_pattern[b, i, j] = True
+    return pattern, beam_pattern
 
 
 @njit(cache=True)

@@ -15,6 +15,8 @@ numpy route.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numba import njit
 
@@ -228,7 +230,50 @@ def _pencil(t_indptr, t_indices, t_data, n, rows, dofs, strain, d, s_indptr, s_i
     for r in range(s_indptr.size - 1):
         _add_gram_row(s_indices, s_data, s_indptr[r], s_indptr[r + 1], t_indptr, t_indices, t_data,
                       spring_stiffness[r], True, K, scratch)
+    _symmetrise(M)
+    _symmetrise(K)
     return M, K, True
+
+
+@njit(cache=True)
+def _symmetrise(A):
+    """(A + Aᵀ) / 2 of the square ``A`` in place, each entry (a + b) * 0.5 as
+    :func:`linmstmm.fe.assembly._symmetric_of_dense` forms it (a diagonal entry is
+    itself: a + a doubles and halves exactly)."""
+    for i in range(A.shape[0]):
+        for j in range(i):
+            A[i, j] = A[j, i] = (A[i, j] + A[j, i]) * 0.5
+
+
+@njit(cache=True)
+def unit_scaled(K, M):
+    """The coarse pencil scaled to unit mass (or stiffness) per unknown, as
+    :func:`linmstmm.coarse_prediction._unit_scaled` scales it in numpy, the same
+    numbers in one pass.
+
+    Parameters
+    ----------
+    K, M : (n, n) float64
+        Stiffness (N/m, N m/rad) and mass (kg, kg m²), symmetric.
+
+    Returns
+    -------
+    scale : (n,) float64
+        1 / √(M_ii, or |K_ii| where M_ii is not positive, or 1 where that is 0).
+    K_scaled, M_scaled : (n, n) float64
+        K_ij (s_i s_j) and M_ij (s_i s_j).
+    """
+    n = K.shape[0]
+    scale = np.empty(n)
+    for i in range(n):
+        size = M[i, i] if M[i, i] > 0 else np.abs(K[i, i])
+        scale[i] = 1 / np.sqrt(size if size > 0 else 1.0)
+    K_scaled, M_scaled = np.empty((n, n)), np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            both = scale[i] * scale[j]
+            K_scaled[i, j], M_scaled[i, j] = K[i, j] * both, M[i, j] * both
+    return scale, K_scaled, M_scaled
 
 
 def counter_terms(parts) -> tuple[np.ndarray, np.ndarray] | None:
@@ -259,20 +304,40 @@ def counter_terms(parts) -> tuple[np.ndarray, np.ndarray] | None:
 
 
 def _triplet_arrays(triplets) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(rows, cols, values) of a :class:`~linmstmm.fe.layout._Triplets`, int64 and float64."""
-    return tuple(np.concatenate(part).astype(dtype, copy=False) if part else np.zeros(0, dtype)
-                 for part, dtype in ((triplets.rows, np.int64), (triplets.cols, np.int64), (triplets.values, float)))
+    """(rows, cols, values) of a :class:`~linmstmm.fe.layout._Triplets`, int64 and float64
+    (shared, :func:`_kept_arrays`: never written)."""
+    return _kept_arrays(triplets, len(triplets.rows))
 
 
 def _triplet_rows(triplets, n_rows) -> tuple | None:
-    """CSR arrays (:func:`_grouped_rows`) of ``triplets`` with ``n_rows`` rows, or None."""
-    indptr, cols, values = _grouped_rows(n_rows, *_triplet_arrays(triplets))
+    """CSR arrays (:func:`_grouped_rows`) of ``triplets`` with ``n_rows`` rows, or None
+    (shared, :func:`_kept_rows`: never written)."""
+    return _kept_rows(triplets, n_rows, len(triplets.rows))
+
+
+#: Triplet objects whose arrays are kept (:func:`_kept_arrays`, :func:`_kept_rows`).
+TRIPLETS_KEPT = 8
+
+
+@functools.lru_cache(maxsize=TRIPLETS_KEPT)
+def _kept_arrays(triplets, pieces: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_triplet_arrays` of ``triplets`` holding ``pieces`` pieces, made once for the
+    counter's and the coarse pencil's build, which take the same springs and bodies (a
+    triplet object is only ever added to, so its pieces tell its contents)."""
+    return tuple(np.concatenate(part[:pieces]).astype(dtype, copy=False) if pieces else np.zeros(0, dtype)
+                 for part, dtype in ((triplets.rows, np.int64), (triplets.cols, np.int64), (triplets.values, float)))
+
+
+@functools.lru_cache(maxsize=TRIPLETS_KEPT)
+def _kept_rows(triplets, n_rows: int, pieces: int) -> tuple | None:
+    """:func:`_triplet_rows` of ``triplets`` holding ``pieces`` pieces, made once (:func:`_kept_arrays`)."""
+    indptr, cols, values = _grouped_rows(n_rows, *_kept_arrays(triplets, pieces))
     return None if indptr.size == 0 else (indptr, cols, values)
 
 
 def pencil_forms(T, elements, parts) -> tuple[np.ndarray, np.ndarray] | None:
     """The ``forms`` of :func:`linmstmm.fe.assembly.assembled`: (Tᵀ M_full T, Gᵀ diag(D) G)
-    dense and not symmetrised, G = S T, the numbers :func:`linmstmm.fe.products.congruence`
+    dense and symmetrised, G = S T, the numbers :func:`linmstmm.fe.products.congruence`
     and ``dense_product(transposed(G, D), G)`` form of the full mass and strain rows
     that :func:`linmstmm.fe.assembly._add_beams` writes (the beams' strain rows, then
     the springs'; the bodies' masses, then the elements'), without writing them.

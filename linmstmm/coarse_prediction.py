@@ -170,14 +170,27 @@ def _pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
         from linmstmm._product_kernels import pencil_forms as forms
     fe = assembled(model, elements_per_beam, kept_node_constraints, forms)
     K, M = (matrix if isinstance(matrix, np.ndarray) else matrix.toarray() for matrix in (fe.K, fe.M))
-    size = np.where(np.diag(M) > 0, np.diag(M), np.abs(np.diag(K)))
-    scale = 1 / np.sqrt(np.where(size > 0, size, 1.0))
-    both = np.outer(scale, scale)
-    K, M = K * both, M * both
+    if forms is not None:  # compiled: the same numbers in one pass
+        from linmstmm._product_kernels import unit_scaled
+
+        scale, K, M = unit_scaled(K, M)
+    else:
+        scale, K, M = _unit_scaled(K, M)
     for matrix in (K, M):
         matrix.setflags(write=False)  # shared by every prediction of this model
     rigid = rigid_mode_count(fe.model, fe.parts.layout, fe.parts.masters, fe.M)
     return CoarsePencil(fe, rigid, K, M, scale)
+
+
+def _unit_scaled(K: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(scale (n,), K (n, n), M (n, n)) of the pencil (K, M) scaled to unit mass per
+    unknown, or unit stiffness where it has none (:class:`CoarsePencil`): scale_i is
+    1 / √M_ii, or 1 / √|K_ii| where M_ii is not positive, or 1 where both are 0, and
+    each entry is multiplied by scale_i scale_j."""
+    size = np.where(np.diag(M) > 0, np.diag(M), np.abs(np.diag(K)))
+    scale = 1 / np.sqrt(np.where(size > 0, size, 1.0))
+    both = np.outer(scale, scale)
+    return scale, K * both, M * both
 
 
 def _forget_pencils() -> None:

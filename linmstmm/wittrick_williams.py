@@ -286,14 +286,9 @@ def sparse_plan(static: np.ndarray, mass: np.ndarray, maps: np.ndarray, columns:
     terms : (4, slots) float64
         ``static`` and ``mass`` at the slots in the lower triangle, then in the upper.
     """
-    from linmstmm._ordering_kernels import slot_terms
+    from linmstmm._ordering_kernels import count_patterns, slot_terms
 
-    kernels = _stiffness_kernels()
-
-    pattern = (static != 0) | (mass != 0)
-    # where a beam's map.T @ local @ map may be nonzero: any other entry is a sum of zeros
-    reach = np.abs(maps) > 0
-    beam_pattern = np.swapaxes(reach, 1, 2).astype(float) @ kernels.LOCAL_PATTERN @ reach > 0
+    pattern, beam_pattern = count_patterns(static, mass, maps, _stiffness_kernels().LOCAL_PATTERN)
     plan, beam_slots = _planned(pattern, beam_pattern, columns)
     terms = slot_terms(static, mass, plan.high, plan.low)
     return (plan.order, plan.starts, plan.rows, plan.high, plan.low, plan.updates, plan.targets, beam_slots), terms

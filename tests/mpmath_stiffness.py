@@ -17,6 +17,7 @@ import numpy as np
 
 from linmstmm.fe import beam_element
 from linmstmm.fe.assembly import constrained_parts
+from linmstmm.fe.sparse import as_scipy
 from linmstmm.wittrick_williams import _beam_maps
 
 _AXIAL, _TORSION = (0, 6), (3, 9)
@@ -30,7 +31,7 @@ class ExactStiffness:
 
     def __init__(self, model, elements: int | None = None):
         parts = constrained_parts(model, 1)
-        T = parts.T
+        T = as_scipy(parts.T)
         springs = parts.spring_strains.matrix(parts.n_full) @ T
         stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
         self.n = T.shape[1]

@@ -19,11 +19,14 @@ the Wittrick–Williams counts and the coarse predictions do not change:
 """
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
-from random_models import random_model
+from random_models import KINDS, random_model
 from test_fe_assembly import mixed_model
+from varied_models import varied_model
 
 import linmstmm.fe.products as products
 from linmstmm.fe.assembly import assemble, assembled, constrained_parts
@@ -35,8 +38,8 @@ from linmstmm.fe.products import (
     rows_scaled,
     transposed,
 )
-from linmstmm.fe.rigid_motions import _held_everywhere, _rigid_motions, rigid_mode_count
-from linmstmm.fe.sparse import compressed_of_summed, scipy_csr
+from linmstmm.fe.rigid_motions import _components, _edges, _held_everywhere, _rigid_motions, rigid_mode_count
+from linmstmm.fe.sparse import as_scipy, compressed_of_summed, scipy_csr
 from linmstmm.model import load_model
 from linmstmm.wittrick_williams import ModeCounter
 
@@ -156,7 +159,7 @@ def test_counter_matrices_are_scipys(name):
     model = MODELS[name]()
     counter = ModeCounter(model, "numpy")
     parts = constrained_parts(model, 1)
-    T = parts.T
+    T = as_scipy(parts.T)
     springs = scipy_csr(parts.spring_strains.compressed(parts.n_full)) @ T
     stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
     assert np.array_equal(counter._static, (springs.T @ springs.multiply(stiffness[:, None])).toarray())
@@ -180,6 +183,36 @@ def test_rigid_modes_counted_as_formed(name):
     layout = _layout(model, 2)
     if _held_everywhere(model, layout):                    # the shortcut: the full search finds none either
         assert _rigid_motions(model, layout)[0].shape[1] == 0
+
+
+def mesh_segments_clamped(model, layout) -> bool:
+    """Whether every segment of the mesh's own edge arrays (:func:`_components`, joints
+    left out) holds a point fixed in all six components."""
+    clamped = [layout.index.points[point] for point, fixed in model.boundary.items() if all(fixed)]
+    edges, joints = _edges(model, layout)
+    segments = _components(edges[~joints], layout.n_nodes)
+    return bool(clamped) and bool(np.bincount(segments[clamped], minlength=segments.max() + 1).all())
+
+
+def test_clamped_everywhere_is_what_the_meshs_segments_say():
+    """The union–find on points and mass centres against the segments of the meshed
+    edges, on random, varied and jointed models, each also with random boundaries."""
+    rng = np.random.default_rng(3)
+    models = [random_model(kind, seed) for kind in KINDS for seed in range(4)]
+    models += [varied_model(seed)[0] for seed in range(8)] + [mixed_model(), mixed_model(held=False)]
+    answers = set()
+    for model in models:
+        variants = [model]
+        for _ in range(3):
+            points = rng.choice(list(model.points), size=min(3, len(model.points)), replace=False)
+            variants.append(replace(model, boundary={point: rng.random(6) < 0.9 for point in points}))
+        for variant in variants:
+            for n in (1, 2):
+                layout = _layout(variant, n)
+                held = _held_everywhere(variant, layout)
+                assert held == mesh_segments_clamped(variant, layout)
+                answers.add(held)
+    assert answers == {True, False}
 
 
 def test_clamped_everywhere_is_recognised():

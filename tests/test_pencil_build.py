@@ -32,8 +32,8 @@ from builders import BUNDLED_MODELS, fixed, make_beam, make_rigid
 from random_models import KINDS, random_model, random_rotation
 from varied_models import varied_model
 
-from linmstmm._product_kernels import pencil_forms
-from linmstmm.coarse_prediction import coarse_pencil
+from linmstmm._product_kernels import pencil_forms, unit_scaled
+from linmstmm.coarse_prediction import _unit_scaled, coarse_pencil
 from linmstmm.fe import products
 from linmstmm.fe.assembly import assemble, assembled
 from linmstmm.fe.masses import (
@@ -43,7 +43,7 @@ from linmstmm.fe.masses import (
 )
 from linmstmm.fe.node_constraints import kept_node_constraints
 from linmstmm.fe.products import small
-from linmstmm.fe.sparse import scipy_csr
+from linmstmm.fe.sparse import as_scipy, scipy_csr
 from linmstmm.model import Model, load_model
 from linmstmm.counter_parts import counter_parts
 from linmstmm.wittrick_williams import ModeCounter, _beam_maps, _reduced_terms
@@ -96,6 +96,24 @@ def test_compiled_products_are_the_numpy_route_s(name):
         assert ours.shape == theirs.shape and np.array_equal(ours, theirs)
 
 
+@pytest.mark.parametrize("name", MODELS)
+def test_compiled_scaling_is_the_numpy_route_s(name):
+    """The coarse pencil scaled to unit mass per unknown by the compiled kernel, against
+    numpy's scaling, bit for bit: on each model's assembled pencil at one and two
+    elements per beam, and with some unknowns' mass (and stiffness) made zero."""
+    model = MODELS[name]()
+    for n in (1, 2):
+        fe = assembled(model, n)
+        K, M = (matrix if isinstance(matrix, np.ndarray) else matrix.toarray() for matrix in (fe.K, fe.M))
+        bare, loose = np.arange(K.shape[0]) % 3 == 0, np.arange(K.shape[0]) % 6 == 0
+        light, stiff = M.copy(), K.copy()
+        light[bare], light[:, bare] = 0.0, 0.0
+        stiff[loose], stiff[:, loose] = 0.0, 0.0
+        for pencil in ((K, M), (K, light), (stiff, light)):
+            for ours, theirs in zip(unit_scaled(*pencil), _unit_scaled(*pencil)):
+                assert np.array_equal(ours, theirs)
+
+
 def test_three_elements_at_a_node_leave_the_mass_to_the_numpy_route():
     """Where three beams meet, a position of the full mass is given three times: its
     sum is scipy's to order, and the compiled forms leave the assembly to the numpy
@@ -146,7 +164,7 @@ def test_negligible_masses_keep_the_model_s_own_node_constraints():
         given, made = assembled(model, n), assembled(light, n)
         assert given.model is not model
         for a, b in zip((given.parts.T, given.M, given.K, given.G), (made.parts.T, made.M, made.K, made.G)):
-            a, b = (m if isinstance(m, np.ndarray) else m.toarray() for m in (a, b))
+            a, b = (m if isinstance(m, np.ndarray) else as_scipy(m).toarray() for m in (a, b))
             assert np.array_equal(a, b)
         assert np.array_equal(given.D, made.D)
     kept_node_constraints.cache_clear()

@@ -6,9 +6,12 @@ References:
 
 * a dense LDLᵀ without pivoting written out in numpy, in the plan's order, for
   the kernel's factorisation (the same numbers, refusals included);
+* the minimum-degree order and joins derived in numpy, every degree counted
+  afresh (:func:`reference_minimum_degree`), for the compiled order;
 * the plan's slots and updates derived in numpy from the minimum-degree order
   (:func:`reference_plan`), for the compiled plan, array for array, and so the
-  beams' slots and the springs' and bodies' terms there;
+  beams' slots and the springs' and bodies' terms there, and the patterns of
+  D(ω) (numpy's masks and products) for the compiled ones;
 * LAPACK's symmetric eigenvalues (dsyevd) for every count decided;
 * the dense count (:func:`linmstmm._stiffness_kernels.count`, LAPACK's dsytrf,
   itself compared with the numpy reference in test_wittrick_williams.py) at
@@ -27,7 +30,7 @@ from linmstmm import _stiffness_kernels as kernels
 from linmstmm.dynamic_stiffness import BeamTable, clamped_counts
 from linmstmm.fe import fe_frequencies
 from linmstmm.model import load_model
-from linmstmm._ordering_kernels import minimum_degree, pattern_with_beams, slot_terms
+from linmstmm._ordering_kernels import count_patterns, minimum_degree, pattern_with_beams, slot_terms
 from linmstmm.ordered_ldlt import elimination_plan
 from linmstmm.wittrick_williams import MOST_GROWTH, SINGULAR_PIVOT, ModeCounter, _block_inertia, _plan_of
 from random_models import KINDS, random_model
@@ -57,6 +60,64 @@ def reference_inertia(matrix, order, singular, most_growth):
     return negatives
 
 
+def reference_minimum_degree(pattern):
+    """(order, joined) of minimum-degree elimination in numpy, every degree counted
+    afresh: at each step the unknown joined to the fewest others left (the lowest
+    index among equals) is eliminated, and the others it was joined to are joined."""
+    n = len(pattern)
+    live = pattern & ~np.eye(n, dtype=bool)
+    left = np.ones(n, bool)
+    order, joined = [], np.zeros((n, n), np.int64)
+    for _ in range(n):
+        k = int(np.argmin(np.where(left, live.sum(axis=1), n + 1)))
+        near = np.flatnonzero(live[k])
+        order.append(k)
+        joined[k, near] = 1
+        left[k] = False
+        live[k, :] = live[:, k] = False
+        live[np.ix_(near, near)] = True
+        live[near, near] = False
+    return np.array(order, np.int64), joined
+
+
+def patterns_to_plan(seed: int, densities: tuple) -> list:
+    """Random patterns of 1 to 120 unknowns at each of ``densities``, and the launchers' counters'."""
+    rng = np.random.default_rng(seed)
+    patterns = [random_sparse(rng, n, density)[1] for n in (1, 2, 5, 20, 60, 120) for density in densities]
+    for path in LAUNCHERS:
+        counter = ModeCounter(load_model(path), "compiled")
+        patterns.append((counter._static != 0) | (counter._mass != 0) | np.eye(counter.n_dof, dtype=bool))
+    return patterns
+
+
+def test_minimum_degree_is_the_numpy_derivation():
+    for pattern in patterns_to_plan(5, (0.02, 0.1, 0.5)):
+        for ours, theirs in zip(minimum_degree(pattern.astype(np.int64)), reference_minimum_degree(pattern)):
+            assert ours.dtype == np.int64 and np.array_equal(ours, theirs)
+
+
+def test_count_patterns_are_the_numpy_derivation():
+    """Where D(ω) may be nonzero, compiled, against numpy's masks and products of them,
+    on the launchers' counters and on random maps with zeros, ±0.0 and tiny entries."""
+    rng = np.random.default_rng(8)
+    cases = []
+    for path in LAUNCHERS:
+        counter = ModeCounter(load_model(path), "compiled")
+        cases.append((counter._static, counter._mass, counter._maps))
+    for n_beams, k in ((1, 3), (4, 9), (3, 14)):
+        maps = rng.standard_normal((n_beams, 12, k)) * (rng.random((n_beams, 12, k)) < 0.3)
+        maps[0, 0, 0], maps[-1, -1, -1] = -0.0, 1e-300
+        static = np.where(rng.random((k, k)) < 0.2, rng.standard_normal((k, k)), 0.0)
+        mass = np.where(rng.random((k, k)) < 0.1, rng.standard_normal((k, k)), -0.0)
+        cases.append((static, mass, maps))
+    local = kernels.LOCAL_PATTERN
+    for static, mass, maps in cases:
+        pattern, beam_pattern = count_patterns(static, mass, maps, local)
+        reach = np.abs(maps) > 0
+        assert np.array_equal(pattern, (static != 0) | (mass != 0))
+        assert np.array_equal(beam_pattern, np.swapaxes(reach, 1, 2).astype(float) @ local @ reach > 0)
+
+
 def reference_plan(pattern):
     """(starts, rows, high, low, updates, targets) of the elimination plan of ``pattern``
     derived in numpy from its minimum-degree order: slots step by step (the diagonal,
@@ -78,12 +139,7 @@ def reference_plan(pattern):
 
 
 def test_compiled_plan_is_the_numpy_derivation():
-    rng = np.random.default_rng(11)
-    patterns = [random_sparse(rng, n, density)[1] for n in (1, 2, 5, 20, 60, 120) for density in (0.02, 0.2, 0.9)]
-    for path in LAUNCHERS:
-        counter = ModeCounter(load_model(path), "compiled")
-        patterns.append((counter._static != 0) | (counter._mass != 0) | np.eye(counter.n_dof, dtype=bool))
-    for pattern in patterns:
+    for pattern in patterns_to_plan(11, (0.02, 0.2, 0.9)):
         plan = elimination_plan(pattern)
         ours = (plan.starts, plan.rows, plan.high, plan.low, plan.updates, plan.targets)
         for mine, theirs in zip(ours, reference_plan(pattern)):

@@ -12,6 +12,8 @@ import pytest
 
 from linmstmm import counter_parts, model_structure, rigid_motion
 from linmstmm.compiled_model import forget_compiled_models
+from linmstmm.fe.assembly import constrained_parts
+from linmstmm.fe.node_constraints import kept_node_constraints, node_constraints
 from linmstmm.wittrick_williams import ModeCounter
 from linmstmm.model import ModelError, load_model
 from test_program_reuse import _edited, _models
@@ -69,24 +71,31 @@ def test_a_counter_on_a_kept_elimination_is_the_counter_built_afresh(model):
         assert len(kept) == len(fresh)
         for ours, theirs in zip(kept, fresh):
             assert ours.shape == theirs.shape and np.array_equal(ours, theirs)
-        layout = counter_parts._eliminations.get(edited, lambda m: None)
-        reused += same and layout is not None and layout.elimination() is not None
+        reused += same and counter_parts._eliminations.get(edited, lambda m: None) is not None
     if model.name.startswith("MLRS"):
         assert reused  # the launcher's structure is of the kind kept, and served
 
 
-def test_the_kept_elimination_is_derived_when_a_second_model_asks():
-    """A model solved once leaves its full build behind, not derived; the next model of
-    its structure derives the kept elimination from it and is built on it."""
+def test_the_kept_elimination_is_the_first_models_and_makes_the_full_builds_arrays():
+    """The layout kept for a structure is the one the first model's node constraints made
+    their T with; the next model of the structure takes its T from it, the arrays (types
+    included) of that model's full build, with the same masters."""
     model = load_model(MODELS / "mlrs/mlrs.toml")
     forget_compiled_models()
     ModeCounter(model)
-    first = counter_parts._eliminations.get(model, lambda m: None)
-    assert first._first is not None and first._elimination is None
-    edited = next(edit for edit in _edits(model)
-                  if model_structure.structure_of(edit) == model_structure.structure_of(model))
-    ModeCounter(edited)
-    assert first._first is None and first._elimination is not None
+    kept = counter_parts._eliminations.get(model, lambda m: None)
+    assert kept.following is kept_node_constraints(model).following
+    edited = [edit for edit in _edits(model)
+              if model_structure.structure_of(edit) == model_structure.structure_of(model)]
+    assert edited
+    for edit in edited:
+        ours = counter_parts.counter_parts(edit)
+        assert counter_parts._eliminations.get(edit, lambda m: None) is kept
+        theirs = constrained_parts(edit, 1, node_constraints(edit))
+        assert np.array_equal(ours.masters, theirs.masters) and ours.T.shape == theirs.T.shape
+        for name in ("indptr", "indices", "data"):
+            a, b = getattr(ours.T, name), getattr(theirs.T, name)
+            assert a.dtype == b.dtype and np.array_equal(a, b)
     forget_compiled_models()
 
 

@@ -224,14 +224,15 @@ def assembled(model: Model, elements_per_beam: int, constraints_of=node_constrai
     M = Tᵀ M_full T and K = (Gᵀ D) G are formed densely where their dense
     intermediate (n_dof × n_full) is small (:func:`linmstmm.fe.products.small`), by
     scipy.sparse otherwise: the same matrices bit for bit either way. Where small,
-    ``forms`` (T, elements, parts) -> (Tᵀ M_full T, Gᵀ D G) dense, or None, with T
+    ``forms`` (T, elements, parts) -> (Tᵀ M_full T, Gᵀ D G) dense and symmetrised as
+    :func:`_symmetric_of_dense` symmetrises, or None, with T
     (n_full, n_dof) scipy CSR, the beams' :class:`_BeamElements` and the
     :class:`ConstrainedParts`, may form them instead of :mod:`linmstmm.fe.products`:
     the same numbers required (the coarse predictions pass compiled ones), and G is
     then not formed.
     """
-    light = _negligible_mass_removed(model)
     nodes = constraints_of(model)       # the model's own (kept ones shared with its counter)
+    light = _negligible_mass_removed(model, nodes.layout.positions)
     if light is not model:
         model, nodes = light, nodes.with_masses_of(light)
     parts = constrained_parts(model, elements_per_beam, nodes)
@@ -240,7 +241,7 @@ def assembled(model: Model, elements_per_beam: int, constraints_of=node_constrai
     D = np.concatenate([_beam_stiffnesses(elements), *parts.spring_stiffness])   # beams' rows first, then the springs'
     formed = forms(T, elements, parts) if forms is not None and small(T.shape[1], n_full) else None
     if formed is not None:
-        return Assembly(model, parts, *(_symmetric_of_dense(product) for product in formed), None, D)
+        return Assembly(model, parts, *formed, None, D)
     parts = replace(parts, T=as_scipy(T))      # scipy's products below, and the FE model's T
     T = parts.T
     strains, mass = _Triplets(), parts.rigid_mass.copy()

@@ -78,15 +78,25 @@ def _frame_masses(rho_a: np.ndarray, rho_ip: np.ndarray, h: np.ndarray) -> np.nd
     rho_a : (b,) mass per length, kg/m. rho_ip : (b,) polar inertia per length, kg m.
     h : (b,) element lengths, m.
     """
-    m = np.zeros((len(h), 12, 12))
-    m[:, [[0], [6]], [0, 6]] = (rho_a * h)[:, None, None] * _BAR                  # axial
-    m[:, [[3], [9]], [3, 9]] = (rho_ip * h)[:, None, None] * _BAR                 # torsion
-    h = h[:, None, None]
-    constant, linear, square = _HERMITE
-    hermite = rho_a[:, None, None] * h / 420.0 * (constant + linear * h + square * h * h)
-    m[:, [[1], [5], [7], [11]], [1, 5, 7, 11]] = hermite                           # v, θz
-    m[:, [[2], [4], [8], [10]], [2, 4, 8, 10]] = hermite * _FLIP                   # w, θy
-    return m
+    m = np.zeros((len(h), 144))                                                   # flattened 12 × 12
+    m[:, _AXIAL] = (rho_a * h)[:, None] * _BAR.ravel()
+    m[:, _TORSION] = (rho_ip * h)[:, None] * _BAR.ravel()
+    h = h[:, None]
+    constant, linear, square = (part.ravel() for part in _HERMITE)
+    hermite = rho_a[:, None] * h / 420.0 * (constant + linear * h + square * h * h)
+    m[:, _BENDING_Y] = hermite
+    m[:, _BENDING_Z] = hermite * _FLIP.ravel()
+    return m.reshape(-1, 12, 12)
+
+
+def _block_places(dofs: list[int]) -> np.ndarray:
+    """The places in a flattened 12 × 12 matrix of the block on ``dofs`` (rows and columns), row-major."""
+    dofs = np.asarray(dofs)
+    return (12 * dofs[:, None] + dofs).ravel()
+
+
+_AXIAL, _TORSION = _block_places([0, 6]), _block_places([3, 9])
+_BENDING_Y, _BENDING_Z = _block_places([1, 5, 7, 11]), _block_places([2, 4, 8, 10])     # (v, θz), (w, θy)
 
 
 #: A wave with kh (rod) or βh (bending) beyond this per element is not resolved by the mesh.

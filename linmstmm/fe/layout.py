@@ -223,14 +223,21 @@ def spring_rows(springs, index: DofIndex, kept_only: bool):
     values : (d, 6) its entries, −axis at end a, +axis at end b.
     Rows are in the springs' order, each spring's in ascending direction.
     """
-    ends = np.array([[index.points[end] for end in spring.ends] for spring in springs], int).reshape(-1, 2)
-    block = np.array([0, 0, 0, 3, 3, 3])[:, None] + np.arange(3)                 # (6 directions, 3)
-    cols = 6 * ends[:, None, :, None] + block[None, :, None, :]                     # (s, 6, 2 ends, 3)
+    points = index.points
+    ends = np.array([(points[spring.ends[0]], points[spring.ends[1]]) for spring in springs], int).reshape(-1, 2)
+    cols = (6 * ends[:, None, :, None] + _DIRECTION_DOFS).reshape(-1, 6, 6)        # (s, 6, 2 ends × 3)
     axes = np.array([spring.axes for spring in springs], float).reshape(-1, 3, 3)[:, [0, 1, 2, 0, 1, 2]]
     values = np.concatenate([-axes, axes], axis=2)                                # (s, 6, 6)
+    released = [i for i, spring in enumerate(springs) if spring.release is not None] if kept_only else []
+    if not released:                                                              # every direction kept
+        return np.repeat(np.arange(len(ends)), 6), np.tile(np.arange(6), len(ends)), cols.reshape(-1, 6), \
+            values.reshape(-1, 6)
     kept = np.ones((len(ends), 6), bool)
-    if kept_only:
-        kept &= ~np.array([np.zeros(6, bool) if spring.release is None else spring.release
-                           for spring in springs], bool).reshape(-1, 6)
+    kept[released] = ~np.array([springs[i].release for i in released], bool).reshape(-1, 6)
     owners, components = np.nonzero(kept)
-    return owners, components, cols.reshape(-1, 6, 6)[kept], values[kept]
+    return owners, components, cols[kept], values[kept]
+
+
+#: The DOFs of a spring's row per direction (x, y, z, rx, ry, rz), (6, 1, 3): three at
+#: each end, translations or rotations, offset by 6 × the end's node.
+_DIRECTION_DOFS = (np.array([0, 0, 0, 3, 3, 3])[:, None] + np.arange(3))[:, None, :]

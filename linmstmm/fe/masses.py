@@ -18,8 +18,10 @@ MASSLESS = 1e-13
 SURE_INERTIA = 2.0
 
 
-def _negligible_mass_removed(model: Model) -> Model:
+def _negligible_mass_removed(model: Model, places: np.ndarray | None = None) -> Model:
     """``model`` with every mass below MASSLESS of the model's own scale set to zero.
+    ``places``: its points then its mass centres, (n, 3) m, where the caller has them
+    (a layout's positions), else gathered here.
 
     The scales are the total mass m of bodies and beams (kg) and m d² plus the
     traces of the bodies' inertia tensors (kg m²), d the largest distance of a
@@ -29,8 +31,10 @@ def _negligible_mass_removed(model: Model) -> Model:
     is kept is exactly as given. A DOF without mass then has an exactly zero row
     and column in the assembled M.
     """
-    places = np.array([*model.points.values(), *(body.com for body in model.rigids)], float)
-    extent = np.linalg.norm(places - places.mean(axis=0), axis=1).max()
+    if places is None:
+        places = np.array([*model.points.values(), *(body.com for body in model.rigids)], float)
+    arms = places - np.add.reduce(places, axis=0) / len(places)     # from the mean, as numpy's mean forms it
+    extent = np.sqrt(np.add.reduce(arms * arms, axis=1).max())      # the largest norm, as numpy's norm forms it
     masses = np.array([body.mass for body in model.rigids], float)
     tensors = np.array([body.inertia for body in model.rigids], float).reshape(-1, 3, 3)
     total = sum(masses.tolist()) + sum(beam.mass for beam in model.beams)

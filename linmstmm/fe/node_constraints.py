@@ -24,6 +24,7 @@ import scipy.sparse as sp
 
 from linmstmm.fe.constraints import _eliminate, reduced_constraints
 from linmstmm.fe.layout import _layout, _Triplets, spring_rows
+from linmstmm.fe.port_following import PortFollowing, port_following, port_kinematics
 from linmstmm.fe.sparse import Compressed, scipy_csr
 from linmstmm.model import Model
 
@@ -51,7 +52,7 @@ class NodeConstraints:
         (r, n_full) CSR constraint rows: infinite spring directions, fixed
         boundary components, ports joining further bodies, in that order.
         These three are None where the model is :func:`held_at_free_points`: its
-        elimination is then made directly, and no mesh eliminates anew.
+        elimination is then made directly (``following``), and no mesh eliminates anew.
     spring_strains : linmstmm.fe.layout._Triplets
         The finite spring directions as strain rows (m or rad) on the full DOFs.
     spring_stiffness : list of numpy.ndarray
@@ -59,8 +60,12 @@ class NodeConstraints:
     rigid_mass : linmstmm.fe.layout._Triplets
         The bodies' 6 × 6 mass blocks (kg, kg m²) on their mass centres' DOFs.
     elimination : tuple or None
-        (T (n_full, n_dof) scipy CSR, masters (n_dof,) full DOFs) of ``rows``
-        where no beam declares a direction rigid, else None.
+        (T (n_full, n_dof) CSR, masters (n_dof,) full DOFs) of ``rows`` where no
+        beam declares a direction rigid, else None. T is scipy CSR, or its arrays
+        as :class:`~linmstmm.fe.sparse.Compressed` where made by ``following``.
+    following : linmstmm.fe.port_following.PortFollowing or None
+        Where the model is :func:`held_at_free_points`, the layout of its elimination
+        (fixed by its structure), which made T; else None.
     """
 
     layout: object
@@ -72,6 +77,7 @@ class NodeConstraints:
     spring_stiffness: list
     rigid_mass: _Triplets
     elimination: tuple | None
+    following: PortFollowing | None
 
     def with_masses_of(self, model: Model) -> NodeConstraints:
         """These constraints with the rigid masses of ``model``: the same model but for
@@ -106,8 +112,8 @@ class NodeConstraints:
         -------
         T : scipy.sparse.csr_matrix or Compressed, shape (n_full, n_dof)
             The full vector is ``T @ q``. Where the nodes' elimination is extended by
-            the interior nodes' identity, the arrays as :class:`Compressed` CSR (their
-            scipy matrix: :func:`~linmstmm.fe.sparse.as_scipy`).
+            the interior nodes' identity or made by ``following``, the arrays as
+            :class:`Compressed` CSR (their scipy matrix: :func:`~linmstmm.fe.sparse.as_scipy`).
         masters : numpy.ndarray, shape (n_dof,)
             The full DOFs kept as the reduced ones, ascending.
         """
@@ -142,7 +148,9 @@ def node_constraints(model: Model) -> NodeConstraints:
     _add_springs(model, layout, strains, stiffness, constraints)
     _add_rigid_masses(model, layout, mass)
     if held_at_free_points(model):
-        return NodeConstraints(layout, n_full, None, None, None, strains, stiffness, mass, _ports_followed(model, layout))
+        following = port_following(model, layout)
+        return NodeConstraints(layout, n_full, None, None, None, strains, stiffness, mass,
+                               (following.T(layout.positions), following.masters), following)
     _add_boundaries(model, layout, constraints)
     t0, kept = _port_map(model, layout, constraints)
     rows = constraints.compressed(n_full)
@@ -151,7 +159,7 @@ def node_constraints(model: Model) -> NodeConstraints:
         t0_csr = scipy_csr(t0)
         t1, masters = _eliminate(reduced_constraints(rows, t0_csr))
         elimination = ((t0_csr @ scipy_csr(t1)).tocsr(), kept[masters])
-    return NodeConstraints(layout, n_full, t0, kept, rows, strains, stiffness, mass, elimination)
+    return NodeConstraints(layout, n_full, t0, kept, rows, strains, stiffness, mass, elimination, None)
 
 
 def held_at_free_points(model: Model) -> bool:
@@ -173,38 +181,6 @@ def held_at_free_points(model: Model) -> bool:
     return (len(owned) == len(ports) and owned.isdisjoint(model.boundary)
             and not np.isinf([spring.k for spring in model.springs]).any()
             and all(beam.axial and beam.torsion for beam in model.beams))
-
-
-def _ports_followed(model: Model, layout) -> tuple[sp.csr_matrix, np.ndarray]:
-    """The elimination (T, masters) of :func:`node_constraints` where the model is
-    :func:`held_at_free_points`: every port follows its body's mass centre and every
-    fixed component is dropped. The arrays the general route's scipy product
-    ``T0 T1`` stores (:func:`~linmstmm.fe.constraints._eliminate` makes each fixed
-    component a slave with no masters): a master's row its unit entry, a port's
-    row its body's lever-arm entries ``v · 1.0``, which are v, zeros left out, in
-    the reverse of the order the product met them (descending columns), a fixed
-    component's row empty."""
-    index, n_full = layout.index, 6 * layout.n_nodes
-    port_nodes = np.array([index.points[port] for body in model.rigids for port in body.ports], int)
-    centre_nodes = np.array([index.rigids[body.name] for body in model.rigids for _ in body.ports], int)
-    ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
-    fixed = np.array([components for components in model.boundary.values()], bool).reshape(-1, 6)
-    dropped = np.zeros(n_full, bool)
-    dropped[ports] = True
-    dropped[(6 * np.array([index.points[point] for point in model.boundary], int).reshape(-1, 1)
-             + np.arange(6))[fixed]] = True
-    masters = np.flatnonzero(~dropped)
-    # each row's possible entries (columns, values), stored where the value is not zero
-    cols, values = np.zeros((n_full, 6), int), np.zeros((n_full, 6))
-    cols[masters, 0], values[masters, 0] = np.arange(len(masters)), 1.0
-    cols[ports] = (np.cumsum(~dropped) - 1)[centres][:, None, ::-1]
-    values[ports] = _port_kinematics(layout.positions[port_nodes], layout.positions[centre_nodes])[:, :, ::-1]
-    stored = values != 0
-    indptr = np.concatenate([[0], np.cumsum(np.count_nonzero(stored, axis=1))])
-    index_type = np.int32 if max(len(masters), indptr[-1]) < 2 ** 31 else np.int64
-    T = sp.csr_matrix((values[stored], cols[stored].astype(index_type), indptr.astype(index_type)),
-                      shape=(n_full, len(masters)))
-    return T, masters
 
 
 #: :func:`node_constraints` kept per model object (a Model cannot change): made on the
@@ -237,21 +213,29 @@ def _add_springs(model, layout, strains, stiffness, constraints):
     """Finite spring directions become strains, ``inf`` ones constraints, released ones nothing
     (each kind written as one block of rows, in the springs' order)."""
     owners, components, cols, values = spring_rows(model.springs, layout.index, kept_only=True)
-    k = np.array([spring.k for spring in model.springs], float).reshape(-1, 6)[owners, components]
+    k = np.array([spring.k for spring in model.springs], float).reshape(-1, 6)
+    k = k.ravel() if len(owners) == k.size else k[owners, components]   # every direction kept: all, in order
     rigid = np.isinf(k)
+    if not rigid.any():  # every direction a strain, taken as it is
+        strains.add(strains.new_rows(len(k))[:, None], cols, values)
+        stiffness.append(k)
+        return
     strains.add(strains.new_rows(np.count_nonzero(~rigid))[:, None], cols[~rigid], values[~rigid])
     stiffness.append(k[~rigid])
-    if rigid.any():
-        constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None], cols[rigid], values[rigid])
+    constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None], cols[rigid], values[rigid])
 
 
 def _add_rigid_masses(model, layout, mass):
     """Each body's mass and inertia on the DOFs of its mass centre."""
     dofs = 6 * np.array([layout.index.rigids[body.name] for body in model.rigids], int)[:, None] + np.arange(6)
-    blocks = np.zeros((len(dofs), 6, 6))
-    blocks[:, [0, 1, 2], [0, 1, 2]] = np.array([body.mass for body in model.rigids], float)[:, None]
-    blocks[:, 3:, 3:] = np.array([body.inertia for body in model.rigids], float).reshape(-1, 3, 3)
-    mass.add(dofs[:, :, None], dofs[:, None, :], blocks)
+    blocks = np.zeros((len(dofs), 36))                                    # each body's 6 × 6 block, row-major
+    blocks[:, :15:7] = np.array([body.mass for body in model.rigids], float)[:, None]
+    blocks[:, _INERTIA_PLACES] = np.array([body.inertia for body in model.rigids], float).reshape(-1, 9)
+    mass.add(np.repeat(dofs, 6, axis=1).ravel(), np.tile(dofs, 6).ravel(), blocks.ravel())
+
+
+#: Where a body's inertia tensor (3 × 3, row-major) sits in its 6 × 6 mass block, flattened.
+_INERTIA_PLACES = (6 * np.arange(3, 6)[:, None] + np.arange(3, 6)).ravel()
 
 
 def _add_boundaries(model, layout, constraints):
@@ -259,20 +243,6 @@ def _add_boundaries(model, layout, constraints):
     dofs = [layout.index.point(point)[np.asarray(fixed, bool)] for point, fixed in model.boundary.items()]
     dofs = np.concatenate(dofs) if dofs else np.zeros(0, int)
     constraints.add(constraints.new_rows(len(dofs)), dofs, 1.0)
-
-
-def _port_kinematics(ports, centres) -> np.ndarray:
-    """(p, 6, 6) maps body-centre DOFs -> port DOFs: u_p = u_c + θ × (p − c), θ_p = θ.
-
-    ports, centres : (p, 3) positions of the ports and of their bodies' mass centres, m.
-    """
-    r = ports - centres
-    block = np.zeros((len(r), 6, 6))
-    block[:, np.arange(6), np.arange(6)] = 1.0
-    # −[r]ₓ, whose zero diagonal stays +0.0 (a −0.0 there would be dropped as any zero is)
-    block[:, [0, 0, 1, 1, 2, 2], [4, 5, 3, 5, 3, 4]] = np.stack([r[:, 2], -r[:, 1], -r[:, 2], r[:, 0],
-                                                                r[:, 1], -r[:, 0]], axis=1)
-    return block
 
 
 def _port_map(model, layout, constraints):
@@ -288,7 +258,7 @@ def _port_map(model, layout, constraints):
     port_nodes = np.array([layout.index.points[port] for _, port in bodies], int)
     centre_nodes = np.array([layout.index.rigids[body.name] for body, _ in bodies], int)
     ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
-    kinematics = _port_kinematics(layout.positions[port_nodes], layout.positions[centre_nodes])
+    kinematics = port_kinematics(layout.positions[port_nodes], layout.positions[centre_nodes])
     if not first.all():
         joined = constraints.new_rows(6 * np.count_nonzero(~first)).reshape(-1, 6, 1)
         constraints.add(joined, ports[~first][:, None, :], np.eye(6))

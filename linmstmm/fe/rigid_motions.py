@@ -217,13 +217,36 @@ def _held_everywhere(model, layout) -> bool:
     components. Then there is no rigid motion: weighted, each such point's six held
     rows are unit upper triangular on its segment's motions (their least singular
     value above 1/3, far above REDUNDANT_CONSTRAINT of the largest), and further
-    rows only add rank."""
-    clamped = [layout.index.points[point] for point, fixed in model.boundary.items() if all(fixed)]
+    rows only add rank.
+
+    The segments are joined here on the points and mass centres alone (a beam's
+    interior nodes lie in its ends' segment), one union–find step per port, spring
+    that releases nothing and beam: a few dozen steps where the mesh's edge arrays
+    and :func:`_components`' passes over them cost twice as much."""
+    index = layout.index
+    clamped = [index.points[point] for point, fixed in model.boundary.items() if all(fixed)]
     if not clamped:
         return False
-    edges, joints = _edges(model, layout)
-    segments = _components(edges[~joints], layout.n_nodes)
-    return bool(np.bincount(segments[clamped], minlength=segments.max() + 1).all())
+    points = index.points
+    joins = [(index.rigids[body.name], points[port]) for body in model.rigids for port in body.ports]
+    joins += [(points[spring.ends[0]], points[spring.ends[1]]) for spring in model.springs
+              if spring.release is None or not any(spring.release)]
+    joins += [(points[beam.ends[0]], points[beam.ends[1]]) for beam in model.beams]
+    parent = list(range(len(points) + len(index.rigids)))
+    segments = len(parent)
+    for a, b in joins:
+        a, b = _root(parent, a), _root(parent, b)
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+            segments -= 1
+    return len({_root(parent, node) for node in clamped}) == segments
+
+
+def _root(parent: list, node: int) -> int:
+    """The root of ``node`` in the union–find forest ``parent``, halving the path to it."""
+    while parent[node] != node:
+        parent[node] = node = parent[parent[node]]
+    return node
 
 
 def _kinetic_directions(motions, M, weight):

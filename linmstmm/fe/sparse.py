@@ -165,11 +165,29 @@ def scipy_csr(matrix) -> sp.csr_matrix:
         matrix = compressed_rows(matrix)
     if not isinstance(matrix, Compressed):
         return matrix.tocsr()
-    index = np.int32 if max(matrix.shape[1], len(matrix.data)) < 2 ** 31 else np.int64
+    index = index_type(matrix.shape[1], len(matrix.data))
     csr = sp.csr_matrix((matrix.data, matrix.indices.astype(index, copy=False),
                          matrix.indptr.astype(index, copy=False)), shape=matrix.shape)
     csr.has_sorted_indices = True
     return csr
+
+
+def index_type(n_cols: int, n_entries: int) -> type:
+    """The index type scipy gives a CSR matrix's ``indices`` and ``indptr``: int32 where
+    every column index and entry count fits, else int64.
+
+    Parameters
+    ----------
+    n_cols : int
+        The matrix's columns.
+    n_entries : int
+        Its stored entries.
+
+    Returns
+    -------
+    numpy.int32 or numpy.int64
+    """
+    return np.int32 if max(n_cols, n_entries) < 2 ** 31 else np.int64
 
 
 def symmetric_part(matrix) -> sp.csr_matrix:

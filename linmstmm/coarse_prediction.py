@@ -34,6 +34,12 @@ SINGULAR_PENCIL = 1e-12
 #: Unknowns of the predicting FE model above which its eigenproblem is solved sparse
 #: (see :func:`coarse_predictions`).
 DENSE_PREDICTION = 400
+#: Eigenvalues wanted of a dense standard form up to which only they are found, by
+#: bisection (syevx); beyond, all of them at once (dsyev: QR, dsterf) costs less: the
+#: launcher's 68 lowest of 84 unknowns 1.2 against 0.2 ms, of 180 2.4 against 0.8 ms
+#: (at 12 of 84, 0.29 against 0.17 ms, but the few a solve of ten modes predicts stay
+#: to the bit those of the generalized solver sygvx).
+BISECTED = 40
 #: Coarse pencils kept (:func:`coarse_pencil`; a model's meshes, least recently used dropped first).
 PENCILS_KEPT = 16
 #: Elements per beam the predicting mesh may take.
@@ -46,15 +52,16 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
 
     elements_per_beam : Hermite elements per beam; bending frequencies come
     out high by about (βh)⁴/720 relative, h the element length. The dense
-    generalized eigenproblem (K, M), its lowest eigenvalues only; where M is
-    singular (massless unknowns) by QZ, whose infinite eigenvalues are dropped.
+    generalized eigenproblem (K, M) in its kept standard form: its lowest
+    eigenvalues only, or all at once where more than BISECTED are wanted; where M
+    is singular (massless unknowns) by QZ, whose infinite eigenvalues are dropped.
     shift : (rad/s)², below the lowest elastic eigenvalue (half a coarser mesh's
     lowest), given for a refined mesh: where every unknown carries mass and there
     are more than DENSE_PREDICTION of them, sparse block shift-invert Lanczos about
     −shift (:mod:`linmstmm.block_lanczos`, to the prediction's accuracy: on the
     second launcher's 1284 unknowns its 112 lowest in 17 ms, against 55 ms by
     ARPACK to machine precision and far more dense, whose Cholesky route's lowest
-    eigenvalue was 2.8e-3 off there); else all eigenvalues of the dense standard form.
+    eigenvalue was 2.8e-3 off there).
     The lowest as many as the FE model has rigid-body modes are theirs, and dropped
     (a threshold relative to the largest would drop a soft strip's first bending
     modes with them).
@@ -200,10 +207,9 @@ def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None) -
     any order: by block shift-invert Lanczos about −shift
     (:func:`~linmstmm.block_lanczos.lowest_eigenvalues`) where a shift is given,
     every unknown carries mass and there are more than DENSE_PREDICTION; else on the
-    kept standard form, a refined mesh's (a shift given: many wanted) all at once
-    (QR, dsterf; 0.8 against 2.4 ms by bisection for the launcher's 68 lowest of 180),
-    otherwise the lowest by bisection (syevx); by QZ where M is singular, the
-    infinite eigenvalues dropped."""
+    kept standard form, the lowest by bisection (syevx), or all at once (QR, dsterf)
+    where more than BISECTED are wanted; by QZ where M is singular, the infinite
+    eigenvalues dropped."""
     if shift is not None and pencil.K.shape[0] > DENSE_PREDICTION and np.all(pencil.assembly.M.diagonal() != 0):
         lam = _sparse_lowest(pencil, count, shift)
         if lam is not None:
@@ -212,7 +218,7 @@ def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None) -
         K, M = _regular_pencil(pencil.K, pencil.M)
         lam = scipy.linalg.eigvals(K, M)
         return lam[np.isfinite(lam)].real
-    if shift is not None:
+    if count > BISECTED:
         return scipy.linalg.eigh(pencil.reduced, eigvals_only=True, driver="ev", lower=True)
     return scipy.linalg.eigh(pencil.reduced, eigvals_only=True, subset_by_index=[0, count - 1], driver="evx",
                              lower=True)

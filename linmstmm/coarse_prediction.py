@@ -59,7 +59,7 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
     lowest), given for a refined mesh: where every unknown carries mass and there
     are more than DENSE_PREDICTION of them, sparse block shift-invert Lanczos about
     −shift (:mod:`linmstmm.block_lanczos`, to the prediction's accuracy: on the
-    second launcher's 1284 unknowns its 112 lowest in 17 ms, against 55 ms by
+    second launcher's 1284 unknowns its 112 lowest in 19 ms, against 54 ms by
     ARPACK to machine precision and far more dense, whose Cholesky route's lowest
     eigenvalue was 2.8e-3 off there).
     The lowest as many as the FE model has rigid-body modes are theirs, and dropped

@@ -21,6 +21,10 @@ does not close the carry, entered with the state of its other side: ``set`` its
 own selection, ``other set`` the other side's) or ``FROM_TIP`` (a boundary end
 or a closing cut's side, ``set`` its selection); the column sets of the
 selections and of the joints' jumps.
+
+Kept whole: numba invalidates a cached kernel when the file that defines it
+changes, not when a kernel it calls in another file does; split, an edit to
+the record's accessors would leave the walk running the old code from the cache.
 """
 from __future__ import annotations
 

@@ -50,8 +50,8 @@ def compiled_walk(deduction, final_carries: int) -> tuple[dict, Constants, tuple
      joints) = _walked(arrays, final_carries, ROOM_AN_INPUT * arrays[3].shape[0])
     constants = _constants(carries, other_inputs, joints)
     matrices = np.zeros((matrix_sets.size, 12, 12))
-    for k in np.flatnonzero(matrix_sets).tolist():
-        code = int(matrix_sets[k])
+    selected = np.flatnonzero(matrix_sets)
+    for k, code in zip(selected.tolist(), matrix_sets[selected].tolist()):
         selection = selections[abs(code) - 1]
         matrices[k, :, :selection.shape[1]] = selection if code > 0 else -selection
     constants.fill(deduction, matrices)
@@ -95,36 +95,40 @@ def _walk_input(deduction) -> tuple[tuple, list]:
         return set_of[link]
 
     root_set = selection_set(topology.root if topology.root[0] == "boundary" else ("cut", topology.root[1], 0))
-    kinds, input_start, links, joints = [], [0], [], []
-    for e in topology.order:
+    order = topology.order
+    kinds, input_start, links, joints = [], [0], [], []  # links and joints flat, four and three a row
+    for e in order:
         element = elements[e]
         kinds.append(_KIND_CODES[element.kind])
         for p in element.inputs:
             link = element.ports[p].link
             if link[0] == "element":
-                links.append((FROM_ELEMENT, link[1], 0, 0))
+                links += (FROM_ELEMENT, link[1], 0, 0)
             elif link[0] == "cut" and not topology.cuts[link[1]].closing:
                 _, c, side = link
-                links.append((FROM_CUT, 2 * c + side, selection_set(link), selection_set(("cut", c, 1 - side))))
+                links += (FROM_CUT, 2 * c + side, selection_set(link), selection_set(("cut", c, 1 - side)))
             else:
-                links.append((FROM_TIP, 0, selection_set(link), 0))
-        input_start.append(len(links))
+                links += (FROM_TIP, 0, selection_set(link), 0)
+        input_start.append(len(links) // 4)
         if e in deduction.jump_columns:
             released = element.record.released
-            joints.append((released.size, int((released < 3).sum()), len(sets)))
+            joints += (released.size, int((released < 3).sum()), len(sets))
             sets.append(deduction.jump_selection(e)[0])
             selections.append(None)
         else:
-            joints.append((-1, -1, -1))
-    sizes = np.array([columns.size for columns in sets], dtype=np.int64)
-    set_start = np.zeros(sizes.size + 1, dtype=np.int64)
-    np.cumsum(sizes, out=set_start[1:])
-    arrays = (np.array(kinds, dtype=np.int64), np.array(topology.order, dtype=np.int64),
+            joints += _NO_JOINT
+    set_start = np.zeros(len(sets) + 1, dtype=np.int64)
+    np.cumsum([columns.size for columns in sets], out=set_start[1:])
+    arrays = (np.array(kinds, dtype=np.int64), np.array(order, dtype=np.int64),
               np.array(input_start, dtype=np.int64), np.array(links, dtype=np.int64).reshape(-1, 4),
               np.array(joints, dtype=np.int64).reshape(-1, 3), np.concatenate(sets).astype(np.int64, copy=False),
               set_start, root_set, topology.root[0] == "boundary", deduction.full_order, len(elements),
               len(topology.cuts))
     return arrays, selections
+
+
+#: A joint's entry for an element that is none (:func:`_walk_input`).
+_NO_JOINT = (-1, -1, -1)
 
 
 def _constants(carries: np.ndarray, other_inputs: np.ndarray, joints: np.ndarray) -> Constants:

@@ -31,6 +31,8 @@ point loads of a forced carry enter as jumps of the state
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
@@ -55,13 +57,21 @@ _RELEASE_ROW_KIND = np.array([3, 3, 3, 2, 2, 2])
 
 
 def boundary_selection(fixed) -> np.ndarray:
-    """(12, 6) map from a boundary end's six unknowns to its state vector.
+    """(12, 6) map from a boundary end's six unknowns to its state vector, read-only (one
+    array for every end with the same ``fixed`` components, made once).
 
     Component c is a free displacement (row c) unless fixed, then its force
     (row FORCE_INDEX[c]) is the unknown.
     """
+    return _boundary_selection(np.asarray(fixed, dtype=bool).tobytes())
+
+
+@functools.lru_cache(maxsize=64)
+def _boundary_selection(fixed: bytes) -> np.ndarray:
+    """:func:`boundary_selection` of the six ``fixed`` flags as bytes."""
     selection = np.zeros((12, 6))
-    selection[np.where(fixed, FORCE_INDEX, np.arange(6)), np.arange(6)] = 1.0
+    selection[np.where(np.frombuffer(fixed, dtype=bool), FORCE_INDEX, np.arange(6)), np.arange(6)] = 1.0
+    selection.flags.writeable = False  # shared by every caller
     return selection
 
 

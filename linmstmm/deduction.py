@@ -56,14 +56,14 @@ _CUT_SIGN = np.diag(np.r_[np.ones(6), -np.ones(6)])
 _RELEASE_ROW_KIND = np.array([3, 3, 3, 2, 2, 2])
 
 
-def boundary_selection(fixed) -> np.ndarray:
-    """(12, 6) map from a boundary end's six unknowns to its state vector.
-
-    Component c is a free displacement (row c) unless fixed, then its force
-    (row FORCE_INDEX[c]) is the unknown.
-    """
+@functools.lru_cache(maxsize=64)
+def boundary_selection(fixed: bytes) -> np.ndarray:
+    """(12, 6) map from a boundary end's six unknowns (``fixed``: which are fixed, as bool
+    bytes) to its state vector, read-only and made once: component c is a free displacement
+    (row c) unless fixed, then its force (row FORCE_INDEX[c]) is the unknown."""
     selection = np.zeros((12, 6))
-    selection[np.where(fixed, FORCE_INDEX, np.arange(6)), np.arange(6)] = 1.0
+    selection[np.where(np.frombuffer(fixed, dtype=bool), FORCE_INDEX, np.arange(6)), np.arange(6)] = 1.0
+    selection.flags.writeable = False  # shared by every caller
     return selection
 
 
@@ -193,7 +193,7 @@ class Deduction:
         if link not in self._tips:
             if link[0] == "boundary":
                 columns = self._boundary_columns[link[1]]
-                selection = boundary_selection(self.topology.boundaries[link[1]].fixed)
+                selection = boundary_selection(self.topology.boundaries[link[1]].fixed.tobytes())
             else:
                 _, c, side = link
                 columns = self._cut_columns[c]

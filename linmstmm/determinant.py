@@ -256,30 +256,10 @@ def _kernel_operations(program, orthos: np.ndarray) -> tuple:
 def _assembly(program) -> tuple[np.ndarray, np.ndarray]:
     """Where each entry of Ū_all comes from: (sources (E,), targets (E,)) int64, entry
     ``sources[e]`` of a frequency's workspace added to entry ``targets[e]`` of the
-    transposed Ū_all (N, N) flattened, in the order the blocks stand (the root state
-    and −Z_root share the first twelve rows: entries met twice add up in that order);
-    rows and columns released are left out."""
+    transposed Ū_all (N, N) flattened (:func:`linmstmm._assembly_kernels.assembly`)."""
+    from linmstmm._assembly_kernels import assembly  # numba loads here, not at import
+
     p = program
-    order, kept = p.order, p.kept_columns.size
-    row_of, column_of = _kept_at(p.kept_rows, order), _kept_at(p.kept_columns, order)
-    sources, targets = [], []
-    start = 0
-    for position, slot in enumerate([p.root, p.root_row, *p.geometric_rows]):
-        rows, width = p.slot_rows[slot], p.slot_width[slot]
-        columns = column_of[p.slot_columns[p.slot_columns_start[slot]:p.slot_columns_start[slot + 1]]]
-        entries = p.slot_offset[slot] + np.arange(rows * width).reshape(rows, width)
-        row = row_of[start:start + rows][:, None]
-        kept_entries = (row >= 0) & (columns[None, :] >= 0)
-        sources.append(entries[kept_entries])
-        targets.append((columns[None, :] * kept + row)[kept_entries])
-        if position > 0:  # the root state and −Z_root share the first twelve rows
-            start += rows
-    return np.concatenate(sources).astype(np.int64), np.concatenate(targets).astype(np.int64)
-
-
-def _kept_at(kept: np.ndarray, order: int) -> np.ndarray:
-    """(order,) int64: where each of the full Ū_all's ``order`` rows (or columns) stands among
-    the ``kept`` ones (k,) of the compiled Ū_all, -1 for one released."""
-    position = np.full(order, -1, dtype=np.int64)
-    position[kept] = np.arange(kept.size)
-    return position
+    blocks = np.concatenate(([p.root, p.root_row], p.geometric_rows)).astype(np.int64)
+    return assembly(p.slot_offset, p.slot_rows, p.slot_width, p.slot_columns, p.slot_columns_start, blocks,
+                    p.kept_rows, p.kept_columns, p.order)

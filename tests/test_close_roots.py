@@ -20,10 +20,12 @@ import linmstmm as lm
 STEEL_ROD = dict(material=dict(E=2.0e11, G=8.0e10, rho=7800.0), A=1.0e-3, Iy=3.0e-7, J=2.0e-7, Ip=4.2e-7)
 
 
-def cantilever(iz: float) -> lm.Model:
-    """A 1.5 m steel cantilever along x, clamped at "root", with Iz = ``iz`` m⁴."""
+def cantilever(iz: float, shear: float = 8.0e10) -> lm.Model:
+    """A 1.5 m steel cantilever along x, clamped at "root", with Iz = ``iz`` m⁴ and the
+    shear modulus ``shear`` (Pa)."""
     points = {"root": np.zeros(3), "tip": np.array([1.5, 0.0, 0.0])}
-    beam = make_beam("b", "root", "tip", points, Iz=iz, **STEEL_ROD)
+    rod = {**STEEL_ROD, "material": {**STEEL_ROD["material"], "G": shear}}
+    beam = make_beam("b", "root", "tip", points, Iz=iz, **rod)
     return lm.Model("cantilever", points, beams=(beam,), boundary={"root": fixed()})
 
 
@@ -75,16 +77,12 @@ def test_bending_pairs_a_hair_apart_come_out_as_two_roots(split):
         assert max(abs(g / e - 1) for g, e in zip(got, exact)) < mp.mpf(10) ** -18
 
 
-def cantilever_hz(iz: float, count: int) -> np.ndarray:
+def cantilever_hz(iz: float, count: int, shear: float = 8.0e10) -> np.ndarray:
     """The steel cantilever's ``count`` lowest frequencies (Hz) in closed form: bending
-    in each plane, (β/L)² √(E I / ρA) / 2π with β the roots of cos β + 1 / cosh β
-    (cos β cosh β + 1 = 0 divided by cosh β, which keeps it near 1 at large β);
-    axial and torsion, (2n − 1) c / 4L with c = √(E/ρ) and √(G J / ρ Ip)."""
-    with mp.workdps(30):
-        betas = [mp.findroot(lambda x: mp.cos(x) + 1 / mp.cosh(x), (k - 0.5) * mp.pi) for k in range(1, count + 1)]
-        bending = [float((beta / mp.mpf(1.5)) ** 2 * mp.sqrt(mp.mpf(2.0e11) * mp.mpf(i) / (mp.mpf(7800.0) * mp.mpf(1.0e-3)))
-                         / (2 * mp.pi)) for beta in betas for i in (3.0e-7, iz)]
-    waves = [np.sqrt(2.0e11 / 7800.0), np.sqrt(8.0e10 * 2.0e-7 / (7800.0 * 4.2e-7))]
+    in each plane (:func:`bending_hz`); axial and torsion, (2n − 1) c / 4L with
+    c = √(E/ρ) and √(G J / ρ Ip)."""
+    bending = [bending_hz(k, i) for k in range(1, count + 1) for i in (3.0e-7, iz)]
+    waves = [np.sqrt(2.0e11 / 7800.0), np.sqrt(shear * 2.0e-7 / (7800.0 * 4.2e-7))]
     other = [(2 * n - 1) * c / (4 * 1.5) for c in waves for n in range(1, count + 1)]
     return np.sort(bending + other)[:count]
 
@@ -101,6 +99,42 @@ def test_bending_pairs_closer_than_a_count_resolves_are_each_found(gap, rtol):
     iz = 3.0e-7 * (1 + gap) ** 2
     result = lm.natural_frequencies(cantilever(iz), count=30, rtol=rtol)
     np.testing.assert_allclose(result.frequencies_hz, cantilever_hz(iz, 30), rtol=rtol or 1e-9)
+
+
+def bending_hz(k: int, second_moment: float) -> float:
+    """The steel cantilever's k-th bending frequency in a plane of ``second_moment`` (m⁴),
+    Hz: (β/L)² √(E I / ρA) / 2π, β the k-th root of cos β + 1 / cosh β (cos β cosh β + 1
+    = 0 divided by cosh β, which keeps it near 1 at large β)."""
+    with mp.workdps(30):
+        beta = mp.findroot(lambda x: mp.cos(x) + 1 / mp.cosh(x), (k - 0.5) * mp.pi)
+        stiffness = mp.mpf(2.0e11) * mp.mpf(second_moment) / (mp.mpf(7800.0) * mp.mpf(1.0e-3))
+        return float((beta / mp.mpf(1.5)) ** 2 * mp.sqrt(stiffness) / (2 * mp.pi))
+
+
+def torsion_beside_bending(k: int, offset: float) -> float:
+    """The shear modulus (Pa) that puts the steel cantilever's first torsion root,
+    √(G J / ρ Ip) / 4L Hz, ``offset`` (relative) above its k-th bending root."""
+    return (4 * 1.5 * bending_hz(k, 3.0e-7) * (1 + offset)) ** 2 * 7800.0 * 4.2e-7 / 2.0e-7
+
+
+@pytest.mark.parametrize("engine", ["compiled", "numpy"])
+@pytest.mark.parametrize("k, offset", [(k, offset) for k in (3, 6, 8)
+                                       for offset in (-1e-4, -1e-5, -1e-6, 1e-6, 5e-6, 2e-5, 1e-4)])
+def test_a_double_root_with_a_simple_one_close_beside_it(k, offset, engine):
+    """Equal bending planes (every bending root double) and the first torsion root
+    ``offset`` (relative) from the k-th: every count from just below the double root
+    to past the torsion root gives the closed form (:func:`cantilever_hz`) to 1e-9.
+    With the torsion root just above, a count that ended on the double root gave it
+    once with the torsion root in its place, or stopped in mpmath refining it as a
+    simple root ("does not settle ... at 172 digits")."""
+    shear = torsion_beside_bending(k, offset)
+    model = cantilever(3.0e-7, shear)
+    exact = cantilever_hz(3.0e-7, 2 * k + 4, shear)
+    for count in range(2 * k - 2, 2 * k + 4):
+        result = lm.natural_frequencies(model, count, engine=engine)
+        np.testing.assert_allclose(result.frequencies_hz, exact[:count], rtol=1e-9, atol=0,
+                                   err_msg=f"count {count}")
+        assert result.note == ""
 
 
 @pytest.mark.parametrize("gap", [1e-6, 1e-7])

@@ -171,8 +171,9 @@ def separated(finder, roots: list[float]) -> list[float]:
     :attr:`unseparated` says so (root -> (multiplicity, radius, rad/s)):
     ``natural_frequencies`` then separates them in mpmath
     (:func:`~linmstmm.precision.separated_cluster`), or names them in its note.
-    Before any count, a multiple root whose pencil shows a distinct root nearby
-    is split into them (:func:`_apart_by_offsets`).
+    First, a multiple root whose pencil shows a distinct root nearby is split
+    into them where a count that leaves that root out finds fewer copies
+    (:func:`_apart_by_offsets`).
     """
     roots = _apart_by_offsets(finder, roots)
     tally = Counter(roots)
@@ -182,17 +183,11 @@ def separated(finder, roots: list[float]) -> list[float]:
     if not multiple:
         return roots
     radii = [finder._circle_radius(r, distinct) for r in multiple]
-    tight = [finder.stiffness_count([], r - radius / 100, r + radius / 100) for r, radius in zip(multiple, radii)]
-    undecided = [i for i, count in enumerate(tight) if count is None]
-    circles = count_zeros_many(finder.log_det, [(multiple[i] - radii[i] / 100, multiple[i] + radii[i] / 100)
-                                                for i in undecided],
-                               max_points=CIRCLE_MAX_POINTS, initial_points=CIRCLE_POINTS) if undecided else []
-    for i, count in zip(undecided, circles):
-        tight[i] = count
+    tight = _counts_within(finder, multiple, [radius / 100 for radius in radii])
     separated = list(roots)
     for r, radius, count in zip(multiple, radii, tight):
         m = finder._counted.get(r, tally[r])  # (``roots`` may end inside a multiple root)
-        if count == m or (r == distinct[-1] and count > tally[r]):
+        if count == m or (r == distinct[-1] and count is not None and count > tally[r]):
             continue
         try:
             members = finder._isolate(r - radius, r + radius, m, [r])
@@ -234,8 +229,10 @@ def beside(finder, polished) -> list[list[float]]:
 
 def _apart_by_offsets(finder, roots: list[float]) -> list[float]:
     """``roots`` with each multiple one whose pencil shows a distinct root beside it
-    (:func:`beside`) split: that root takes one of its copies. The counts of
-    :func:`separated` only say how many roots a circle holds."""
+    (:func:`beside`) split: that root takes one of its copies, unless a count across
+    the multiple root that leaves it out finds all the copies there
+    (:func:`_holds_its_copies`): it is then a root beside it, not one of them. The
+    counts of :func:`separated` only say how many roots a circle holds."""
     copies = {r: max(m, finder._counted.get(r, 1)) for r, m in Counter(roots).items()}
     multiple = sorted(r for r, m in copies.items() if m > 1)
     if not multiple:
@@ -246,11 +243,48 @@ def _apart_by_offsets(finder, roots: list[float]) -> list[float]:
     offsets.update((r, finder.offsets_at[r]) for r in known)
     split = list(roots)
     for r, near in zip(multiple, beside(finder, [(r, offsets[r]) for r in multiple])):
-        for member in near:
-            if any(abs(member - other) <= finder.rtol * other for other in split):
-                continue  # a root found already
+        near = [member for member in near if not any(abs(member - other) <= finder.rtol * other for other in split)]
+        if near and _holds_its_copies(finder, r, copies[r], near):
+            continue
+        for member in near:  # (each not a root found already)
             if split.count(r) > 1:
                 split.remove(r)
             finder._counted[r] = max(finder._counted.get(r, 1) - 1, 1)
             split.append(member)
     return sorted(split)
+
+
+def _holds_its_copies(finder, root: float, copies: int, near: list[float]) -> bool:
+    """Whether ``root`` (rad/s) holds all its ``copies`` on its own: a count over half
+    the distance to the nearest of the distinct roots ``near`` (rad/s) beside it finds
+    them all, so those lie outside what gave it its multiplicity and take none of its
+    copies. That count becomes its multiplicity (:attr:`RootFinder._counted`), so that a
+    later count of it over a wider circle does not take them in.
+
+    A cantilever with equal bending planes whose first torsion root lies 2e-5 above
+    a bending double root, asked for a count that ends on the double root: the
+    torsion root, found beside it but above the roots asked for, took one of its
+    copies, and the double root was reported once, the torsion root in its place, or
+    refined in mpmath as a simple root that never settled.
+    """
+    radius = min(abs(member - root) for member in near) / 2
+    held = _counts_within(finder, [root], [radius])[0]
+    if held != copies:
+        return False
+    finder._counted[root] = held
+    finder._circles[root] = radius
+    return True
+
+
+def _counts_within(finder, centres: list[float], radii: list[float]) -> list[int | None]:
+    """The natural frequencies within ``radii`` (rad/s) of ``centres`` (rad/s), one per
+    centre: the Wittrick–Williams count across each, where it decides, else the
+    argument principle over the circle (all those in one count); None where neither
+    can be made."""
+    counts = [finder.stiffness_count([], c - radius, c + radius) for c, radius in zip(centres, radii)]
+    undecided = [i for i, count in enumerate(counts) if count is None]
+    circles = count_zeros_many(finder.log_det, [(centres[i] - radii[i], centres[i] + radii[i]) for i in undecided],
+                               max_points=CIRCLE_MAX_POINTS, initial_points=CIRCLE_POINTS) if undecided else []
+    for i, count in zip(undecided, circles):
+        counts[i] = None if isinstance(count, RuntimeError) else count
+    return counts

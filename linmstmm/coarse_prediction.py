@@ -109,10 +109,12 @@ class CoarsePencil:
         shape (n, n); None where M is not positive definite (massless unknowns).
 
         LAPACK's potrf and sygst, the first two steps of the generalized eigensolver
-        sygvx, made once per pencil: each prediction then runs only the standard
-        eigensolver syevx on C, whose eigenvalues are sygvx's on (K, M) to the bit
-        (tests/test_coarse_prediction.py), and a repeat solve of the second
-        launcher's ten lowest saves a quarter of its prediction.
+        sygvx, made once per pencil: each prediction then runs only a standard
+        eigensolver on C (:func:`_lowest_eigenvalues`). Up to BISECTED eigenvalues
+        it is syevx, whose eigenvalues are sygvx's on (K, M) to the bit
+        (tests/test_coarse_prediction.py); beyond, syev finds them all at once, not
+        to the bit of sygvx's (1e-10 apart on the launcher). A repeat solve of the second launcher's ten lowest
+        saves a quarter of its prediction.
         """
         factor, info = scipy.linalg.lapack.dpotrf(self.M, lower=1, clean=0)
         if info:

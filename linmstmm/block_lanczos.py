@@ -90,7 +90,7 @@ def lowest_eigenvalues(K, M, count: int, shift: float, seed: int = 0) -> np.ndar
         lower = _m_normalising_factor(block, m_block)
         if lower is None:
             return None
-        if size and size >= check:
+        if size >= check:
             theta, error = _ritz_values(rayleigh[:size, :size], lower, count)
             if np.all(error <= PRECISION * theta):
                 return np.sort(1.0 / theta - shift)

@@ -113,8 +113,8 @@ class CoarsePencil:
         eigensolver on C (:func:`_lowest_eigenvalues`). Up to BISECTED eigenvalues
         it is syevx, whose eigenvalues are sygvx's on (K, M) to the bit
         (tests/test_coarse_prediction.py); beyond, syev finds them all at once, not
-        to the bit of sygvx's (1e-10 apart on the launcher). A repeat solve of the second launcher's ten lowest
-        saves a quarter of its prediction.
+        to the bit of sygvx's (1e-10 apart on the launcher). A repeat solve of the
+        second launcher's ten lowest saves a quarter of its prediction.
         """
         factor, info = scipy.linalg.lapack.dpotrf(self.M, lower=1, clean=0)
         if info:

@@ -216,13 +216,11 @@ def _add_springs(model, layout, strains, stiffness, constraints):
     k = np.array([spring.k for spring in model.springs], float).reshape(-1, 6)
     k = k.ravel() if len(owners) == k.size else k[owners, components]   # every direction kept: all, in order
     rigid = np.isinf(k)
-    if not rigid.any():  # every direction a strain, taken as it is
-        strains.add(strains.new_rows(len(k))[:, None], cols, values)
-        stiffness.append(k)
-        return
-    strains.add(strains.new_rows(np.count_nonzero(~rigid))[:, None], cols[~rigid], values[~rigid])
-    stiffness.append(k[~rigid])
-    constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None], cols[rigid], values[rigid])
+    if rigid.any():  # else every direction a strain, taken as it is
+        constraints.add(constraints.new_rows(np.count_nonzero(rigid))[:, None], cols[rigid], values[rigid])
+        k, cols, values = k[~rigid], cols[~rigid], values[~rigid]
+    strains.add(strains.new_rows(len(k))[:, None], cols, values)
+    stiffness.append(k)
 
 
 def _add_rigid_masses(model, layout, mass):

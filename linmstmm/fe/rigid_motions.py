@@ -10,6 +10,7 @@ from linmstmm.fe.constraints import NEGLIGIBLE_ENTRY, REDUNDANT_CONSTRAINT
 from linmstmm.fe.layout import spring_rows
 from linmstmm.fe.masses import MASSLESS
 from linmstmm.fe.sparse import scipy_csr
+from linmstmm.union_find import components
 
 
 def _edges(model, layout) -> tuple[np.ndarray, np.ndarray]:
@@ -220,33 +221,20 @@ def _held_everywhere(model, layout) -> bool:
     rows only add rank.
 
     The segments are joined here on the points and mass centres alone (a beam's
-    interior nodes lie in its ends' segment), one union–find step per port, spring
-    that releases nothing and beam: a few dozen steps where the mesh's edge arrays
-    and :func:`_components`' passes over them cost twice as much."""
+    interior nodes lie in its ends' segment), one edge per port, spring that
+    releases nothing and beam: a few dozen edges where the mesh's edge arrays and
+    :func:`_components`' passes over them cost twice as much."""
     index = layout.index
     clamped = [index.points[point] for point, fixed in model.boundary.items() if all(fixed)]
     if not clamped:
         return False
     points = index.points
     joins = [(index.rigids[body.name], points[port]) for body in model.rigids for port in body.ports]
-    joins += [(points[spring.ends[0]], points[spring.ends[1]]) for spring in model.springs
-              if spring.release is None or not any(spring.release)]
+    joins += [(points[spring.ends[0]], points[spring.ends[1]])
+              for spring, joint in zip(model.springs, _released_any(model.springs)) if not joint]
     joins += [(points[beam.ends[0]], points[beam.ends[1]]) for beam in model.beams]
-    parent = list(range(len(points) + len(index.rigids)))
-    segments = len(parent)
-    for a, b in joins:
-        a, b = _root(parent, a), _root(parent, b)
-        if a != b:
-            parent[max(a, b)] = min(a, b)
-            segments -= 1
-    return len({_root(parent, node) for node in clamped}) == segments
-
-
-def _root(parent: list, node: int) -> int:
-    """The root of ``node`` in the union–find forest ``parent``, halving the path to it."""
-    while parent[node] != node:
-        parent[node] = node = parent[parent[node]]
-    return node
+    segments = components(len(points) + len(index.rigids), joins)
+    return np.unique(segments[clamped]).size == segments.max() + 1
 
 
 def _kinetic_directions(motions, M, weight):

@@ -15,8 +15,6 @@ numpy route.
 """
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 from numba import njit
 
@@ -294,7 +292,7 @@ def counter_terms(parts) -> tuple[np.ndarray, np.ndarray] | None:
     """
     T, n = parts.T, parts.T.shape[1]
     springs = _triplet_rows(parts.spring_strains, parts.spring_strains.n_rows)
-    bodies = _triplet_arrays(parts.rigid_mass)
+    bodies = parts.rigid_mass.joined()
     indptr, cols, values = _full_mass(T.shape[0], *bodies, np.zeros((0, 0, 12), np.int64), np.zeros((0, 0, 12, 12)))
     if springs is None or indptr.size == 0:
         return None
@@ -303,35 +301,10 @@ def counter_terms(parts) -> tuple[np.ndarray, np.ndarray] | None:
             ordered_congruence(T.indptr, T.indices, T.data, indptr, cols, values, n))
 
 
-def _triplet_arrays(triplets) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(rows, cols, values) of a :class:`~linmstmm.fe.layout._Triplets`, int64 and float64
-    (shared, :func:`_kept_arrays`: never written)."""
-    return _kept_arrays(triplets, len(triplets.rows))
-
-
 def _triplet_rows(triplets, n_rows) -> tuple | None:
-    """CSR arrays (:func:`_grouped_rows`) of ``triplets`` with ``n_rows`` rows, or None
-    (shared, :func:`_kept_rows`: never written)."""
-    return _kept_rows(triplets, n_rows, len(triplets.rows))
-
-
-#: Triplet objects whose arrays are kept (:func:`_kept_arrays`, :func:`_kept_rows`).
-TRIPLETS_KEPT = 8
-
-
-@functools.lru_cache(maxsize=TRIPLETS_KEPT)
-def _kept_arrays(triplets, pieces: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`_triplet_arrays` of ``triplets`` holding ``pieces`` pieces, made once for the
-    counter's and the coarse pencil's build, which take the same springs and bodies (a
-    triplet object is only ever added to, so its pieces tell its contents)."""
-    return tuple(np.concatenate(part[:pieces]).astype(dtype, copy=False) if pieces else np.zeros(0, dtype)
-                 for part, dtype in ((triplets.rows, np.int64), (triplets.cols, np.int64), (triplets.values, float)))
-
-
-@functools.lru_cache(maxsize=TRIPLETS_KEPT)
-def _kept_rows(triplets, n_rows: int, pieces: int) -> tuple | None:
-    """:func:`_triplet_rows` of ``triplets`` holding ``pieces`` pieces, made once (:func:`_kept_arrays`)."""
-    indptr, cols, values = _grouped_rows(n_rows, *_kept_arrays(triplets, pieces))
+    """CSR arrays (:func:`_grouped_rows`) of ``triplets`` (:class:`~linmstmm.fe.layout._Triplets`)
+    with ``n_rows`` rows, or None where they are not grouped by row."""
+    indptr, cols, values = _grouped_rows(n_rows, *triplets.joined())
     return None if indptr.size == 0 else (indptr, cols, values)
 
 
@@ -362,5 +335,5 @@ def pencil_forms(T, elements, parts) -> tuple[np.ndarray, np.ndarray] | None:
     stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
     mass = np.swapaxes(elements.to_local, 2, 3) @ elements.m[:, None] @ elements.to_local
     M, K, formed = _pencil(T.indptr, T.indices, T.data, T.shape[1], elements.rows, elements.dofs, elements.strain,
-                           elements.d, *springs, stiffness, *_triplet_arrays(parts.rigid_mass), mass)
+                           elements.d, *springs, stiffness, *parts.rigid_mass.joined(), mass)
     return (M, K) if formed else None

@@ -143,6 +143,7 @@ class _Triplets:
         self.rows, self.cols, self.values = [], [], []
         self.n_rows = 0
         self.repeats = repeats
+        self._joined = None   # joined(), made on first use, dropped when entries are added
 
     def add(self, rows, cols, values):
         shape = np.broadcast(rows, cols, values).shape
@@ -154,6 +155,17 @@ class _Triplets:
         self.rows.append(rows)
         self.cols.append(cols)
         self.values.append(values)
+        self._joined = None
+
+    def joined(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(rows, cols, values) of every entry, (nnz,) int64, int64 and float64: made
+        once until more entries are added, and shared (never written), so that the
+        counter and the coarse pencil of one model join them once."""
+        if self._joined is None:
+            self._joined = tuple(np.concatenate(part).astype(dtype, copy=False) if part else np.zeros(0, dtype)
+                                 for part, dtype in ((self.rows, np.int64), (self.cols, np.int64),
+                                                     (self.values, float)))
+        return self._joined
 
     def new_rows(self, count):
         """Indices of ``count`` fresh rows."""
@@ -184,7 +196,7 @@ class _Triplets:
         n_rows = self.n_rows if n_rows is None else n_rows
         if not self.rows:
             return Compressed("csr", np.zeros(n_rows + 1, int), np.zeros(0, int), np.zeros(0), (n_rows, n_cols))
-        rows, cols, values = (np.concatenate(part) for part in (self.rows, self.cols, self.values))
+        rows, cols, values = self.joined()
         if self.repeats:
             return compressed_of_summed(rows, cols, values, (n_rows, n_cols))
         nonzero = values != 0

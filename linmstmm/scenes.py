@@ -255,7 +255,6 @@ class SceneMaker:
         loaded, rocket = loaded_tube(model, bundle)
         self._tubes = {False: loaded, True: loaded - rocket}  # fired -> the tube in the base slot
         self._lumped: dict[tuple[int, bool], MassProps] = {}  # (slot, fired) -> :meth:`_lumped_tube`
-        self._offsets: dict[int, np.ndarray] = {}  # slot -> its offset from the base slot, m
         self._sums = {(): bundle.frame(self.axes)}  # slots added so far -> frame + those tubes
         moving = set()
         for element in map(model.element, bundle.tube):
@@ -291,9 +290,7 @@ class SceneMaker:
         """The tube of ``slot`` as a rigid mass there (kg, m, kg m²), loaded or, where
         ``fired``, without its rocket; made once, when a scene first sums it."""
         if (slot, fired) not in self._lumped:
-            if slot not in self._offsets:
-                self._offsets[slot] = self.bundle.offset(slot, self.axes)
-            self._lumped[slot, fired] = self._tubes[fired].shifted(self._offsets[slot])
+            self._lumped[slot, fired] = self._tubes[fired].shifted(self.bundle.offset(slot, self.axes))
         return self._lumped[slot, fired]
 
     def values(self, tube: int, rockets_fired=frozenset()) -> dict[str, float]:

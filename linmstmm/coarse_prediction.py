@@ -114,7 +114,8 @@ class CoarsePencil:
         it is syevx, whose eigenvalues are sygvx's on (K, M) to the bit
         (tests/test_coarse_prediction.py); beyond, syev finds them all at once, not
         to the bit of sygvx's (1e-10 apart on the launcher). A repeat solve of the
-        second launcher's ten lowest saves a quarter of its prediction.
+        second launcher's ten lowest saved a quarter of its prediction (one asking
+        the same count now takes the kept predictions, :func:`predict_frequencies`).
         """
         factor, info = scipy.linalg.lapack.dpotrf(self.M, lower=1, clean=0)
         if info:
@@ -131,7 +132,7 @@ def coarse_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
     :func:`~linmstmm.fe.node_constraints.kept_node_constraints`; its rigid-body
     modes counted, not formed), the same after (a Model cannot change; see
     :mod:`linmstmm.compiled_model`). ``coarse_pencil.cache_clear()`` drops every
-    pencil and every node elimination kept.
+    pencil, node elimination and prediction kept.
 
     Parameters
     ----------
@@ -183,8 +184,9 @@ def _unit_scaled(K: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndarray, 
 
 
 def _forget_pencils() -> None:
-    """Drop every coarse pencil and node elimination kept (:func:`coarse_pencil`)."""
+    """Drop every coarse pencil, node elimination and prediction kept (:func:`coarse_pencil`)."""
     _pencil.cache_clear()
+    _kept_predictions.cache_clear()
     kept_node_constraints.cache_clear()
 
 
@@ -262,7 +264,30 @@ def predict_frequencies(model: Model, count: int) -> np.ndarray:
     where more would be needed: without predictions the scan-based search took
     24,708 evaluations for the second launcher's 100 lowest on a mesh of 1,800
     unknowns, which a twice finer wave per element asked for).
+
+    The last answer is kept (:func:`_kept_predictions`): a parameter study's first
+    step asks again, with the count its root search asked for, to measure the
+    predictions' error at the roots found (:func:`linmstmm.warm_starts.prediction_error`),
+    and a repeat solve of a model asks again; neither solves the eigenproblem anew.
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    count : int
+        Elastic frequencies wanted, >= 1.
+
+    Returns
+    -------
+    numpy.ndarray, shape (m,), rad/s
+        Ascending, m <= count (:func:`coarse_predictions`); a copy, the caller's own.
     """
+    return _kept_predictions(model, count).copy()
+
+
+@functools.lru_cache(maxsize=1)
+def _kept_predictions(model: Model, count: int) -> np.ndarray:
+    """:func:`predict_frequencies` made anew."""
     predictions = coarse_predictions(model, count, 2)
     if not model.beams or not predictions.size:
         return predictions

@@ -40,14 +40,15 @@ def largest_difference(values: np.ndarray, found: np.ndarray) -> float:
     return float(np.max(np.abs(values[:ranks] / found[:ranks] - 1))) if ranks else math.nan
 
 
-@single_blas_thread  # as the search's own predictions: the eigenproblem is small
+@single_blas_thread  # as the search's own predictions, where they are not kept: the eigenproblem is small
 def prediction_error(model: Model, count: int, found: np.ndarray) -> float:
     """Largest relative error of the coarse predictions of ``model`` at its lowest
     frequencies ``found`` (Hz), as many as the root search asks for ``count``
-    (:meth:`~linmstmm.roots.RootFinder.find`: the model's coarse mesh is kept from
-    that search, so only its eigenproblem is solved again); nan without predictions."""
+    (:meth:`~linmstmm.roots.RootFinder.find`: the predictions that search made are
+    kept, :func:`~linmstmm.coarse_prediction.predict_frequencies`, and nothing is
+    solved again); nan without predictions."""
     from linmstmm.coarse_prediction import predict_frequencies
-    from linmstmm.roots import PREDICTION_MARGIN
+    from linmstmm.roots.settings import predictions_wanted
 
-    predicted = predict_frequencies(model, count + PREDICTION_MARGIN + count // 10)
+    predicted = predict_frequencies(model, predictions_wanted(count))
     return largest_difference(predicted / (2 * np.pi), found)

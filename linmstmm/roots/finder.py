@@ -21,7 +21,7 @@ from linmstmm.roots.settings import (
     MIN_POINTS_PER_OCTAVE,
     MIN_RTOL,
     POINTS_PER_OCTAVE,
-    PREDICTION_MARGIN,
+    predictions_wanted,
 )
 
 
@@ -249,7 +249,7 @@ class RootFinder:
     def _found(self, count: int | None, omega_max: float | None) -> list[float]:
         """The roots :meth:`find` returns, as a list (rad/s)."""
         if count is not None and self.predictor is not None:
-            predictions = self.predictor(count + PREDICTION_MARGIN + count // 10)
+            predictions = self.predictor(predictions_wanted(count))
             wanted = count if predictions.size >= count else self._existing(count)
             if wanted == 0:
                 return []

@@ -54,6 +54,24 @@ FLOOR_CHECK = 1e3
 #: Predictions asked for beyond the count (plus a tenth of it): a coarse mesh can rank
 #: a true root among the first N one or two places too high (the launcher's 100th).
 PREDICTION_MARGIN = 2
+
+
+def predictions_wanted(count: int) -> int:
+    """How many predictions a search for the lowest ``count`` roots asks for: PREDICTION_MARGIN
+    and a tenth of ``count`` beyond it.
+
+    Parameters
+    ----------
+    count : int
+        Roots wanted.
+
+    Returns
+    -------
+    int
+    """
+    return count + PREDICTION_MARGIN + count // 10
+
+
 #: Predictions whose lowest is below this many times the floor are not used (the scan
 #: from the floor searches instead): with an absolute floor of 1e-3 rad/s a free strip
 #: 9.9 m long with Iz = 1e-12 m⁴ (first bending mode 1.4e-3 rad/s) was refused; the

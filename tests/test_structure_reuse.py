@@ -13,7 +13,9 @@ import pytest
 from linmstmm import counter_parts, model_structure, rigid_motion
 from linmstmm.compiled_model import forget_compiled_models
 from linmstmm.fe.assembly import constrained_parts
+from linmstmm.fe.layout import _layout
 from linmstmm.fe.node_constraints import kept_node_constraints, node_constraints
+from linmstmm.fe.port_following import kept_port_following, port_following
 from linmstmm.wittrick_williams import ModeCounter
 from linmstmm.model import ModelError, load_model
 from test_program_reuse import _edited, _models
@@ -71,26 +73,34 @@ def test_a_counter_on_a_kept_elimination_is_the_counter_built_afresh(model):
         assert len(kept) == len(fresh)
         for ours, theirs in zip(kept, fresh):
             assert ours.shape == theirs.shape and np.array_equal(ours, theirs)
-        reused += same and counter_parts._eliminations.get(edited, lambda m: None) is not None
+        reused += same and counter_parts._springs.get(edited, lambda m: None) is not None
     if model.name.startswith("MLRS"):
         assert reused  # the launcher's structure is of the kind kept, and served
 
 
 def test_the_kept_elimination_is_the_first_models_and_makes_the_full_builds_arrays():
     """The layout kept for a structure is the one the first model's node constraints made
-    their T with; the next model of the structure takes its T from it, the arrays (types
-    included) of that model's full build, with the same masters."""
+    their T with, and equals the layout made anew for every next model of the structure;
+    that model takes its T from it, the arrays (types included) of its full build, with
+    the same masters."""
     model = load_model(MODELS / "mlrs/mlrs.toml")
     forget_compiled_models()
     ModeCounter(model)
-    kept = counter_parts._eliminations.get(model, lambda m: None)
-    assert kept.following is kept_node_constraints(model).following
+    kept = counter_parts._springs.get(model, lambda m: None)
+    following = kept_node_constraints(model).following
+    assert kept is not None and kept_port_following(model, _layout(model, 1)) is following
     edited = [edit for edit in _edits(model)
               if model_structure.structure_of(edit) == model_structure.structure_of(model)]
     assert edited
     for edit in edited:
         ours = counter_parts.counter_parts(edit)
-        assert counter_parts._eliminations.get(edit, lambda m: None) is kept
+        assert counter_parts._springs.get(edit, lambda m: None) is kept
+        assert node_constraints(edit).following is following
+        fresh = port_following(edit, _layout(edit, 1))          # the layout made anew: the kept one
+        for name in ("arm_ends", "arm_starts", "arm_signs", "rows", "cols", "source", "masters"):
+            a, b = getattr(following, name), getattr(fresh, name)
+            assert a.dtype == b.dtype and np.array_equal(a, b)
+        assert following.shape == fresh.shape
         theirs = constrained_parts(edit, 1, node_constraints(edit))
         assert np.array_equal(ours.masters, theirs.masters) and ours.T.shape == theirs.T.shape
         for name in ("indptr", "indices", "data"):
@@ -105,13 +115,13 @@ def test_only_an_elimination_fixed_by_the_structure_is_kept():
     model = load_model(MODELS / "mlrs/mlrs.toml")
     forget_compiled_models()
     ModeCounter(model)
-    assert counter_parts._eliminations.get(model, lambda m: None) is not None
+    assert counter_parts._springs.get(model, lambda m: None) is not None
     body = model.rigids[0]
     for changed in (dataclasses.replace(model, boundary={**model.boundary, body.ports[0]: np.ones(6, bool)}),
                     dataclasses.replace(model, springs=tuple(dataclasses.replace(s, k=np.where(
                         np.arange(6) == 0, np.inf, s.k)) for s in model.springs))):
         ModeCounter(changed)
-        assert counter_parts._eliminations.get(changed, lambda m: 0) is None
+        assert counter_parts._springs.get(changed, lambda m: 0) is None
 
 
 def test_a_structure_differs_where_a_release_or_a_boundary_does():

@@ -24,7 +24,7 @@ import scipy.sparse as sp
 
 from linmstmm.fe.constraints import _eliminate, reduced_constraints
 from linmstmm.fe.layout import _layout, _Triplets, spring_rows
-from linmstmm.fe.port_following import PortFollowing, port_following, port_kinematics
+from linmstmm.fe.port_following import PortFollowing, kept_port_following, port_kinematics
 from linmstmm.fe.sparse import Compressed, scipy_csr
 from linmstmm.model import Model
 
@@ -130,7 +130,9 @@ class NodeConstraints:
 
 
 def node_constraints(model: Model) -> NodeConstraints:
-    """The :class:`NodeConstraints` of ``model``, made anew.
+    """The :class:`NodeConstraints` of ``model``, made anew (but for the layout of a
+    held model's elimination, kept by its structure:
+    :func:`~linmstmm.fe.port_following.kept_port_following`).
 
     Parameters
     ----------
@@ -148,7 +150,7 @@ def node_constraints(model: Model) -> NodeConstraints:
     _add_springs(model, layout, strains, stiffness, constraints)
     _add_rigid_masses(model, layout, mass)
     if held_at_free_points(model):
-        following = port_following(model, layout)
+        following = kept_port_following(model, layout)
         return NodeConstraints(layout, n_full, None, None, None, strains, stiffness, mass,
                                (following.T(layout.positions), following.masters), following)
     _add_boundaries(model, layout, constraints)

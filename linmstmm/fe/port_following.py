@@ -5,10 +5,11 @@ fixed component is dropped, every other DOF is kept as it is.
 Where each entry of that elimination T sits, and which number it takes, is fixed
 by the model's structure (its points, bodies, ports and boundary); only the
 numbers, the ports' lever arms, come from where the nodes sit. A
-:class:`PortFollowing` holds the first and puts the second into it: the node
-constraints (:func:`linmstmm.fe.node_constraints.node_constraints`) make T with
-it, and the Wittrick–Williams counter's parts (:mod:`linmstmm.counter_parts`)
-keep one per structure and make the next model's T with it, the same arrays.
+:class:`PortFollowing` holds the first and puts the second into it. One is kept
+per structure (:func:`kept_port_following`): the node constraints
+(:func:`linmstmm.fe.node_constraints.node_constraints`) and the Wittrick–Williams
+counter's parts (:mod:`linmstmm.counter_parts`) make every model's T with it, the
+same arrays.
 """
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ import numpy as np
 
 from linmstmm.fe.sparse import Compressed, index_type
 from linmstmm.model import Model
+from linmstmm.model_structure import MODELS_KEPT, KeptByStructure
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,6 +80,28 @@ class PortFollowing:
         indptr = np.zeros(self.shape[0] + 1, index)
         np.cumsum(np.bincount(self.rows[stored], minlength=self.shape[0]), out=indptr[1:])
         return Compressed("csr", indptr, self.cols[stored].astype(index, copy=False), data, self.shape)
+
+
+#: The layout of T of each structure seen last (:func:`kept_port_following`).
+_followings = KeptByStructure(MODELS_KEPT)
+
+
+def kept_port_following(model: Model, layout) -> PortFollowing:
+    """The :func:`port_following` of ``model`` on ``layout``, made for the first model
+    of its structure and kept for the next (it depends on the structure alone).
+
+    Parameters
+    ----------
+    model : Model
+    layout : linmstmm.fe.layout._Layout
+        As for :func:`port_following`.
+
+    Returns
+    -------
+    PortFollowing
+        The same object for every model of the structure.
+    """
+    return _followings.get(model, lambda model: port_following(model, layout))
 
 
 def port_following(model: Model, layout) -> PortFollowing:

@@ -266,9 +266,7 @@ def _taken(r, block):
 @njit
 def _slot(r, rows, words):
     """Index of a new slot of ``rows`` rows on the columns ``words``."""
-    s = _push(r, _SLOT_ROWS, rows)
-    if s >= r.masks.shape[0]:
-        raise Full("the walk needs more room")
+    s = _push(r, _SLOT_ROWS, rows)  # raises Full past the room, which is masks' rows too
     for k in range(words.size):
         r.masks[s, k] = words[k]
     return s

@@ -328,9 +328,8 @@ def _bits(word):
 def _combined(r, slots, matrices):
     """New slot = Σ matrix @ source over the union of the sources' columns (COMBINE)."""
     union = r.masks[slots[0]].copy()
-    for slot in slots:
-        for k in range(union.size):
-            union[k] |= r.masks[slot, k]
+    for slot in slots[1:]:
+        _or_into(union, r.masks, slot)
     dst = _slot(r, _STATE_ROWS, union)
     first = r.counts[_RECORDS, _TERMS]
     for k in range(slots.size):
@@ -376,8 +375,7 @@ def _orthonormalise(r, state, emit):
             slot = blocks[open_blocks[j], _SLOT]
             if not chosen[j] and _shared(masks, slot, columns):
                 chosen[j] = grown = True
-                for k in range(columns.size):
-                    columns[k] |= masks[slot, k]
+                _or_into(columns, masks, slot)
     rows = 12
     for j in range(count):
         if chosen[j]:
@@ -403,10 +401,16 @@ def _orthonormalise(r, state, emit):
 @njit
 def _union(masks, a, b):
     """(w,) int64 words of the columns of slots ``a`` and ``b`` (rows of ``masks``)."""
-    union = np.empty(masks.shape[1], dtype=np.int64)
-    for k in range(union.size):
-        union[k] = masks[a, k] | masks[b, k]
+    union = masks[a].copy()
+    _or_into(union, masks, b)
     return union
+
+
+@njit(inline="always")
+def _or_into(words, masks, slot):
+    """``words`` (w,) int64 |= the columns of ``slot`` (a row of ``masks``), in place."""
+    for k in range(words.size):
+        words[k] |= masks[slot, k]
 
 
 @njit

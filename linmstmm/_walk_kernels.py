@@ -25,6 +25,11 @@ selections and of the joints' jumps.
 Kept whole: numba invalidates a cached kernel when the file that defines it
 changes, not when a kernel it calls in another file does; split, an edit to
 the record's accessors would leave the walk running the old code from the cache.
+The cached walk also keeps the integers it reads from other modules, which numba
+compiles in as constants: the element kinds and link codes of
+:mod:`linmstmm.compiled_walk` and the operation codes and block kinds of
+:mod:`linmstmm.program_record`. After a change to any of them, touch this file (or
+delete its cache), or the cached walk records the old codes.
 """
 from __future__ import annotations
 

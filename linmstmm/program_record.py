@@ -13,7 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# Operation codes (first entry of each record in Program.operations).
+# Operation codes (first entry of each record in Program.operations). The kernels
+# compile them, and the block kinds, into their caches: after a change, touch
+# linmstmm/_kernels.py and linmstmm/_walk_kernels.py (see the latter).
 #: TIP dst constant: the slot holds a constant (12, k) selection, reference 1.
 TIP = 0
 #: CARRY dst src U0 U2: dst = (U0 + ω² U2) src (U2 = −1: none; only U2[6:, :6] acts).

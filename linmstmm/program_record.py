@@ -69,6 +69,9 @@ class Program:
     row_kinds : (order,) int64 what each row of Ū_all before release is (0 a
         displacement, 1 a rotation, 2 a moment, 3 a force), as
         :meth:`~linmstmm.deduction.Deduction.kinds` has it.
+    assembly_sources, assembly_targets : (E,) int64, entry ``assembly_sources[e]`` of a
+        frequency's workspace is added to entry ``assembly_targets[e]`` of the
+        transposed Ū_all (N, N) flattened (:func:`linmstmm._assembly_kernels.assembly`).
     """
 
     slot_offset: np.ndarray
@@ -93,3 +96,5 @@ class Program:
     kept_rows: np.ndarray
     kept_columns: np.ndarray
     row_kinds: np.ndarray
+    assembly_sources: np.ndarray
+    assembly_targets: np.ndarray

@@ -25,6 +25,11 @@ selections and of the joints' jumps.
 Kept whole: numba invalidates a cached kernel when the file that defines it
 changes, not when a kernel it calls in another file does; split, an edit to
 the record's accessors would leave the walk running the old code from the cache.
+The cached walk also keeps the integers it reads from other modules, which numba
+compiles in as constants: the element kinds and link codes of
+:mod:`linmstmm.compiled_walk` and the operation codes and block kinds of
+:mod:`linmstmm.program_record`. After a change to any of them, touch this file (or
+delete its cache), or the cached walk records the old codes.
 """
 from __future__ import annotations
 
@@ -266,9 +271,7 @@ def _taken(r, block):
 @njit
 def _slot(r, rows, words):
     """Index of a new slot of ``rows`` rows on the columns ``words``."""
-    s = _push(r, _SLOT_ROWS, rows)
-    if s >= r.masks.shape[0]:
-        raise Full("the walk needs more room")
+    s = _push(r, _SLOT_ROWS, rows)  # raises Full past the room, which is masks' rows too
     for k in range(words.size):
         r.masks[s, k] = words[k]
     return s
@@ -330,9 +333,8 @@ def _bits(word):
 def _combined(r, slots, matrices):
     """New slot = Σ matrix @ source over the union of the sources' columns (COMBINE)."""
     union = r.masks[slots[0]].copy()
-    for slot in slots:
-        for k in range(union.size):
-            union[k] |= r.masks[slot, k]
+    for slot in slots[1:]:
+        _or_into(union, r.masks, slot)
     dst = _slot(r, _STATE_ROWS, union)
     first = r.counts[_RECORDS, _TERMS]
     for k in range(slots.size):
@@ -378,8 +380,7 @@ def _orthonormalise(r, state, emit):
             slot = blocks[open_blocks[j], _SLOT]
             if not chosen[j] and _shared(masks, slot, columns):
                 chosen[j] = grown = True
-                for k in range(columns.size):
-                    columns[k] |= masks[slot, k]
+                _or_into(columns, masks, slot)
     rows = 12
     for j in range(count):
         if chosen[j]:
@@ -405,10 +406,16 @@ def _orthonormalise(r, state, emit):
 @njit
 def _union(masks, a, b):
     """(w,) int64 words of the columns of slots ``a`` and ``b`` (rows of ``masks``)."""
-    union = np.empty(masks.shape[1], dtype=np.int64)
-    for k in range(union.size):
-        union[k] = masks[a, k] | masks[b, k]
+    union = masks[a].copy()
+    _or_into(union, masks, b)
     return union
+
+
+@njit(inline="always")
+def _or_into(words, masks, slot):
+    """``words`` (w,) int64 |= the columns of ``slot`` (a row of ``masks``), in place."""
+    for k in range(words.size):
+        words[k] |= masks[slot, k]
 
 
 @njit

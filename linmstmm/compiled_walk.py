@@ -11,7 +11,8 @@ import numpy as np
 
 from linmstmm.program_constants import Constants
 
-#: Element kinds as the kernel takes them.
+#: Element kinds as the kernel takes them (compiled into its cache, as the link codes
+#: below: after a change, see :mod:`linmstmm._walk_kernels`).
 RIGID, SPRING, JUNCTION, BEAM_ELEMENT = 0, 1, 2, 3
 _KIND_CODES = {"rigid": RIGID, "spring": SPRING, "junction": JUNCTION, "beam": BEAM_ELEMENT}
 _KIND_NAMES = {code: kind for kind, code in _KIND_CODES.items()}

@@ -36,7 +36,6 @@ import functools
 import numpy as np
 
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
-from linmstmm.elements.frames import FORCE_INDEX
 from linmstmm.elements.rigid import force_extraction, position_incidence, rigid_transfer_parts
 from linmstmm.elements.spring import joint_force, joint_jump, spring_constant_transfer
 from linmstmm.godunov import PortState, _Orthonormaliser, _row_kinds
@@ -57,12 +56,12 @@ _RELEASE_ROW_KIND = np.array([3, 3, 3, 2, 2, 2])
 
 
 @functools.lru_cache(maxsize=64)
-def boundary_selection(fixed: bytes) -> np.ndarray:
-    """(12, 6) map from a boundary end's six unknowns (``fixed``: which are fixed, as bool
-    bytes) to its state vector, read-only and made once: component c is a free displacement
-    (row c) unless fixed, then its force (row FORCE_INDEX[c]) is the unknown."""
+def boundary_selection(rows: tuple[int, ...]) -> np.ndarray:
+    """(12, 6) map from a boundary end's six unknowns to its state vector, read-only and
+    made once per ``rows``: unknown c stands in state row ``rows[c]``
+    (:func:`~linmstmm.unknowns.boundary_state_rows`)."""
     selection = np.zeros((12, 6))
-    selection[np.where(np.frombuffer(fixed, dtype=bool), FORCE_INDEX, np.arange(6)), np.arange(6)] = 1.0
+    selection[list(rows), np.arange(6)] = 1.0
     selection.flags.writeable = False  # shared by every caller
     return selection
 
@@ -193,7 +192,7 @@ class Deduction:
         if link not in self._tips:
             if link[0] == "boundary":
                 columns = self._boundary_columns[link[1]]
-                selection = boundary_selection(self.topology.boundaries[link[1]].fixed.tobytes())
+                selection = boundary_selection(tuple(self._boundary_rows[link[1]]))
             else:
                 _, c, side = link
                 columns = self._cut_columns[c]

@@ -173,7 +173,7 @@ class CompiledDeterminant(EvaluationCount):
         deduction.adopt_row_kinds(self.program.row_kinds)
         p = self.program
         self._operations = _kernel_operations(p, p.orthos)
-        self._layout = (p.workspace, p.slot_rows.size, p.kept_columns.size, *_assembly(p))
+        self._layout = (p.workspace, p.slot_rows.size, p.kept_columns.size, p.assembly_sources, p.assembly_targets)
 
     @property
     def order(self) -> int:
@@ -252,14 +252,3 @@ def _kernel_operations(program, orthos: np.ndarray) -> tuple:
     return (p.slot_offset, p.slot_rows, p.slot_width, p.operations, p.terms, p.places, p.places_start,
             p.matrices, orthos, p.ortho_blocks, p.beams, p.beam_rotation)
 
-
-def _assembly(program) -> tuple[np.ndarray, np.ndarray]:
-    """Where each entry of Ū_all comes from: (sources (E,), targets (E,)) int64, entry
-    ``sources[e]`` of a frequency's workspace added to entry ``targets[e]`` of the
-    transposed Ū_all (N, N) flattened (:func:`linmstmm._assembly_kernels.assembly`)."""
-    from linmstmm._assembly_kernels import assembly  # numba loads here, not at import
-
-    p = program
-    blocks = np.concatenate(([p.root, p.root_row], p.geometric_rows)).astype(np.int64)
-    return assembly(p.slot_offset, p.slot_rows, p.slot_width, p.slot_columns, p.slot_columns_start, blocks,
-                    p.kept_rows, p.kept_columns, p.order)

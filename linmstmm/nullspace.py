@@ -12,11 +12,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import scipy.linalg
-import scipy.linalg.blas
-import scipy.linalg.lapack
+import scipy.linalg  # scipy.linalg.blas and scipy.linalg.lapack with it
 
-from linmstmm.numeric import power_of_two_scale
+from linmstmm.numeric import power_of_two_scale, scale_into_half_one
 from linmstmm.own_units import extent, unit_sizes
 
 #: A singular value below this fraction of the largest counts as zero.
@@ -329,7 +327,7 @@ def _well_above(matrix: np.ndarray, threshold: float) -> bool:
     margin = BOUND_MARGIN * threshold
     n = matrix.shape[0]
     if margin ** 2 >= GRAM_ROUNDING * (n + 1) ** 2 * _EPS:
-        unit = math.ldexp(1.0, -math.frexp(bound)[1])  # exact: s of ``matrix * unit`` is about 1
+        unit = scale_into_half_one(bound)  # exact: s of ``matrix * unit`` is about 1
         return _gram_clears(matrix * unit, margin * bound * unit)
     try:
         inverse = np.linalg.inv(matrix)

@@ -9,6 +9,8 @@ serves all three.
 """
 from __future__ import annotations
 
+import math
+
 import mpmath
 import numpy as np
 
@@ -84,6 +86,13 @@ def power_of_two_scale(magnitude):
     """1 / (nearest power of two of ``magnitude``), 1 where it is 0: scaling by it is exact."""
     safe = np.where(magnitude > 0, magnitude, 1.0)
     return np.exp2(-np.round(np.log2(safe)))
+
+
+def scale_into_half_one(magnitude: float) -> float:
+    """The power of two that takes ``magnitude`` (one positive finite float) into [1/2, 1):
+    1 / (the least power of two above it), from its binary exponent, so that scaling by it
+    is exact. :func:`power_of_two_scale` rounds to the nearest power of two instead."""
+    return math.ldexp(1.0, -math.frexp(magnitude)[1])
 
 
 def zeros_like_stack(omega, shape) -> np.ndarray:

@@ -371,11 +371,24 @@ def _program(deduction: Deduction, beams, slot_rows: np.ndarray, slot_width: np.
     released rows and columns, and the walk's other ``arrays`` (Program's fields)."""
     offsets = _starts(slot_rows * slot_width)
     order = deduction.full_order
-    return Program(slot_offset=offsets[:-1], slot_rows=slot_rows, slot_width=slot_width,
-                   slot_columns_start=_starts(slot_width), workspace=int(offsets[-1]),
-                   beams=_beam_parameters(deduction, beams), beam_rotation=_beam_rotations(deduction, beams),
-                   order=order, kept_rows=_kept(order, deduction.released_rows),
-                   kept_columns=_kept(order, deduction.released_columns), **arrays)
+    layout = dict(slot_offset=offsets[:-1], slot_rows=slot_rows, slot_width=slot_width,
+                  slot_columns_start=_starts(slot_width), order=order,
+                  kept_rows=_kept(order, deduction.released_rows),
+                  kept_columns=_kept(order, deduction.released_columns), **arrays)
+    return Program(workspace=int(offsets[-1]), beams=_beam_parameters(deduction, beams),
+                   beam_rotation=_beam_rotations(deduction, beams), **_assembly(layout), **layout)
+
+
+def _assembly(layout: dict) -> dict:
+    """Where each entry of Ū_all comes from in a program of the fields ``layout``: its
+    ``assembly_sources`` and ``assembly_targets`` (:func:`linmstmm._assembly_kernels.assembly`).
+    Found once per walk: a program with new numbers keeps them (:func:`_revalued`)."""
+    from linmstmm._assembly_kernels import assembly  # numba loads here, not at import
+
+    blocks = np.concatenate(([layout["root"], layout["root_row"]], layout["geometric_rows"])).astype(np.int64)
+    slots = [layout[name] for name in ("slot_offset", "slot_rows", "slot_width", "slot_columns", "slot_columns_start")]
+    sources, targets = assembly(*slots, blocks, layout["kept_rows"], layout["kept_columns"], layout["order"])
+    return {"assembly_sources": sources, "assembly_targets": targets}
 
 
 def _starts(counts: np.ndarray) -> np.ndarray:

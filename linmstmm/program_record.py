@@ -13,7 +13,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# Operation codes (first entry of each record in Program.operations).
+# Operation codes (first entry of each record in Program.operations). The kernels
+# compile them, and the block kinds, into their caches: after a change, touch
+# linmstmm/_kernels.py and linmstmm/_walk_kernels.py (see the latter).
 #: TIP dst constant: the slot holds a constant (12, k) selection, reference 1.
 TIP = 0
 #: CARRY dst src U0 U2: dst = (U0 + ω² U2) src (U2 = −1: none; only U2[6:, :6] acts).
@@ -67,6 +69,9 @@ class Program:
     row_kinds : (order,) int64 what each row of Ū_all before release is (0 a
         displacement, 1 a rotation, 2 a moment, 3 a force), as
         :meth:`~linmstmm.deduction.Deduction.kinds` has it.
+    assembly_sources, assembly_targets : (E,) int64, entry ``assembly_sources[e]`` of a
+        frequency's workspace is added to entry ``assembly_targets[e]`` of the
+        transposed Ū_all (N, N) flattened (:func:`linmstmm._assembly_kernels.assembly`).
     """
 
     slot_offset: np.ndarray
@@ -91,3 +96,5 @@ class Program:
     kept_rows: np.ndarray
     kept_columns: np.ndarray
     row_kinds: np.ndarray
+    assembly_sources: np.ndarray
+    assembly_targets: np.ndarray

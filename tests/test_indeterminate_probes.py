@@ -224,6 +224,25 @@ def test_the_gram_test_clears_exactly_what_its_bound_says(n):
             assert _well_above(matrix, threshold)
 
 
+def test_the_gram_tests_scale_is_an_exact_power_of_two_into_half_one():
+    """numeric.scale_into_half_one, which scales the Gram test's matrix: a power of two
+    that takes each magnitude into [1/2, 1) exactly, checked in rational arithmetic on
+    magnitudes from 1e-300 to 1e300 and on powers of two (which go to 1/2)."""
+    from fractions import Fraction
+
+    from linmstmm.numeric import scale_into_half_one
+
+    rng = np.random.default_rng(3)
+    powers = [2.0 ** k for k in range(-990, 1000, 37)]
+    for magnitude in [*(10.0 ** rng.uniform(-300, 300, 2000)), *powers]:
+        scale = Fraction(scale_into_half_one(magnitude))
+        assert scale.numerator == 1 or scale.denominator == 1
+        assert (scale.numerator * scale.denominator) & (scale.numerator * scale.denominator - 1) == 0
+        assert Fraction(1, 2) <= Fraction(magnitude) * scale < 1
+        assert magnitude * float(scale) == Fraction(magnitude) * scale
+    assert all(p * scale_into_half_one(p) == 0.5 for p in powers)
+
+
 def test_the_first_probe_alone_releases_what_all_three_did(monkeypatch):
     """The screen decides on the first probe alone (nullspace._screened_probe); before, it
     evaluated all three and sent the probes to the numpy carry where a later one was not

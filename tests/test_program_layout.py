@@ -43,16 +43,22 @@ def models():
 RELEASED = ("varied 24", "varied 358 (two)", "random loops 25", "random tree 19 with joints")
 
 
+#: Fields left out of the digest: the constants' matrices, and where each entry of Ū_all
+#: comes from (found from the walk's arrays by linmstmm._assembly_kernels, not by the walk).
+NOT_DIGESTED = ("matrices", "assembly_sources", "assembly_targets")
+
+
 def layout_digest(model) -> str:
     """SHA-256 of every array of ``model``'s program (indeterminate unknowns released) but
-    ``matrices``: each field's name, shape and bytes (integers as int64, numbers as float64)."""
+    :data:`NOT_DIGESTED`: each field's name, shape and bytes (integers as int64, numbers as
+    float64)."""
     forget_compiled_models()
     deduction = Deduction(build_topology(model))
     release_indeterminate(deduction)
     compiled = program.compile_program(deduction)
     digest = hashlib.sha256()
     for field in dataclasses.fields(compiled):
-        if field.name == "matrices":
+        if field.name in NOT_DIGESTED:
             continue
         value = np.asarray(getattr(compiled, field.name))
         value = value.astype(np.float64 if value.dtype.kind == "f" else np.int64)

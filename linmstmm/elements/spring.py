@@ -21,24 +21,10 @@ import numpy as np
 from linmstmm.elements.frames import FORCE_INDEX, M, Q, R, U, identities
 from linmstmm.numeric import number_type
 
-#: The released directions of every spring with none: one empty read-only array, shared.
-NOTHING_RELEASED = np.broadcast_to(np.zeros(0, dtype=np.intp), (0,))
-
-
-def released_directions(spring) -> np.ndarray:
-    """Indices (0..5: x, y, z, rx, ry, rz) of the released directions of a spring record
-    (:attr:`linmstmm.model.Spring.released`), ascending, read-only: NOTHING_RELEASED
-    where its ``release`` is None, so that asking costs what testing that does (0.1 µs
-    against 1.3 µs for a cached property's first look-up), else found once per spring
-    and kept in the record's ``__dict__`` as a cached property keeps its value (the
-    kinematics of a 10,000-body chain asked 40,000 times)."""
-    if spring.release is None:
-        return NOTHING_RELEASED
-    if "_released" not in spring.__dict__:
-        indices = np.flatnonzero(spring.release)
-        indices.setflags(write=False)
-        spring.__dict__["_released"] = indices
-    return spring.__dict__["_released"]
+#: The released directions of a spring with none (:attr:`linmstmm.model.Spring.released`):
+#: no indices, read-only, one array shared by every such spring.
+NO_RELEASED_INDICES = np.zeros(0, dtype=np.intp)
+NO_RELEASED_INDICES.setflags(write=False)
 
 
 def spring_compliance(k, axes, release=None) -> tuple[np.ndarray, np.ndarray]:

@@ -6,6 +6,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from linmstmm._compile_notice import announce_compiles
+
+announce_compiles()  # one line on stderr if this run compiles (linmstmm._compile_notice)
+
 
 @njit(cache=True)
 def assembly(slot_offset, slot_rows, slot_width, slot_columns, slot_columns_start, blocks, kept_rows,

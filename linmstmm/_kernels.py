@@ -37,8 +37,11 @@ from numba.core.imputils import impl_ret_borrowed
 from numba.extending import intrinsic
 from numba.np.arrayobj import populate_array
 
+from linmstmm._compile_notice import announce_compiles
 from linmstmm._lapack import lapack_routine
 from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, STATE_BLOCK, TIP
+
+announce_compiles()  # one line on stderr if this run compiles (linmstmm._compile_notice)
 
 #: See linmstmm.deduction: beam pieces, growth between orthonormalisations, far scale.
 BEAM_PIECE_BETA_L = 4.0

@@ -20,6 +20,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from linmstmm._compile_notice import announce_compiles
+
+announce_compiles()  # one line on stderr if this run compiles (linmstmm._compile_notice)
+
 
 @njit(cache=True)
 def minimum_degree(pattern):

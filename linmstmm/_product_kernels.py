@@ -18,6 +18,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from linmstmm._compile_notice import announce_compiles
+
+announce_compiles()  # one line on stderr if this run compiles (linmstmm._compile_notice)
+
 
 @njit(cache=True)
 def ordered_congruence(t_indptr, t_indices, t_data, m_indptr, m_indices, m_data, n):

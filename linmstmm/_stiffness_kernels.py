@@ -36,8 +36,11 @@ import math
 import numpy as np
 from numba import njit
 
+from linmstmm._compile_notice import announce_compiles
 from linmstmm._lapack import lapack_routine
 from linmstmm.dynamic_stiffness import POLE, SERIES_BELOW, SERIES_COEFFICIENTS, SERIES_TERMS
+
+announce_compiles()  # one line on stderr if this run compiles (linmstmm._compile_notice)
 
 #: Columns of the beam table the kernels take (see :func:`beam_columns`).
 EA, GJ, EIY, EIZ, RHO_A, RHO_IP, LENGTH, AXIAL, TORSION = range(9)

@@ -38,8 +38,11 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
+from linmstmm._compile_notice import announce_compiles
 from linmstmm.compiled_walk import BEAM_ELEMENT, FROM_CUT, FROM_ELEMENT, RIGID
 from linmstmm import program_record
+
+announce_compiles()  # one line on stderr if this run compiles (linmstmm._compile_notice)
 
 #: Columns to a word of a column set (below 63: no sign bit in an int64).
 BITS = 62

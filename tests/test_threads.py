@@ -42,10 +42,9 @@ def test_the_decorated_solve_runs_on_one_thread_and_restores_on_error():
         assert blas_threads() == before
 
 
-def test_the_fe_route_solves_on_one_thread(monkeypatch):
-    """fe_frequencies (the ``fe`` command's route) sets BLAS to one thread for its
-    eigensolves as the transfer-matrix solve does: OpenBLAS's second thread made the
-    launcher's ten lowest 16 times slower on a busy two-core machine."""
+def fe_route_threads(monkeypatch, threaded_nodes=None) -> list[int]:
+    """The BLAS thread counts seen by the FE route's eigensolve of a 4-body chain under a
+    two-thread limit (``threaded_nodes``: THREADED_NODES for this call)."""
     import linmstmm.fe.frequencies as frequencies
     from linmstmm.builders import spring_chain
 
@@ -57,6 +56,21 @@ def test_the_fe_route_solves_on_one_thread(monkeypatch):
         return solve(*args, **kwargs)
 
     monkeypatch.setattr(frequencies, "fe_modes", watched)
+    if threaded_nodes is not None:
+        monkeypatch.setattr(frequencies, "THREADED_NODES", threaded_nodes)
     with threadpool_limits(limits=2, user_api="blas"):
         frequencies.fe_frequencies(spring_chain(4), 2)
-    assert seen and all(threads == 1 for threads in seen)
+    assert seen
+    return seen
+
+
+def test_the_fe_route_solves_a_small_model_on_one_thread(monkeypatch):
+    """fe_frequencies (the ``fe`` command's route) sets BLAS to one thread for its
+    eigensolves as the transfer-matrix solve does: OpenBLAS's second thread made the
+    launcher's ten lowest 16 times slower on a busy two-core machine."""
+    assert all(threads == 1 for threads in fe_route_threads(monkeypatch))
+
+
+def test_the_fe_route_keeps_the_threads_for_a_model_of_many_nodes(monkeypatch):
+    """Above THREADED_NODES (the 10,000-body chain: 0.80 s on two threads, 1.19 s on one)."""
+    assert all(threads == 2 for threads in fe_route_threads(monkeypatch, threaded_nodes=3))

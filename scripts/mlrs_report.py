@@ -687,7 +687,10 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
         "time beside it (it counts every BLAS thread) and the largest error over all rounds. "
         f"This was done twice: with the machine's default OpenBLAS threading ({blas_default}) "
         "and with OpenBLAS limited to one thread (set at run time through OpenBLAS's own "
-        "`set_num_threads`; no environment variable is changed).")
+        "`set_num_threads`; no environment variable is changed). Both routes set BLAS to one "
+        "thread themselves on a model of this size (`linmstmm.threads`; the FE route up to "
+        "`linmstmm.fe.frequencies.THREADED_NODES` nodes), so the two settings differ by the "
+        "noise of the run only.")
     add("")
     add("| method | system size | time [s], default BLAS threads | CPU [s] | time [s], 1 BLAS thread | "
         "CPU [s] | max rel. error | time ratio this : MSTMM (default / 1 thread) |")

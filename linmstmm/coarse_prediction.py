@@ -72,7 +72,7 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
         return np.zeros(0)
     pencil = coarse_pencil(model, elements_per_beam)
     rigid = pencil.rigid_body_modes
-    lam = np.sort(_lowest_eigenvalues(pencil, min(count + rigid, pencil.K.shape[0]), shift))[rigid:]
+    lam = np.sort(_lowest_eigenvalues(pencil, min(count + rigid, pencil.size), shift))[rigid:]
     return np.sqrt(np.maximum(lam[:count], 0.0))
 
 
@@ -87,21 +87,54 @@ class CoarsePencil:
     rigid_body_modes : int
         Its rigid-body modes, counted as the FE route counts them
         (:func:`linmstmm.fe.rigid_motions.rigid_mode_count`), not formed.
-    K, M : numpy.ndarray, shape (n, n)
-        Dense, each unknown scaled to unit mass (or stiffness, where it has
-        none): the same eigenvalues, and a pencil that no longer depends on
+    scale : numpy.ndarray, shape (n,)
+        The scaling of each unknown: to unit mass (or stiffness, where it has
+        none), the same eigenvalues, and a pencil that no longer depends on
         the units (in km the translations' and rotations' entries lie 1e6
         further apart, and the predictions were 1e-4 to 3e-2 off where in m
         they were 1e-7 to 1e-4 off).
-    scale : numpy.ndarray, shape (n,)
-        The scaling of each unknown.
+    compiled : bool
+        Whether the dense K and M are scaled by the compiled kernel (the same numbers).
+    K, M : numpy.ndarray, shape (n, n)
+        Dense and scaled, made on first use: the sparse route of a refined mesh
+        never asks for them (on the second launcher's 1,284 unknowns they cost
+        about 10 ms).
     """
 
     assembly: object
     rigid_body_modes: int
-    K: np.ndarray
-    M: np.ndarray
     scale: np.ndarray
+    compiled: bool
+
+    @property
+    def size(self) -> int:
+        """n, the unknowns of the pencil."""
+        return self.scale.size
+
+    @property
+    def K(self) -> np.ndarray:
+        """(n, n) the scaled stiffness, dense (made on first use)."""
+        return self._dense[0]
+
+    @property
+    def M(self) -> np.ndarray:
+        """(n, n) the scaled mass, dense (made on first use)."""
+        return self._dense[1]
+
+    @functools.cached_property
+    def _dense(self) -> tuple[np.ndarray, np.ndarray]:
+        """(K, M) dense, scaled (:attr:`scale`), read-only: shared by every prediction of this model."""
+        K, M = (matrix if isinstance(matrix, np.ndarray) else matrix.toarray()
+                for matrix in (self.assembly.K, self.assembly.M))
+        if self.compiled:  # the same numbers in one pass
+            from linmstmm._product_kernels import unit_scaled
+
+            _, K, M = unit_scaled(K, M)
+        else:
+            _, K, M = _unit_scaled(K, M)
+        for matrix in (K, M):
+            matrix.setflags(write=False)
+        return K, M
 
     @functools.cached_property
     def reduced(self) -> np.ndarray | None:
@@ -159,17 +192,8 @@ def _pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
     if kernels_loaded():  # compiled products where numba is loaded already: the same K and M
         from linmstmm._product_kernels import pencil_forms as forms
     fe = assembled(model, elements_per_beam, kept_node_constraints, forms)
-    K, M = (matrix if isinstance(matrix, np.ndarray) else matrix.toarray() for matrix in (fe.K, fe.M))
-    if forms is not None:  # compiled: the same numbers in one pass
-        from linmstmm._product_kernels import unit_scaled
-
-        scale, K, M = unit_scaled(K, M)
-    else:
-        scale, K, M = _unit_scaled(K, M)
-    for matrix in (K, M):
-        matrix.setflags(write=False)  # shared by every prediction of this model
     rigid = rigid_mode_count(fe.model, fe.parts.layout, fe.parts.masters, fe.M)
-    return CoarsePencil(fe, rigid, K, M, scale)
+    return CoarsePencil(fe, rigid, _unit_scale(fe.K.diagonal(), fe.M.diagonal()), forms is not None)
 
 
 def _unit_scaled(K: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -177,10 +201,16 @@ def _unit_scaled(K: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndarray, 
     unknown, or unit stiffness where it has none (:class:`CoarsePencil`): scale_i is
     1 / √M_ii, or 1 / √|K_ii| where M_ii is not positive, or 1 where both are 0, and
     each entry is multiplied by scale_i scale_j."""
-    size = np.where(np.diag(M) > 0, np.diag(M), np.abs(np.diag(K)))
-    scale = 1 / np.sqrt(np.where(size > 0, size, 1.0))
+    scale = _unit_scale(np.diag(K), np.diag(M))
     both = np.outer(scale, scale)
     return scale, K * both, M * both
+
+
+def _unit_scale(stiffness: np.ndarray, mass: np.ndarray) -> np.ndarray:
+    """(n,) 1 / √M_ii, or 1 / √|K_ii| where M_ii is not positive, or 1 where both are 0,
+    from the diagonals ``stiffness`` K_ii and ``mass`` M_ii (n,) (:func:`_unit_scaled`)."""
+    size = np.where(mass > 0, mass, np.abs(stiffness))
+    return 1 / np.sqrt(np.where(size > 0, size, 1.0))
 
 
 def _forget_pencils() -> None:
@@ -227,7 +257,7 @@ def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None) -
     kept standard form, the lowest by bisection (syevx), or all at once (QR, dsterf)
     where more than BISECTED are wanted; by QZ where M is singular, the infinite
     eigenvalues dropped."""
-    if shift is not None and pencil.K.shape[0] > DENSE_PREDICTION and np.all(pencil.assembly.M.diagonal() != 0):
+    if shift is not None and pencil.size > DENSE_PREDICTION and np.all(pencil.assembly.M.diagonal() != 0):
         lam = _sparse_lowest(pencil, count, shift)
         if lam is not None:
             return lam

@@ -26,7 +26,8 @@ Measured per model (the launcher-size files in models/):
   shift-invert ``eigsh``, assembly excluded, the faster of the two taken as
   the FE baseline; and the ``fe`` command's own automatic refinement
   (``fe_frequencies``);
-* the start-up of a new process running the README's main command.
+* the start-up of a new process running the README's main command, and new processes
+  of the ``response`` command on the bundled load cases.
 """
 from __future__ import annotations
 
@@ -67,6 +68,10 @@ from linmstmm.wittrick_williams import ModeCounter  # noqa: E402
 DENSE_LIMIT = 2000
 MODELS = {"launcher (models/mlrs/mlrs.toml)": REPO / "models" / "mlrs" / "mlrs.toml",
           "launcher 2 (models/launcher2/launcher2.toml)": REPO / "models" / "launcher2" / "launcher2.toml"}
+
+#: The bundled load cases and their models, timed as new processes of the ``response`` command.
+RESPONSE_CASES = (("models/mlrs/mlrs.toml", "models/loads/mlrs_firing.toml"),
+                  ("models/cantilever_tip_mass.toml", "models/loads/cantilever_step.toml"))
 
 
 def best_time(function, rounds: int) -> tuple[float, object]:
@@ -362,12 +367,15 @@ def main() -> None:
               "beam-node masses shrink. The eigensolver times exclude assembly, which the `fe` command's "
               "refinement with Richardson extrapolation includes.", ""]
     command = [sys.executable, "-m", "linmstmm", "freqs", "models/mlrs/mlrs.toml"]
-    lines += ["## Start-up: a new process", "",
+    lines += ["## New processes: start-up and modal response", "",
               "| command | median wall time |", "|---|---:|",
               f"| `linmstmm freqs models/mlrs/mlrs.toml` (engine auto: numpy in a new process) | "
               f"{startup(command, rounds):.2f} s |",
               f"| the same with `--engine compiled` (numba import and cached kernels) | "
-              f"{startup(command + ['--engine', 'compiled'], rounds):.2f} s |", ""]
+              f"{startup(command + ['--engine', 'compiled'], rounds):.2f} s |",
+              *[f"| `linmstmm response {model} {loads}` (the bundled load case; BLAS threads as the "
+                f"machine sets them) | {startup([sys.executable, '-m', 'linmstmm', 'response', model, loads], rounds):.2f} s |"
+                for model, loads in RESPONSE_CASES], ""]
     figure = draw(curves, out / "figures" / "speed_vs_fe.png")
     lines += [f"![time against the number of frequencies]({figure.relative_to(out).as_posix()})", "",
               "*Wall time against the number of frequencies asked for, both launcher models; "

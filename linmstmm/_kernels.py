@@ -24,7 +24,11 @@ orthonormalised Ū_all (Newton's pencil).
 Kept whole: numba invalidates cached machine code when the file that defines
 a kernel changes, not when a kernel it calls in another file does (its
 documented limit); split across files, an edit to a callee would leave its
-callers running the old code from the cache.
+callers running the old code from the cache. The cached replay also keeps the
+operation codes and block kinds it reads from :mod:`linmstmm.program_record`
+(through :mod:`linmstmm.program`), which numba compiles in as constants: after a
+change to their values, touch this file (or delete its cache), or the cached
+replay reads programs by the old codes.
 """
 from __future__ import annotations
 

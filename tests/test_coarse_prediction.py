@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from linmstmm.coarse_prediction import coarse_pencil, coarse_predictions
+from linmstmm.coarse_prediction import BISECTED, _standard_lowest, coarse_pencil, coarse_predictions
 from linmstmm.model import load_model
 from random_models import KINDS, random_model
 
@@ -42,3 +42,18 @@ def test_both_kinds_of_mass_matrix_are_among_the_models():
     """The test above sees positive definite and singular mass matrices alike."""
     kinds = {coarse_pencil(build(), 2).reduced is None for build in MODELS.values()}
     assert kinds == {True, False}
+
+
+@pytest.mark.parametrize("name", ["launcher", "launcher 2", "cantilever"])
+@pytest.mark.parametrize("count", [1, 13, BISECTED, BISECTED + 1, 60])
+def test_the_standard_form_is_solved_as_scipy_eigh_solves_it(name, count):
+    """LAPACK's syevx (bisection) and syev (all at once), called directly, give
+    scipy.linalg.eigh's eigenvalues of the kept standard form to the bit."""
+    reduced = coarse_pencil(MODELS[name](), 2).reduced
+    count = min(count, reduced.shape[0])
+    if count > BISECTED:
+        expected = scipy.linalg.eigh(reduced, eigvals_only=True, driver="ev", lower=True)
+    else:
+        expected = scipy.linalg.eigh(reduced, eigvals_only=True, subset_by_index=[0, count - 1], driver="evx",
+                                     lower=True)
+    assert np.array_equal(_standard_lowest(reduced, count), expected)

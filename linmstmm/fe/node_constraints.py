@@ -23,8 +23,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from linmstmm.fe.constraints import _eliminate, reduced_constraints
-from linmstmm.fe.layout import _layout, _Triplets, spring_rows
-from linmstmm.fe.port_following import PortFollowing, kept_port_following, port_kinematics
+from linmstmm.fe.layout import _DIRECTION_DOFS, _layout, _Triplets, spring_rows
+from linmstmm.fe.port_following import PortFollowing, compiled_nodes, kept_port_following, port_kinematics
 from linmstmm.fe.sparse import Compressed, scipy_csr
 from linmstmm.model import Model
 
@@ -213,7 +213,33 @@ def _stacked(top: Compressed, bottom: Compressed) -> Compressed:
 
 def _add_springs(model, layout, strains, stiffness, constraints):
     """Finite spring directions become strains, ``inf`` ones constraints, released ones nothing
-    (each kind written as one block of rows, in the springs' order)."""
+    (each kind written as one block of rows, in the springs' order): by
+    :func:`linmstmm._node_kernels.spring_entries` where :func:`compiled_nodes`, the same
+    entries as :func:`_add_springs_in_numpy`."""
+    if not compiled_nodes():
+        _add_springs_in_numpy(model, layout, strains, stiffness, constraints)
+        return
+    from linmstmm._node_kernels import spring_entries
+
+    springs, points = model.springs, layout.index.points
+    ends = np.array([(points[spring.ends[0]], points[spring.ends[1]]) for spring in springs], int).reshape(-1, 2)
+    axes = np.array([spring.axes for spring in springs], float).reshape(-1, 3, 3)
+    k = np.array([spring.k for spring in springs], float).reshape(-1, 6)
+    kept = np.ones(k.shape, bool)
+    for i, spring in enumerate(springs):
+        if spring.release is not None:
+            kept[i] = ~np.asarray(spring.release, bool)
+    (rows, cols, values), k, rigid = spring_entries(ends, axes, k, kept, _DIRECTION_DOFS.reshape(6, 3))
+    if len(rigid[0]):
+        constraints.add(rigid[0] + constraints.new_rows(len(rigid[0]) // 6)[0], *rigid[1:])
+    strains.add(rows + strains.n_rows, cols, values)
+    strains.new_rows(len(k))
+    stiffness.append(k)
+
+
+def _add_springs_in_numpy(model, layout, strains, stiffness, constraints):
+    """:func:`_add_springs` in numpy: the readable reference of
+    :func:`linmstmm._node_kernels.spring_entries`."""
     owners, components, cols, values = spring_rows(model.springs, layout.index, kept_only=True)
     k = np.array([spring.k for spring in model.springs], float).reshape(-1, 6)
     k = k.ravel() if len(owners) == k.size else k[owners, components]   # every direction kept: all, in order
@@ -226,7 +252,23 @@ def _add_springs(model, layout, strains, stiffness, constraints):
 
 
 def _add_rigid_masses(model, layout, mass):
-    """Each body's mass and inertia on the DOFs of its mass centre."""
+    """Each body's mass and inertia on the DOFs of its mass centre: by
+    :func:`linmstmm._node_kernels.rigid_mass_entries` where :func:`compiled_nodes`, the
+    same entries as :func:`_add_rigid_masses_in_numpy`."""
+    if not compiled_nodes():
+        _add_rigid_masses_in_numpy(model, layout, mass)
+        return
+    from linmstmm._node_kernels import rigid_mass_entries
+
+    rigids = layout.index.rigids
+    nodes = np.array([rigids[body.name] for body in model.rigids], int)
+    inertias = np.array([body.inertia for body in model.rigids], float).reshape(-1, 3, 3)
+    mass.add(*rigid_mass_entries(nodes, np.array([body.mass for body in model.rigids], float), inertias))
+
+
+def _add_rigid_masses_in_numpy(model, layout, mass):
+    """:func:`_add_rigid_masses` in numpy: the readable reference of
+    :func:`linmstmm._node_kernels.rigid_mass_entries`."""
     dofs = 6 * np.array([layout.index.rigids[body.name] for body in model.rigids], int)[:, None] + np.arange(6)
     blocks = np.zeros((len(dofs), 36))                                    # each body's 6 × 6 block, row-major
     blocks[:, :15:7] = np.array([body.mass for body in model.rigids], float)[:, None]

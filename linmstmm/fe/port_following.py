@@ -71,6 +71,17 @@ class PortFollowing:
             empty), indices of the type scipy gives them
             (:func:`~linmstmm.fe.sparse.index_type`).
         """
+        if compiled_nodes():
+            from linmstmm._node_kernels import following_entries
+
+            indptr, indices, data = following_entries(positions.ravel(), self.arm_ends, self.arm_starts,
+                                                      self.arm_signs, self.rows, self.cols, self.source, self.shape[0])
+            index = index_type(self.shape[1], len(data))
+            return Compressed("csr", indptr.astype(index), indices.astype(index), data, self.shape)
+        return self._T_in_numpy(positions)
+
+    def _T_in_numpy(self, positions: np.ndarray) -> Compressed:
+        """:meth:`T` in numpy: the readable reference of :func:`linmstmm._node_kernels.following_entries`."""
         flat = positions.ravel()
         arms = (flat[self.arm_ends] - flat[self.arm_starts]) * self.arm_signs
         values = np.concatenate([[1.0, 0.0], arms])[self.source]
@@ -80,6 +91,21 @@ class PortFollowing:
         indptr = np.zeros(self.shape[0] + 1, index)
         np.cumsum(np.bincount(self.rows[stored], minlength=self.shape[0]), out=indptr[1:])
         return Compressed("csr", indptr, self.cols[stored].astype(index, copy=False), data, self.shape)
+
+
+def compiled_nodes() -> bool:
+    """Whether the node constraints (T here, the springs' and bodies' entries in
+    :mod:`linmstmm.fe.node_constraints`) are made by :mod:`linmstmm._node_kernels`:
+    where the compiled kernels are loaded already (:func:`linmstmm.determinant.kernels_loaded`;
+    the FE route alone never starts numba). The same arrays as in numpy either way.
+
+    Returns
+    -------
+    bool
+    """
+    from linmstmm.determinant import kernels_loaded
+
+    return kernels_loaded()
 
 
 #: The layout of T of each structure seen last (:func:`kept_port_following`).
@@ -122,12 +148,30 @@ def port_following(model: Model, layout) -> PortFollowing:
     index, n_full = layout.index, 6 * layout.n_nodes
     port_nodes = np.array([index.points[port] for body in model.rigids for port in body.ports], int)
     centre_nodes = np.array([index.rigids[body.name] for body in model.rigids for _ in body.ports], int)
-    ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
     fixed = np.array([components for components in model.boundary.values()], bool).reshape(-1, 6)
+    fixed_dofs = (6 * np.array([index.points[point] for point in model.boundary], int).reshape(-1, 1)
+                  + np.arange(6))[fixed]
+    if compiled_nodes():
+        from linmstmm._node_kernels import following_layout
+
+        rows, cols, source, masters, arm_ends, arm_starts = following_layout(
+            n_full, port_nodes, centre_nodes, fixed_dofs, _BLOCK_SOURCE, _ON_ARM, ARM_AXES)
+    else:
+        rows, cols, source, masters, arm_ends, arm_starts = _following_in_numpy(n_full, port_nodes, centre_nodes,
+                                                                                fixed_dofs)
+    return PortFollowing(arm_ends, arm_starts, np.tile(ARM_SIGNS, len(port_nodes)), rows, cols, source, masters,
+                         (n_full, len(masters)))
+
+
+def _following_in_numpy(n_full: int, port_nodes: np.ndarray, centre_nodes: np.ndarray, fixed_dofs: np.ndarray) -> tuple:
+    """(rows, cols, source, masters, arm_ends, arm_starts) of :class:`PortFollowing` of ports at
+    ``port_nodes`` (p,) following their bodies' mass centres at ``centre_nodes`` (p,), the
+    full DOFs ``fixed_dofs`` dropped, in numpy: the readable reference of
+    :func:`linmstmm._node_kernels.following_layout`."""
+    ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
     dropped = np.zeros(n_full, bool)
     dropped[ports] = True
-    dropped[(6 * np.array([index.points[point] for point in model.boundary], int).reshape(-1, 1)
-             + np.arange(6))[fixed]] = True
+    dropped[fixed_dofs] = True
     masters = np.flatnonzero(~dropped)
     # each row's possible entries: a master's its unit entry, a port's its body's six
     # centre columns descending, their numbers the lever-arm block's row reversed
@@ -139,8 +183,7 @@ def port_following(model: Model, layout) -> PortFollowing:
                              (_BLOCK_SOURCE + 6 * np.arange(p)[:, None, None] * _ON_ARM).ravel()])
     order = np.argsort(rows, kind="stable")             # rows ascending, each row's entries in their order
     arm_ends, arm_starts = ((3 * nodes[:, None] + ARM_AXES).ravel() for nodes in (port_nodes, centre_nodes))
-    return PortFollowing(arm_ends, arm_starts, np.tile(ARM_SIGNS, p), rows[order], cols[order], source[order],
-                         masters, (n_full, len(masters)))
+    return rows[order], cols[order], source[order], masters, arm_ends, arm_starts
 
 
 #: Where −[r]ₓ puts a port's lever arm r (m) in its 6 × 6 block, flattened

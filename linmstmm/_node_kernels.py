@@ -12,7 +12,9 @@ kernels are loaded (:func:`linmstmm.fe.port_following.compiled_nodes`):
 * :func:`spring_entries` and :func:`rigid_mass_entries` — the springs' strain and
   constraint rows and the bodies' mass blocks as triplets
   (:func:`linmstmm.fe.node_constraints._add_springs_in_numpy`,
-  :func:`~linmstmm.fe.node_constraints._add_rigid_masses_in_numpy`).
+  :func:`~linmstmm.fe.node_constraints._add_rigid_masses_in_numpy`);
+* :func:`element_entries` — the beams' elements' DOFs and maps to their local ones
+  (:func:`linmstmm.fe.layout._element_maps_in_numpy`), for every mesh.
 
 The model's records are read into flat arrays in Python (names to node numbers);
 everything made of them here is one loop.
@@ -32,7 +34,8 @@ announce_compiles()  # one line on stderr if this run compiles (linmstmm._compil
 
 
 @njit(cache=True)
-def following_layout(n_full, port_nodes, centre_nodes, fixed_dofs, block_source, on_arm, arm_axes):
+def following_layout(n_full, port_nodes, centre_nodes, boundary_nodes, fixed, block_source, on_arm, arm_axes,
+                     arm_signs):
     """The layout of T of a model held at free points, as
     :func:`linmstmm.fe.port_following.port_following` makes it.
 
@@ -42,23 +45,27 @@ def following_layout(n_full, port_nodes, centre_nodes, fixed_dofs, block_source,
         6 per point and mass centre.
     port_nodes, centre_nodes : (p,) int64
         Each port's node and its body's mass centre's, bodies and ports in model order.
-    fixed_dofs : (f,) int64
-        The full DOFs the boundary fixes.
+    boundary_nodes : (f,) int64
+        The nodes of the boundary's points.
+    fixed : (f, 6) bool
+        Their fixed components.
     block_source, on_arm : (6, 6) int64
         :data:`linmstmm.fe.port_following._BLOCK_SOURCE` and ``_ON_ARM``.
-    arm_axes : (6,) int64
-        :data:`linmstmm.fe.port_following.ARM_AXES`.
+    arm_axes : (6,) int64. arm_signs : (6,) float64
+        :data:`linmstmm.fe.port_following.ARM_AXES` and ``ARM_SIGNS``.
 
     Returns
     -------
+    arm_ends, arm_starts : (6 p,) int64
+        Where each port's and its mass centre's coordinates of its lever-arm entries sit
+        in the flattened positions.
+    arm_signs : (6 p,) float64
+        The sign each lever-arm entry takes.
     rows, cols, source : (e,) int64
         :attr:`~linmstmm.fe.port_following.PortFollowing.rows`, ``cols`` and ``source``:
         DOF after DOF, a master's unit entry, a port's six entries in its block's order.
     masters : (n_dof,) int64
         The full DOFs kept, ascending.
-    arm_ends, arm_starts : (6 p,) int64
-        Where each port's and its mass centre's coordinates of its lever-arm entries sit
-        in the flattened positions.
     """
     p = port_nodes.size
     dropped = np.zeros(n_full, dtype=np.bool_)
@@ -67,8 +74,10 @@ def following_layout(n_full, port_nodes, centre_nodes, fixed_dofs, block_source,
         for a in range(6):
             dropped[6 * port_nodes[i] + a] = True
             port_of[6 * port_nodes[i] + a] = 6 * i + a
-    for d in fixed_dofs:
-        dropped[d] = True
+    for b in range(boundary_nodes.size):
+        for a in range(6):
+            if fixed[b, a]:
+                dropped[6 * boundary_nodes[b] + a] = True
     column = np.empty(n_full, dtype=np.int64)            # the reduced DOF of each kept one
     kept = 0
     for d in range(n_full):
@@ -93,11 +102,13 @@ def following_layout(n_full, port_nodes, centre_nodes, fixed_dofs, block_source,
                 source[e] = block_source[a, c] + 6 * i * on_arm[a, c]
                 e += 1
     arm_ends, arm_starts = np.empty(6 * p, dtype=np.int64), np.empty(6 * p, dtype=np.int64)
+    signs = np.empty(6 * p)
     for i in range(p):
         for j in range(6):
             arm_ends[6 * i + j] = 3 * port_nodes[i] + arm_axes[j]
             arm_starts[6 * i + j] = 3 * centre_nodes[i] + arm_axes[j]
-    return rows[:e], cols[:e], source[:e], masters, arm_ends, arm_starts
+            signs[6 * i + j] = arm_signs[j]
+    return arm_ends, arm_starts, signs, rows[:e], cols[:e], source[:e], masters
 
 
 @njit(cache=True)
@@ -234,3 +245,39 @@ def rigid_mass_entries(nodes, masses, inertias):
                 elif i >= 3 and j >= 3:
                     values[e] = inertias[b, i - 3, j - 3]
     return rows, cols, values
+
+
+@njit(cache=True)
+def element_entries(nodes, axes):
+    """The elements' full DOFs and maps to their local DOFs as
+    :func:`linmstmm.fe.layout.element_maps` makes them.
+
+    Parameters
+    ----------
+    nodes : (b, n + 1) int64
+        Each beam's nodes, end a to end b.
+    axes : (b, 3, 3) float64
+        Rows = each beam's local axes.
+
+    Returns
+    -------
+    dofs : (b, n, 12) int64
+        Each element's full DOFs, node 1 then node 2.
+    to_local : (b, n, 12, 12) float64
+        The identity, but for the beam's end nodes' DOFs (inertial), rotated by ``axes``.
+    """
+    b, n = nodes.shape[0], nodes.shape[1] - 1
+    dofs = np.empty((b, n, 12), dtype=np.int64)
+    to_local = np.zeros((b, n, 12, 12))
+    for beam in range(b):
+        for e in range(n):
+            for a in range(6):
+                dofs[beam, e, a], dofs[beam, e, 6 + a] = 6 * nodes[beam, e] + a, 6 * nodes[beam, e + 1] + a
+            for a in range(12):
+                to_local[beam, e, a, a] = 1.0
+        for block in (0, 3):
+            for i in range(3):
+                for j in range(3):
+                    to_local[beam, 0, block + i, block + j] = axes[beam, i, j]
+                    to_local[beam, n - 1, 6 + block + i, 6 + block + j] = axes[beam, i, j]
+    return dofs, to_local

@@ -5,6 +5,8 @@ integer for integer and bit for bit, the node constraints the numpy reference ma
   numbers come from) and T itself (linmstmm.fe.port_following);
 * the springs' strain and constraint rows and stiffnesses, and the bodies' mass
   entries (linmstmm.fe.node_constraints._add_springs, _add_rigid_masses);
+* the beams' elements' DOFs and maps to their local DOFs, one to three elements
+  per beam (linmstmm.fe.layout.element_maps);
 
 on the bundled models, models with joints, released directions, rigid spring
 directions and beams rigid axially, and 60 random models.
@@ -24,7 +26,7 @@ from test_program_layout import BUNDLED
 
 import linmstmm.determinant as determinant
 from linmstmm.fe import port_following
-from linmstmm.fe.layout import _layout
+from linmstmm.fe.layout import _element_maps_in_numpy, _layout, element_maps
 from linmstmm.fe.node_constraints import held_at_free_points, node_constraints
 from linmstmm.model import load_model
 
@@ -84,3 +86,11 @@ def test_the_compiled_port_following_is_the_numpy_one(model):
                                                                                    model, layout)
     assert _same(compiled, reference)
     assert _same(compiled.T(layout.positions), compiled._T_in_numpy(layout.positions))
+
+
+@pytest.mark.parametrize("model", list(_models()), ids=lambda m: m.name)
+def test_the_compiled_element_maps_are_the_numpy_ones(model):
+    for elements_per_beam in (1, 2, 3):
+        layout = _layout(model, elements_per_beam)
+        assert _same(element_maps(layout.beam_table, layout.beam_axes),
+                     _element_maps_in_numpy(layout.beam_table, layout.beam_axes))

@@ -23,8 +23,8 @@ import numpy as np
 import scipy.sparse as sp
 
 from linmstmm.fe.constraints import _eliminate, reduced_constraints
-from linmstmm.fe.layout import _DIRECTION_DOFS, _layout, _Triplets, spring_rows
-from linmstmm.fe.port_following import PortFollowing, compiled_nodes, kept_port_following, port_kinematics
+from linmstmm.fe.layout import _DIRECTION_DOFS, _layout, _Triplets, compiled_nodes, spring_rows
+from linmstmm.fe.port_following import PortFollowing, kept_port_following, port_kinematics
 from linmstmm.fe.sparse import Compressed, scipy_csr
 from linmstmm.model import Model
 

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from linmstmm.fe.layout import compiled_nodes
 from linmstmm.fe.sparse import Compressed, index_type
 from linmstmm.model import Model
 from linmstmm.model_structure import MODELS_KEPT, KeptByStructure
@@ -93,21 +94,6 @@ class PortFollowing:
         return Compressed("csr", indptr, self.cols[stored].astype(index, copy=False), data, self.shape)
 
 
-def compiled_nodes() -> bool:
-    """Whether the node constraints (T here, the springs' and bodies' entries in
-    :mod:`linmstmm.fe.node_constraints`) are made by :mod:`linmstmm._node_kernels`:
-    where the compiled kernels are loaded already (:func:`linmstmm.determinant.kernels_loaded`;
-    the FE route alone never starts numba). The same arrays as in numpy either way.
-
-    Returns
-    -------
-    bool
-    """
-    from linmstmm.determinant import kernels_loaded
-
-    return kernels_loaded()
-
-
 #: The layout of T of each structure seen last (:func:`kept_port_following`).
 _followings = KeptByStructure(MODELS_KEPT)
 
@@ -148,30 +134,28 @@ def port_following(model: Model, layout) -> PortFollowing:
     index, n_full = layout.index, 6 * layout.n_nodes
     port_nodes = np.array([index.points[port] for body in model.rigids for port in body.ports], int)
     centre_nodes = np.array([index.rigids[body.name] for body in model.rigids for _ in body.ports], int)
+    boundary_nodes = np.array([index.points[point] for point in model.boundary], int)
     fixed = np.array([components for components in model.boundary.values()], bool).reshape(-1, 6)
-    fixed_dofs = (6 * np.array([index.points[point] for point in model.boundary], int).reshape(-1, 1)
-                  + np.arange(6))[fixed]
     if compiled_nodes():
         from linmstmm._node_kernels import following_layout
 
-        rows, cols, source, masters, arm_ends, arm_starts = following_layout(
-            n_full, port_nodes, centre_nodes, fixed_dofs, _BLOCK_SOURCE, _ON_ARM, ARM_AXES)
+        arrays = following_layout(n_full, port_nodes, centre_nodes, boundary_nodes, fixed, _BLOCK_SOURCE, _ON_ARM,
+                                  ARM_AXES, ARM_SIGNS)
     else:
-        rows, cols, source, masters, arm_ends, arm_starts = _following_in_numpy(n_full, port_nodes, centre_nodes,
-                                                                                fixed_dofs)
-    return PortFollowing(arm_ends, arm_starts, np.tile(ARM_SIGNS, len(port_nodes)), rows, cols, source, masters,
-                         (n_full, len(masters)))
+        arrays = _following_in_numpy(n_full, port_nodes, centre_nodes, boundary_nodes, fixed)
+    return PortFollowing(*arrays, (n_full, len(arrays[-1])))
 
 
-def _following_in_numpy(n_full: int, port_nodes: np.ndarray, centre_nodes: np.ndarray, fixed_dofs: np.ndarray) -> tuple:
-    """(rows, cols, source, masters, arm_ends, arm_starts) of :class:`PortFollowing` of ports at
-    ``port_nodes`` (p,) following their bodies' mass centres at ``centre_nodes`` (p,), the
-    full DOFs ``fixed_dofs`` dropped, in numpy: the readable reference of
-    :func:`linmstmm._node_kernels.following_layout`."""
+def _following_in_numpy(n_full: int, port_nodes: np.ndarray, centre_nodes: np.ndarray, boundary_nodes: np.ndarray,
+                        fixed: np.ndarray) -> tuple:
+    """(arm_ends, arm_starts, arm_signs, rows, cols, source, masters) of :class:`PortFollowing`
+    of ports at ``port_nodes`` (p,) following their bodies' mass centres at ``centre_nodes``
+    (p,), the ``fixed`` (f, 6) components of the points at ``boundary_nodes`` (f,) dropped,
+    in numpy: the readable reference of :func:`linmstmm._node_kernels.following_layout`."""
     ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
     dropped = np.zeros(n_full, bool)
     dropped[ports] = True
-    dropped[fixed_dofs] = True
+    dropped[(6 * boundary_nodes.reshape(-1, 1) + np.arange(6))[fixed]] = True
     masters = np.flatnonzero(~dropped)
     # each row's possible entries: a master's its unit entry, a port's its body's six
     # centre columns descending, their numbers the lever-arm block's row reversed
@@ -183,7 +167,7 @@ def _following_in_numpy(n_full: int, port_nodes: np.ndarray, centre_nodes: np.nd
                              (_BLOCK_SOURCE + 6 * np.arange(p)[:, None, None] * _ON_ARM).ravel()])
     order = np.argsort(rows, kind="stable")             # rows ascending, each row's entries in their order
     arm_ends, arm_starts = ((3 * nodes[:, None] + ARM_AXES).ravel() for nodes in (port_nodes, centre_nodes))
-    return rows[order], cols[order], source[order], masters, arm_ends, arm_starts
+    return arm_ends, arm_starts, np.tile(ARM_SIGNS, p), rows[order], cols[order], source[order], masters
 
 
 #: Where −[r]ₓ puts a port's lever arm r (m) in its 6 × 6 block, flattened

@@ -14,7 +14,10 @@ kernels are loaded (:func:`linmstmm.fe.port_following.compiled_nodes`):
   (:func:`linmstmm.fe.node_constraints._add_springs_in_numpy`,
   :func:`~linmstmm.fe.node_constraints._add_rigid_masses_in_numpy`);
 * :func:`element_entries` — the beams' elements' DOFs and maps to their local ones
-  (:func:`linmstmm.fe.layout._element_maps_in_numpy`), for every mesh.
+  (:func:`linmstmm.fe.layout._element_maps_in_numpy`), for every mesh;
+* :func:`held_nodes` — the springs', bodies' and elimination's of a model held at
+  free points in one call (in a first solve each call of a kernel costs a few
+  microseconds before it starts).
 
 The model's records are read into flat arrays in Python (names to node numbers);
 everything made of them here is one loop.
@@ -281,3 +284,29 @@ def element_entries(nodes, axes):
                     to_local[beam, 0, block + i, block + j] = axes[beam, i, j]
                     to_local[beam, n - 1, 6 + block + i, 6 + block + j] = axes[beam, i, j]
     return dofs, to_local
+
+
+@njit(cache=True)
+def held_nodes(spring_ends, spring_axes, spring_stiffness, spring_kept, direction_dofs, rigid_nodes, rigid_masses,
+               rigid_inertias, n_full, port_nodes, centre_nodes, boundary_nodes, fixed, block_source, on_arm,
+               arm_axes, arm_signs, flat):
+    """The node constraints of a model held at free points in one call: its springs'
+    strain rows (:func:`spring_entries`), its bodies' mass entries
+    (:func:`rigid_mass_entries`), the layout of its elimination
+    (:func:`following_layout`) and T (:func:`following_entries`) of the nodes at
+    ``flat``; the arguments theirs, in their order.
+
+    Returns
+    -------
+    strains : (3,) tuple of (6 f,) arrays. stiffness : (f,) float64.
+    mass : (3,) tuple of (36 r,) arrays.
+    following : (7,) tuple of arrays, :func:`following_layout`'s.
+    T : (3,) tuple of arrays, :func:`following_entries`'s.
+    """
+    strains, stiffness, _ = spring_entries(spring_ends, spring_axes, spring_stiffness, spring_kept, direction_dofs)
+    mass = rigid_mass_entries(rigid_nodes, rigid_masses, rigid_inertias)
+    following = following_layout(n_full, port_nodes, centre_nodes, boundary_nodes, fixed, block_source, on_arm,
+                                 arm_axes, arm_signs)
+    arm_ends, arm_starts, signs, rows, cols, source, _ = following
+    return strains, stiffness, mass, following, following_entries(flat, arm_ends, arm_starts, signs, rows, cols,
+                                                                  source, n_full)

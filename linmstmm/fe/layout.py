@@ -3,6 +3,7 @@ the growing sparse triplets the assembly writes into, and a spring's elongation
 as a row on those DOFs."""
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -116,16 +117,16 @@ def compiled_nodes() -> bool:
     """Whether the node constraints (the elimination T of :mod:`linmstmm.fe.port_following`,
     the springs' and bodies' entries of :mod:`linmstmm.fe.node_constraints`) and the
     elements' maps (:func:`element_maps`) are made by :mod:`linmstmm._node_kernels`:
-    where the compiled kernels are loaded already (:func:`linmstmm.determinant.kernels_loaded`;
-    the FE route alone never starts numba). The same arrays as in numpy either way.
+    where the compiled kernels are loaded already (:func:`linmstmm.determinant.kernels_loaded`,
+    asked only where that module is loaded: the FE route alone loads neither it nor
+    numba). The same arrays as in numpy either way.
 
     Returns
     -------
     bool
     """
-    from linmstmm.determinant import kernels_loaded
-
-    return kernels_loaded()
+    determinant = sys.modules.get("linmstmm.determinant")
+    return determinant is not None and determinant.kernels_loaded()
 
 
 def element_maps(nodes: np.ndarray, axes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

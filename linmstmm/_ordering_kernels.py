@@ -11,7 +11,9 @@ Wittrick–Williams counter of a new pattern:
   :func:`slot_terms` — where D(ω) may be nonzero, its pattern with the entries
   the beams reach, where each beam's entries go among the slots, and the
   springs' and bodies' terms there
-  (:func:`linmstmm.wittrick_williams.sparse_plan`).
+  (:func:`linmstmm.wittrick_williams.sparse_plan`);
+* :func:`beams_plan` — the plan of a pattern with the beams' entries and the
+  beams' slots in it, those kernels in one call.
 
 tests/test_sparse_count.py derives each in numpy and compares.
 """
@@ -237,3 +239,23 @@ def slot_terms(static, mass, high, low):
         if i > j:
             terms[2, s], terms[3, s] = static[j, i], mass[j, i]
     return terms
+
+
+@njit(cache=True)
+def beams_plan(pattern, beam_pattern, columns):
+    """The :class:`~linmstmm.ordered_ldlt.EliminationPlan` of ``pattern`` (n, n) bool with
+    the entries the beams reach (:func:`pattern_with_beams`), as
+    :func:`~linmstmm.ordered_ldlt.elimination_plan` makes it, and the beams' slots in it
+    (:func:`beam_slots`), in one call.
+
+    Returns
+    -------
+    order, starts, rows, high, low, updates, targets : int64 arrays
+        The plan's fields, in that order.
+    placed : (n_beams, k, k) int64
+        :func:`beam_slots` of the plan.
+    """
+    order, joined = minimum_degree(pattern_with_beams(pattern, beam_pattern, columns).astype(np.int64))
+    starts, rows, high, low, updates, targets = plan_slots(order, joined)
+    return order, starts, rows, high, low, updates, targets, beam_slots(high, low, beam_pattern, columns,
+                                                                       pattern.shape[0])

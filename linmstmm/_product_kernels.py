@@ -283,7 +283,7 @@ def counter_terms(parts) -> tuple[np.ndarray, np.ndarray] | None:
     DOFs of ``parts`` (:class:`~linmstmm.fe.assembly.ConstrainedParts`): the numbers
     ``dense_product(transposed(G), rows_scaled(G, k))``, G = S T, and
     :func:`~linmstmm.fe.products.congruence` form of the compressed spring rows S and
-    body masses, formed from their triplets.
+    body masses, formed from their triplets in one call (:func:`_counter_products`).
 
     Parameters
     ----------
@@ -294,15 +294,29 @@ def counter_terms(parts) -> tuple[np.ndarray, np.ndarray] | None:
     (static, mass) : (n, n) float64 each (N/m, N m/rad; kg, kg m²), or None where the
     triplets are not of the kind compressed here (left to the numpy route).
     """
-    T, n = parts.T, parts.T.shape[1]
-    springs = _triplet_rows(parts.spring_strains, parts.spring_strains.n_rows)
-    bodies = parts.rigid_mass.joined()
-    indptr, cols, values = _full_mass(T.shape[0], *bodies, np.zeros((0, 0, 12), np.int64), np.zeros((0, 0, 12, 12)))
-    if springs is None or indptr.size == 0:
-        return None
-    stiffness = np.concatenate(parts.spring_stiffness) if parts.spring_stiffness else np.zeros(0)
-    return (ordered_gram(*springs, T.indptr, T.indices, T.data, stiffness, n, False),
-            ordered_congruence(T.indptr, T.indices, T.data, indptr, cols, values, n))
+    T = parts.T
+    stiffness = parts.spring_stiffness
+    stiffness = stiffness[0] if len(stiffness) == 1 else (np.concatenate(stiffness) if stiffness else np.zeros(0))
+    static, mass, formed = _counter_products(parts.spring_strains.n_rows, *parts.spring_strains.joined(),
+                                             stiffness.astype(float, copy=False), *parts.rigid_mass.joined(),
+                                             T.indptr, T.indices, T.data, T.shape[1])
+    return (static, mass) if formed else None
+
+
+@njit(cache=True)
+def _counter_products(n_strains, strain_rows, strain_cols, strain_values, stiffness, mass_rows, mass_cols,
+                      mass_values, t_indptr, t_indices, t_data, n):
+    """(static, mass, formed) of :func:`counter_terms`: the strain triplets grouped into
+    CSR rows (:func:`_grouped_rows`), the mass triplets summed (:func:`_full_mass`),
+    then ``ordered_gram`` and ``ordered_congruence`` on T; formed False (both empty)
+    where the triplets are not of that kind."""
+    s_indptr, s_cols, s_values = _grouped_rows(n_strains, strain_rows, strain_cols, strain_values)
+    indptr, cols, values = _full_mass(t_indptr.size - 1, mass_rows, mass_cols, mass_values,
+                                      np.zeros((0, 0, 12), dtype=np.int64), np.zeros((0, 0, 12, 12)))
+    if s_indptr.size == 0 or indptr.size == 0:
+        return np.zeros((0, 0)), np.zeros((0, 0)), False
+    return (ordered_gram(s_indptr, s_cols, s_values, t_indptr, t_indices, t_data, stiffness, n, False),
+            ordered_congruence(t_indptr, t_indices, t_data, indptr, cols, values, n), True)
 
 
 def _triplet_rows(triplets, n_rows) -> tuple | None:

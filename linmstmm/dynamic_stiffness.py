@@ -83,14 +83,10 @@ class BeamTable:
     @classmethod
     def of(cls, beams: tuple[Beam, ...]) -> BeamTable:
         """The table of ``beams`` (records of :class:`linmstmm.model.Beam`)."""
-        def column(value):
-            return np.array([value(b) for b in beams], dtype=float)
-        return cls(EA=column(lambda b: b.E * b.A), GJ=column(lambda b: b.G * b.J),
-                   EIy=column(lambda b: b.E * b.Iy), EIz=column(lambda b: b.E * b.Iz),
-                   rhoA=column(lambda b: b.rho * b.A), rhoIp=column(lambda b: b.rho * b.Ip),
-                   L=column(lambda b: b.length),
-                   axial=np.array([b.axial for b in beams], bool),
-                   torsion=np.array([b.torsion for b in beams], bool))
+        # one row per beam, read in one pass; each column the same products as one by one
+        rows = np.array([(b.E * b.A, b.G * b.J, b.E * b.Iy, b.E * b.Iz, b.rho * b.A, b.rho * b.Ip, b.length,
+                          b.axial, b.torsion) for b in beams], dtype=float).reshape(-1, 9)
+        return cls(*rows[:, :7].T.copy(), axial=rows[:, 7] != 0, torsion=rows[:, 8] != 0)
 
 
 def dynamic_stiffness(beams: BeamTable, omega: float) -> np.ndarray:

@@ -312,12 +312,12 @@ def _planned(pattern: np.ndarray, beam_pattern: np.ndarray, columns: np.ndarray)
 
 
 def _plan_of(pattern: np.ndarray, beam_pattern: np.ndarray, columns: np.ndarray) -> tuple:
-    """:func:`_planned` made anew (:mod:`linmstmm._ordering_kernels`)."""
-    from linmstmm._ordering_kernels import beam_slots, pattern_with_beams
-    from linmstmm.ordered_ldlt import elimination_plan
+    """:func:`_planned` made anew, in one call (:func:`linmstmm._ordering_kernels.beams_plan`)."""
+    from linmstmm._ordering_kernels import beams_plan
+    from linmstmm.ordered_ldlt import EliminationPlan
 
-    plan = elimination_plan(pattern_with_beams(pattern, beam_pattern, columns))
-    return plan, beam_slots(plan.high, plan.low, beam_pattern, columns, pattern.shape[0])
+    *plan, placed = beams_plan(pattern, beam_pattern, columns)
+    return EliminationPlan(*plan), placed
 
 
 def _reduced_terms(parts, engine: str) -> tuple[np.ndarray, np.ndarray]:

@@ -173,6 +173,8 @@ def test_beams_slots_are_the_numpy_derivation():
         assert np.array_equal(pattern_with_beams(pattern, beam_pattern, counter._columns), joined)
         plan, placed = _plan_of(pattern, beam_pattern, counter._columns)
         assert np.array_equal(placed, slots)
+        planned = elimination_plan(joined)
+        assert all(np.array_equal(getattr(plan, field), getattr(planned, field)) for field in planned.__dataclass_fields__)
         static, mass, high, low = counter._static, counter._mass, plan.high, plan.low
         assert np.array_equal(slot_terms(static, mass, high, low), np.stack([
             static[high, low], mass[high, low], np.where(high > low, static[low, high], 0.0),

@@ -3,6 +3,7 @@ the growing sparse triplets the assembly writes into, and a spring's elongation
 as a row on those DOFs."""
 from __future__ import annotations
 
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -92,19 +93,40 @@ def _layout(model: Model, elements_per_beam: int, nodes: _Layout | None = None) 
             return nodes
     if n == 1:  # no interior node: the points and mass centres as they are
         return _Layout(DofIndex(points, rigids, {beam.name: nodes for beam, nodes in zip(model.beams, ends)}),
-                       placed, np.broadcast_to(np.eye(3), (len(placed), 3, 3)).copy(), ends, axes)
+                       placed, np.repeat(_INERTIAL[None], len(placed), axis=0), ends, axes)
     interior = len(placed) + np.arange(len(ends) * (n - 1)).reshape(len(ends), n - 1)
     table = np.concatenate([ends[:, :1], interior, ends[:, 1:]], axis=1)
     xa, xb = placed[ends[:, 0]], placed[ends[:, 1]]
     inside = xa[:, None] + (xb - xa)[:, None] * (np.arange(1, n) / n)[None, :, None]
-    frames = np.concatenate([np.broadcast_to(np.eye(3), (len(placed), 3, 3)), np.repeat(axes, n - 1, axis=0)])
+    frames = np.concatenate([np.broadcast_to(_INERTIAL, (len(placed), 3, 3)), np.repeat(axes, n - 1, axis=0)])
     return _Layout(DofIndex(points, rigids, {beam.name: nodes for beam, nodes in zip(model.beams, table)}),
                    np.concatenate([placed, inside.reshape(-1, 3)]), frames, table, axes)
+
+
+#: The axes of a point's or mass centre's DOFs (rows): the inertial ones.
+_INERTIAL = np.eye(3)
+_INERTIAL.setflags(write=False)
 
 
 def _beam_axes(beams) -> np.ndarray:
     """(n_beams, 3, 3) rows = each beam's local axes in the inertial frame."""
     return np.array([beam.axes for beam in beams], float).reshape(-1, 3, 3)
+
+
+def compiled_nodes() -> bool:
+    """Whether the node constraints (the elimination T of :mod:`linmstmm.fe.port_following`,
+    the springs' and bodies' entries of :mod:`linmstmm.fe.node_constraints`) and the
+    elements' maps (:func:`element_maps`) are made by :mod:`linmstmm._node_kernels`:
+    where the compiled kernels are loaded already (:func:`linmstmm.determinant.kernels_loaded`,
+    asked only where that module is loaded: the FE route alone loads neither it nor
+    numba). The same arrays as in numpy either way.
+
+    Returns
+    -------
+    bool
+    """
+    determinant = sys.modules.get("linmstmm.determinant")
+    return determinant is not None and determinant.kernels_loaded()
 
 
 def element_maps(nodes: np.ndarray, axes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -121,6 +143,16 @@ def element_maps(nodes: np.ndarray, axes: np.ndarray) -> tuple[np.ndarray, np.nd
     to_local : (b, n, 12, 12) maps from those DOFs to the element's local ones: the
         end nodes' DOFs are inertial (rotated by ``axes``), interior ones local already.
     """
+    if compiled_nodes():
+        from linmstmm._node_kernels import element_entries
+
+        return element_entries(nodes, axes)
+    return _element_maps_in_numpy(nodes, axes)
+
+
+def _element_maps_in_numpy(nodes: np.ndarray, axes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`element_maps` in numpy: the readable reference of
+    :func:`linmstmm._node_kernels.element_entries`."""
     b, n = nodes.shape[0], nodes.shape[1] - 1
     to_local = np.zeros((b, n, 12, 12))
     to_local[:, :, np.arange(12), np.arange(12)] = 1.0
@@ -146,6 +178,10 @@ class _Triplets:
         self._joined = None   # joined(), made on first use, dropped when entries are added
 
     def add(self, rows, cols, values):
+        """Add the entries ``values`` at (``rows``, ``cols``), the three broadcast together."""
+        if _flat_alike(rows, cols, values):  # flat already (as the compiled node builder writes them)
+            self._append(rows, cols, values.astype(float, copy=False))
+            return
         shape = np.broadcast(rows, cols, values).shape
         rows, cols, values = (_flat(part, shape) for part in (rows, cols, values))
         self._append(rows, cols, values.astype(float, copy=False))
@@ -162,9 +198,8 @@ class _Triplets:
         once until more entries are added, and shared (never written), so that the
         counter and the coarse pencil of one model join them once."""
         if self._joined is None:
-            self._joined = tuple(np.concatenate(part).astype(dtype, copy=False) if part else np.zeros(0, dtype)
-                                 for part, dtype in ((self.rows, np.int64), (self.cols, np.int64),
-                                                     (self.values, float)))
+            self._joined = tuple(_joined(part, dtype) for part, dtype in ((self.rows, np.int64), (self.cols, np.int64),
+                                                                          (self.values, float)))
         return self._joined
 
     def new_rows(self, count):
@@ -201,6 +236,19 @@ class _Triplets:
             return compressed_of_summed(rows, cols, values, (n_rows, n_cols))
         nonzero = values != 0
         return compressed_of_distinct(rows[nonzero], cols[nonzero], values[nonzero], (n_rows, n_cols))
+
+
+def _joined(parts: list, dtype) -> np.ndarray:
+    """The arrays ``parts`` end to end as ``dtype``: a lone one as it is where it has that type."""
+    if len(parts) == 1:
+        return parts[0].astype(dtype, copy=False)
+    return np.concatenate(parts).astype(dtype, copy=False) if parts else np.zeros(0, dtype)
+
+
+def _flat_alike(*parts) -> bool:
+    """Whether ``parts`` are all one-dimensional arrays of one length."""
+    first = parts[0]
+    return all(isinstance(part, np.ndarray) and part.ndim == 1 and len(part) == len(first) for part in parts)
 
 
 def _flat(part, shape: tuple) -> np.ndarray:

@@ -23,8 +23,15 @@ import numpy as np
 import scipy.sparse as sp
 
 from linmstmm.fe.constraints import _eliminate, reduced_constraints
-from linmstmm.fe.layout import _layout, _Triplets, spring_rows
-from linmstmm.fe.port_following import PortFollowing, kept_port_following, port_kinematics
+from linmstmm.fe.layout import _DIRECTION_DOFS, _layout, _Triplets, compiled_nodes, spring_rows
+from linmstmm.fe.port_following import (
+    FOLLOWING_CONSTANTS,
+    PortFollowing,
+    followed,
+    following_nodes,
+    kept_port_following,
+    port_kinematics,
+)
 from linmstmm.fe.sparse import Compressed, scipy_csr
 from linmstmm.model import Model
 
@@ -145,11 +152,14 @@ def node_constraints(model: Model) -> NodeConstraints:
     """
     layout = _layout(model, 1)              # the points and mass centres only
     n_full = 6 * layout.n_nodes
+    held = held_at_free_points(model)
+    if held and compiled_nodes():
+        return _held_node_constraints(model, layout)
     strains, mass, constraints = _Triplets(), _Triplets(repeats=True), _Triplets()
     stiffness = []
     _add_springs(model, layout, strains, stiffness, constraints)
     _add_rigid_masses(model, layout, mass)
-    if held_at_free_points(model):
+    if held:
         following = kept_port_following(model, layout)
         return NodeConstraints(layout, n_full, None, None, None, strains, stiffness, mass,
                                (following.T(layout.positions), following.masters), following)
@@ -162,6 +172,25 @@ def node_constraints(model: Model) -> NodeConstraints:
         t1, masters = _eliminate(reduced_constraints(rows, t0_csr))
         elimination = ((t0_csr @ scipy_csr(t1)).tocsr(), kept[masters])
     return NodeConstraints(layout, n_full, t0, kept, rows, strains, stiffness, mass, elimination, None)
+
+
+def _held_node_constraints(model: Model, layout) -> NodeConstraints:
+    """:func:`node_constraints` of a model :func:`held_at_free_points`, made in one call of
+    :func:`linmstmm._node_kernels.held_nodes` (the same arrays as made step by step), its
+    elimination's layout kept by its structure as :func:`kept_port_following` keeps it."""
+    from linmstmm._node_kernels import held_nodes
+
+    n_full = 6 * layout.n_nodes
+    strain_rows, stiffness, mass_entries, arrays, entries = held_nodes(
+        *_spring_arrays(model, layout), *_rigid_arrays(model, layout), n_full, *following_nodes(model, layout),
+        *FOLLOWING_CONSTANTS, layout.positions.ravel())
+    strains, mass = _Triplets(), _Triplets(repeats=True)
+    strains.add(*strain_rows)
+    strains.new_rows(len(stiffness))
+    mass.add(*mass_entries)
+    following = kept_port_following(model, layout, followed(n_full, arrays))
+    return NodeConstraints(layout, n_full, None, None, None, strains, [stiffness], mass,
+                           (following.compressed(*entries), following.masters), following)
 
 
 def held_at_free_points(model: Model) -> bool:
@@ -213,7 +242,44 @@ def _stacked(top: Compressed, bottom: Compressed) -> Compressed:
 
 def _add_springs(model, layout, strains, stiffness, constraints):
     """Finite spring directions become strains, ``inf`` ones constraints, released ones nothing
-    (each kind written as one block of rows, in the springs' order)."""
+    (each kind written as one block of rows, in the springs' order): by
+    :func:`linmstmm._node_kernels.spring_entries` where :func:`compiled_nodes`, the same
+    entries as :func:`_add_springs_in_numpy`."""
+    if not compiled_nodes():
+        _add_springs_in_numpy(model, layout, strains, stiffness, constraints)
+        return
+    from linmstmm._node_kernels import spring_entries
+
+    (rows, cols, values), k, rigid = spring_entries(*_spring_arrays(model, layout))
+    if len(rigid[0]):
+        constraints.add(rigid[0] + constraints.new_rows(len(rigid[0]) // 6)[0], *rigid[1:])
+    strains.add(rows + strains.n_rows, cols, values)
+    strains.new_rows(len(k))
+    stiffness.append(k)
+
+
+def _spring_arrays(model, layout) -> tuple:
+    """(ends (s, 2) nodes, axes (s, 3, 3), k (s, 6) N/m or N m/rad, kept (s, 6) bool, the
+    directions' DOFs (6, 3)): the springs of ``model`` on ``layout`` as
+    :func:`linmstmm._node_kernels.spring_entries` takes them."""
+    springs, points = model.springs, layout.index.points
+    ends = np.array([(points[spring.ends[0]], points[spring.ends[1]]) for spring in springs], int).reshape(-1, 2)
+    axes = np.array([spring.axes for spring in springs], float).reshape(-1, 3, 3)
+    k = np.array([spring.k for spring in springs], float).reshape(-1, 6)
+    kept = np.ones(k.shape, bool)
+    for i, spring in enumerate(springs):
+        if spring.release is not None:
+            kept[i] = ~np.asarray(spring.release, bool)
+    return ends, axes, k, kept, _DIRECTIONS
+
+
+#: :data:`linmstmm.fe.layout._DIRECTION_DOFS` as (6, 3): each direction's three DOFs at an end.
+_DIRECTIONS = _DIRECTION_DOFS.reshape(6, 3)
+
+
+def _add_springs_in_numpy(model, layout, strains, stiffness, constraints):
+    """:func:`_add_springs` in numpy: the readable reference of
+    :func:`linmstmm._node_kernels.spring_entries`."""
     owners, components, cols, values = spring_rows(model.springs, layout.index, kept_only=True)
     k = np.array([spring.k for spring in model.springs], float).reshape(-1, 6)
     k = k.ravel() if len(owners) == k.size else k[owners, components]   # every direction kept: all, in order
@@ -226,7 +292,29 @@ def _add_springs(model, layout, strains, stiffness, constraints):
 
 
 def _add_rigid_masses(model, layout, mass):
-    """Each body's mass and inertia on the DOFs of its mass centre."""
+    """Each body's mass and inertia on the DOFs of its mass centre: by
+    :func:`linmstmm._node_kernels.rigid_mass_entries` where :func:`compiled_nodes`, the
+    same entries as :func:`_add_rigid_masses_in_numpy`."""
+    if not compiled_nodes():
+        _add_rigid_masses_in_numpy(model, layout, mass)
+        return
+    from linmstmm._node_kernels import rigid_mass_entries
+
+    mass.add(*rigid_mass_entries(*_rigid_arrays(model, layout)))
+
+
+def _rigid_arrays(model, layout) -> tuple:
+    """(nodes (r,), masses (r,) kg, inertias (r, 3, 3) kg m²): the bodies' mass centres on
+    ``layout`` and their masses, as :func:`linmstmm._node_kernels.rigid_mass_entries` takes them."""
+    rigids = layout.index.rigids
+    nodes = np.array([rigids[body.name] for body in model.rigids], int)
+    inertias = np.array([body.inertia for body in model.rigids], float).reshape(-1, 3, 3)
+    return nodes, np.array([body.mass for body in model.rigids], float), inertias
+
+
+def _add_rigid_masses_in_numpy(model, layout, mass):
+    """:func:`_add_rigid_masses` in numpy: the readable reference of
+    :func:`linmstmm._node_kernels.rigid_mass_entries`."""
     dofs = 6 * np.array([layout.index.rigids[body.name] for body in model.rigids], int)[:, None] + np.arange(6)
     blocks = np.zeros((len(dofs), 36))                                    # each body's 6 × 6 block, row-major
     blocks[:, :15:7] = np.array([body.mass for body in model.rigids], float)[:, None]

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from linmstmm.fe.layout import compiled_nodes
 from linmstmm.fe.sparse import Compressed, index_type
 from linmstmm.model import Model
 from linmstmm.model_structure import MODELS_KEPT, KeptByStructure
@@ -71,6 +72,23 @@ class PortFollowing:
             empty), indices of the type scipy gives them
             (:func:`~linmstmm.fe.sparse.index_type`).
         """
+        if compiled_nodes():
+            from linmstmm._node_kernels import following_entries
+
+            return self.compressed(*following_entries(positions.ravel(), self.arm_ends, self.arm_starts,
+                                                      self.arm_signs, self.rows, self.cols, self.source,
+                                                      self.shape[0]))
+        return self._T_in_numpy(positions)
+
+    def compressed(self, indptr: np.ndarray, indices: np.ndarray, data: np.ndarray) -> Compressed:
+        """T of the CSR arrays :func:`linmstmm._node_kernels.following_entries` makes
+        ((n_full + 1,), (nnz,) int64 and (nnz,) float64), its indices of the type scipy
+        gives them (:func:`~linmstmm.fe.sparse.index_type`)."""
+        index = index_type(self.shape[1], len(data))
+        return Compressed("csr", indptr.astype(index), indices.astype(index), data, self.shape)
+
+    def _T_in_numpy(self, positions: np.ndarray) -> Compressed:
+        """:meth:`T` in numpy: the readable reference of :func:`linmstmm._node_kernels.following_entries`."""
         flat = positions.ravel()
         arms = (flat[self.arm_ends] - flat[self.arm_starts]) * self.arm_signs
         values = np.concatenate([[1.0, 0.0], arms])[self.source]
@@ -86,7 +104,7 @@ class PortFollowing:
 _followings = KeptByStructure(MODELS_KEPT)
 
 
-def kept_port_following(model: Model, layout) -> PortFollowing:
+def kept_port_following(model: Model, layout, made: PortFollowing | None = None) -> PortFollowing:
     """The :func:`port_following` of ``model`` on ``layout``, made for the first model
     of its structure and kept for the next (it depends on the structure alone).
 
@@ -95,13 +113,16 @@ def kept_port_following(model: Model, layout) -> PortFollowing:
     model : Model
     layout : linmstmm.fe.layout._Layout
         As for :func:`port_following`.
+    made : PortFollowing, optional
+        The model's, made already (by :func:`linmstmm._node_kernels.held_nodes`): kept
+        where none is, instead of making it.
 
     Returns
     -------
     PortFollowing
         The same object for every model of the structure.
     """
-    return _followings.get(model, lambda model: port_following(model, layout))
+    return _followings.get(model, lambda model: port_following(model, layout) if made is None else made)
 
 
 def port_following(model: Model, layout) -> PortFollowing:
@@ -119,15 +140,43 @@ def port_following(model: Model, layout) -> PortFollowing:
     -------
     PortFollowing
     """
-    index, n_full = layout.index, 6 * layout.n_nodes
+    n_full, nodes = 6 * layout.n_nodes, following_nodes(model, layout)
+    if compiled_nodes():
+        from linmstmm._node_kernels import following_layout
+
+        return followed(n_full, following_layout(n_full, *nodes, *FOLLOWING_CONSTANTS))
+    return followed(n_full, _following_in_numpy(n_full, *nodes))
+
+
+def following_nodes(model: Model, layout) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(port_nodes (p,), centre_nodes (p,), boundary_nodes (f,), fixed (f, 6) bool): each
+    port's node and its body's mass centre's (bodies and ports in model order), the
+    boundary's points' nodes and their fixed components, on ``layout``: what
+    :func:`port_following` is made of."""
+    index = layout.index
     port_nodes = np.array([index.points[port] for body in model.rigids for port in body.ports], int)
     centre_nodes = np.array([index.rigids[body.name] for body in model.rigids for _ in body.ports], int)
-    ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
+    boundary_nodes = np.array([index.points[point] for point in model.boundary], int)
     fixed = np.array([components for components in model.boundary.values()], bool).reshape(-1, 6)
+    return port_nodes, centre_nodes, boundary_nodes, fixed
+
+
+def followed(n_full: int, arrays: tuple) -> PortFollowing:
+    """The :class:`PortFollowing` of (arm_ends, arm_starts, arm_signs, rows, cols, source,
+    masters) on ``n_full`` full DOFs."""
+    return PortFollowing(*arrays, (n_full, len(arrays[-1])))
+
+
+def _following_in_numpy(n_full: int, port_nodes: np.ndarray, centre_nodes: np.ndarray, boundary_nodes: np.ndarray,
+                        fixed: np.ndarray) -> tuple:
+    """(arm_ends, arm_starts, arm_signs, rows, cols, source, masters) of :class:`PortFollowing`
+    of ports at ``port_nodes`` (p,) following their bodies' mass centres at ``centre_nodes``
+    (p,), the ``fixed`` (f, 6) components of the points at ``boundary_nodes`` (f,) dropped,
+    in numpy: the readable reference of :func:`linmstmm._node_kernels.following_layout`."""
+    ports, centres = (6 * nodes.reshape(-1, 1) + np.arange(6) for nodes in (port_nodes, centre_nodes))
     dropped = np.zeros(n_full, bool)
     dropped[ports] = True
-    dropped[(6 * np.array([index.points[point] for point in model.boundary], int).reshape(-1, 1)
-             + np.arange(6))[fixed]] = True
+    dropped[(6 * boundary_nodes.reshape(-1, 1) + np.arange(6))[fixed]] = True
     masters = np.flatnonzero(~dropped)
     # each row's possible entries: a master's its unit entry, a port's its body's six
     # centre columns descending, their numbers the lever-arm block's row reversed
@@ -139,8 +188,7 @@ def port_following(model: Model, layout) -> PortFollowing:
                              (_BLOCK_SOURCE + 6 * np.arange(p)[:, None, None] * _ON_ARM).ravel()])
     order = np.argsort(rows, kind="stable")             # rows ascending, each row's entries in their order
     arm_ends, arm_starts = ((3 * nodes[:, None] + ARM_AXES).ravel() for nodes in (port_nodes, centre_nodes))
-    return PortFollowing(arm_ends, arm_starts, np.tile(ARM_SIGNS, p), rows[order], cols[order], source[order],
-                         masters, (n_full, len(masters)))
+    return arm_ends, arm_starts, np.tile(ARM_SIGNS, p), rows[order], cols[order], source[order], masters
 
 
 #: Where −[r]ₓ puts a port's lever arm r (m) in its 6 × 6 block, flattened
@@ -162,6 +210,9 @@ def _block_source() -> tuple[np.ndarray, np.ndarray]:
 
 
 _BLOCK_SOURCE, _ON_ARM = _block_source()
+
+#: The constant arguments of :func:`linmstmm._node_kernels.following_layout`, in its order.
+FOLLOWING_CONSTANTS = (_BLOCK_SOURCE, _ON_ARM, ARM_AXES, ARM_SIGNS)
 
 
 def port_kinematics(ports: np.ndarray, centres: np.ndarray) -> np.ndarray:

@@ -37,11 +37,10 @@ def balanced(matrix, start_rows, start_cols, sweeps):
         least its largest singular value.
     """
     n, m = matrix.shape
-    size = np.abs(matrix)
     rows, cols = start_rows.copy(), start_cols.copy()
     weighted = np.empty((n, m))  # the rows' part of the scaled |a|, formed once per change of rows
-    _weigh(size, rows, weighted)
-    peaks = _column_peaks(weighted)
+    peaks = np.empty(m)  # each column's largest weighted |a|
+    _weigh(matrix, rows, weighted, peaks)
     row_factors, column_factors = np.empty(n), np.empty(m)
     for _ in range(sweeps):
         for i in range(n):
@@ -52,8 +51,7 @@ def balanced(matrix, start_rows, start_cols, sweeps):
         rows_kept = np.all(row_factors == 1.0)
         if not rows_kept:
             rows *= row_factors
-            _weigh(size, rows, weighted)
-            peaks = _column_peaks(weighted)
+            _weigh(matrix, rows, weighted, peaks)
         for j in range(m):
             column_factors[j] = _power_of_two_scale(peaks[j] * cols[j])
         cols *= column_factors
@@ -71,21 +69,13 @@ def balanced(matrix, start_rows, start_cols, sweeps):
 
 
 @njit(cache=True)
-def _weigh(size, rows, weighted):
-    """``weighted[i, j] = rows[i] * size[i, j]``, in place."""
-    for i in range(size.shape[0]):
-        for j in range(size.shape[1]):
-            weighted[i, j] = rows[i] * size[i, j]
-
-
-@njit(cache=True)
-def _column_peaks(weighted):
-    """(M,) the largest entry of each column of ``weighted`` (N, M)."""
-    peaks = weighted[0].copy()
-    for i in range(1, weighted.shape[0]):
-        for j in range(weighted.shape[1]):
+def _weigh(matrix, rows, weighted, peaks):
+    """``weighted[i, j] = rows[i] * |matrix[i, j]|`` and ``peaks[j]`` the largest of column j, in place."""
+    peaks[:] = 0.0
+    for i in range(matrix.shape[0]):
+        for j in range(matrix.shape[1]):
+            weighted[i, j] = rows[i] * abs(matrix[i, j])
             peaks[j] = max(peaks[j], weighted[i, j])
-    return peaks
 
 
 @njit(cache=True)

@@ -296,7 +296,7 @@ def _clearly_regular(sample: np.ndarray, threshold: float, start) -> bool:
     (:func:`equilibration`), has no singular value below ``threshold`` times its largest
     (:func:`nullity`; decided by :func:`_well_above` where that can, on the one balanced
     matrix both read). The balance and its bound are compiled
-    (:func:`linmstmm._balance_kernels.balanced`: the launcher's 65 µs in numpy, 18 µs so)."""
+    (:func:`linmstmm._balance_kernels.balanced`: the launcher's 65 µs in numpy, 17 µs so)."""
     if not np.isfinite(sample).all():
         return False
     from linmstmm._balance_kernels import balanced  # numba loads here: a screen is a compiled determinant's

@@ -191,7 +191,7 @@ def _structure(deduction: Deduction) -> tuple:
     directions), the order, root, cuts and boundary conditions, and the unknowns
     and rows released."""
     topology = deduction.topology
-    elements = tuple((el.kind, el.output, tuple(el.inputs), tuple(port.link for port in el.ports),
+    elements = tuple((el.kind, el.output, tuple(el.inputs), tuple([port.link for port in el.ports]),
                       deduction.jump_columns[e].tobytes() + el.record.released.tobytes()
                       if e in deduction.jump_columns else None)
                      for e, el in enumerate(topology.elements))

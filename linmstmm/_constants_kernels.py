@@ -8,13 +8,12 @@ entry as the element modules write it for one element
 these to bit for bit, the sign of every zero included).
 
 The products of two 3 × 3 matrices (a body's moment rows, a spring's compliances turned
-into the inertial frame) are not formed here: numpy forms them
-(:func:`~linmstmm.elements.rigid.moment_rows`, :func:`~linmstmm.elements.spring.rotated`),
-whose BLAS sums in an order of its own (fused multiply-adds on this machine), which a
-loop here would not repeat. :mod:`linmstmm.program_constants` calls :func:`rigid_factors`
-and :func:`spring_diagonals` for their factors, numpy for the products, then
-:func:`place` for the rest: on the launcher 0.04 ms against 0.1 ms for some eighty
-numpy calls on stacks of a few elements.
+into the inertial frame) are not formed here: numpy forms them (``arm @ weighted``,
+:func:`~linmstmm.elements.spring.rotated`), by BLAS, whose sums differ from a plain
+loop's in the last bit (on this machine one entry in three of random 3 × 3 products).
+:mod:`linmstmm.program_constants` calls :func:`factors` for their factors, numpy for
+the products, then :func:`place` for the rest: on the launcher 0.04 ms against 0.1 ms
+for some eighty numpy calls on stacks of a few elements.
 """
 from __future__ import annotations
 
@@ -27,23 +26,33 @@ announce_compiles()  # one line on stderr if this run compiles (linmstmm._compil
 
 
 @njit(cache=True)
-def rigid_factors(mass, com, inp, out):
-    """The factors of the rigid bodies' moment rows: ``arm @ weighted``.
+def factors(mass, com, inp, out, k, release, released):
+    """The factors numpy multiplies: the rigid bodies' moment rows are ``arm @ weighted``,
+    the springs' compliances in the inertial frame ``axesᵀ diagonal axes``
+    (:func:`~linmstmm.elements.spring.rotated`).
 
     Parameters
     ----------
-    mass : (n,) float64
+    mass : (nr,) float64
         kg.
-    com, inp, out : (n, 3) float64
+    com, inp, out : (nr, 3) float64
         Mass centres, first inputs and outputs, m.
+    k : (ns, 6) float64
+        Stiffnesses, N/m and N m/rad, ``inf`` a rigid direction.
+    release : (ns, 6) float64
+        1 where a direction is released (its compliance 0), read where ``released``.
+    released : int
+        0: nothing is released in any spring (the compliance is 1 / k throughout).
 
     Returns
     -------
-    arm : (n, 3, 3) float64
+    arm : (nr, 3, 3) float64
         −skew(out − com).
-    weighted : (n, 3, 6) float64
+    weighted : (nr, 3, 6) float64
         ``[I | −skew(com − inp)] m``: the mass centre's displacement from the input's
         displacement and rotation, times the mass.
+    diagonal : (ns, 2, 3, 3) float64
+        Translational and rotational compliances on the diagonals, zeros elsewhere.
     """
     n = mass.size
     arm, weighted = np.empty((n, 3, 3)), np.empty((n, 3, 6))
@@ -56,34 +65,12 @@ def rigid_factors(mass, com, inp, out):
             for j in range(3):
                 weighted[b, i, j] = (1.0 if i == j else 0.0) * mass[b]
                 weighted[b, i, 3 + j] = -lever[i, j] * mass[b]
-    return arm, weighted
-
-
-@njit(cache=True)
-def spring_diagonals(k, release, released):
-    """The springs' compliances in their own axes, as diagonal matrices.
-
-    Parameters
-    ----------
-    k : (n, 6) float64
-        Stiffnesses, N/m and N m/rad, ``inf`` a rigid direction.
-    release : (n, 6) float64
-        1 where a direction is released (its compliance 0), read where ``released``.
-    released : int
-        0: nothing is released in any spring (the compliance is 1 / k throughout).
-
-    Returns
-    -------
-    (n, 2, 3, 3) float64
-        Translational and rotational compliances on the diagonals, zeros elsewhere.
-    """
-    n = k.shape[0]
-    diagonal = np.zeros((n, 2, 3, 3))
-    for s in range(n):
+    diagonal = np.zeros((k.shape[0], 2, 3, 3))
+    for s in range(k.shape[0]):
         for d in range(6):
             free = released != 0 and release[s, d] != 0.0
             diagonal[s, d // 3, d % 3, d % 3] = 0 * k[s, d] if free else 1 / k[s, d]
-    return diagonal
+    return arm, weighted, diagonal
 
 
 @njit(cache=True)
@@ -99,7 +86,7 @@ def place(matrices, rigid, inp, out, weighted, moments, inertia, spring, complia
     inp, out : (nr, 3) float64
         Its first input and output, m.
     weighted, moments, inertia : (nr, 3, 6), (nr, 3, 6), (nr, 3, 3) float64
-        :func:`rigid_factors`'s ``weighted``, ``arm @ weighted`` and the inertia about
+        :func:`factors`'s ``weighted``, ``arm @ weighted`` and the inertia about
         the mass centre, kg m².
     spring : (ns, 2) int64
         (element, U0 index) of each spring.

@@ -418,6 +418,8 @@ def _table(records: list[tuple], width: int) -> np.ndarray:
 
 def _kept(order: int, released: np.ndarray) -> np.ndarray:
     """(order - released,) int64: 0..order-1, less the indices ``released``, ascending."""
+    if not released.size:  # nothing released (most models)
+        return np.arange(order, dtype=np.int64)
     kept = np.ones(order, dtype=bool)
     kept[released] = False
     return np.flatnonzero(kept).astype(np.int64, copy=False)

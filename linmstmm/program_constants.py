@@ -63,7 +63,7 @@ class Constants:
             structure (whose padding is zeros already); each one written is padded with
             zeros to 12 × 12.
         """
-        from linmstmm._constants_kernels import place, rigid_factors, spring_diagonals  # numba loads here
+        from linmstmm._constants_kernels import factors, place  # numba loads here
 
         elements = deduction.topology.elements
         if self._indices is None:
@@ -72,10 +72,9 @@ class Constants:
                              np.array(self.other_input, dtype=np.int64).reshape(-1, 4))
         rigid, spring, other_input = self._indices
         mass, com, inertia, inp, out = _rigid_numbers(elements, rigid)
-        arm, weighted = rigid_factors(mass, com, inp, out)
         k, axes, release = _spring_numbers(elements, spring)
-        compliances = rotated(axes, spring_diagonals(k, release, int(release.size > 0)))
-        place(matrices, rigid, inp, out, weighted, arm @ weighted, inertia, spring, compliances, other_input,
+        arm, weighted, diagonal = factors(mass, com, inp, out, k, release, int(release.size > 0))
+        place(matrices, rigid, inp, out, weighted, arm @ weighted, inertia, spring, rotated(axes, diagonal), other_input,
               _other_input_positions(elements, other_input))
         if self.junction:
             matrices[self.junction] = np.eye(12)

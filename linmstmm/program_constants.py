@@ -74,8 +74,8 @@ class Constants:
         mass, com, inertia, inp, out = _rigid_numbers(elements, rigid)
         k, axes, release = _spring_numbers(elements, spring)
         arm, weighted, diagonal = factors(mass, com, inp, out, k, release, int(release.size > 0))
-        place(matrices, rigid, inp, out, weighted, arm @ weighted, inertia, spring, rotated(axes, diagonal), other_input,
-              _other_input_positions(elements, other_input))
+        place(matrices, rigid, inp, out, weighted, arm @ weighted, inertia, spring, rotated(axes, diagonal),
+              other_input, _other_input_positions(elements, other_input))
         if self.junction:
             matrices[self.junction] = np.eye(12)
         for e, force, jump in self.joint:

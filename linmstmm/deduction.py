@@ -81,13 +81,10 @@ class Deduction:
         self._runs = None
         self._tips: dict[tuple, tuple] = {}  # link -> (columns, selection (12, k)), less released ones
         self._layouts: dict[tuple, tuple] = {}  # see _combined
-        self._boundary_columns = {b: np.arange(6 * b, 6 * b + 6) for b in range(len(topology.boundaries))}
-        self._cut_columns = {}
         self._boundary_rows = boundary_state_rows(topology.boundaries)
         state_rows = [row for rows in self._boundary_rows for row in rows]  # the state vector's row of each unknown
-        for c in range(len(topology.cuts)):
-            self._cut_columns[c] = np.arange(len(state_rows), len(state_rows) + 12)
-            state_rows += range(12)
+        self._first_cut_column = len(state_rows)  # cut c's twelve follow the boundary ends' six each
+        state_rows += list(range(12)) * len(topology.cuts)
         #: element -> columns of the jumps across its released directions
         self.jump_columns: dict[int, np.ndarray] = {}
         for e, element in enumerate(topology.elements):
@@ -191,11 +188,11 @@ class Deduction:
         ``selection @ z̄[columns]`` (less released unknowns); found once per link."""
         if link not in self._tips:
             if link[0] == "boundary":
-                columns = self._boundary_columns[link[1]]
+                columns = np.arange(6 * link[1], 6 * link[1] + 6)
                 selection = boundary_selection(tuple(self._boundary_rows[link[1]]))
             else:
                 _, c, side = link
-                columns = self._cut_columns[c]
+                columns = np.arange(self._first_cut_column + 12 * c, self._first_cut_column + 12 * c + 12)
                 selection = np.eye(12) if (side == 0 or self.topology.cuts[c].closing) else _CUT_SIGN
             self._tips[link] = self._kept(columns, selection)
         return self._tips[link]

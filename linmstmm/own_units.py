@@ -8,6 +8,8 @@ singular values (:mod:`linmstmm.nullspace`) is too.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -24,8 +26,13 @@ def extent(topology) -> float:
     float
         Model length unit; 0 for a model whose ports all coincide.
     """
-    positions = np.array([port.position for element in topology.elements for port in element.ports], float)
-    return float(np.linalg.norm(positions.max(axis=0) - positions.min(axis=0))) if positions.size else 0.0
+    # each point once (a port stands at its point): half the ports of the launcher to stack
+    at = {port.point: port.position for element in topology.elements for port in element.ports}
+    if not at:
+        return 0.0
+    positions = np.array(list(at.values()), float)
+    span = positions.max(axis=0) - positions.min(axis=0)
+    return math.sqrt(span.dot(span))  # numpy.linalg.norm's sum and root, without its checks
 
 
 def unit_sizes(topology, frequency: float) -> np.ndarray:

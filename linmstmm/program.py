@@ -191,7 +191,7 @@ def _structure(deduction: Deduction) -> tuple:
     directions), the order, root, cuts and boundary conditions, and the unknowns
     and rows released."""
     topology = deduction.topology
-    elements = tuple((el.kind, el.output, tuple(el.inputs), tuple(port.link for port in el.ports),
+    elements = tuple((el.kind, el.output, tuple(el.inputs), tuple([port.link for port in el.ports]),
                       deduction.jump_columns[e].tobytes() + el.record.released.tobytes()
                       if e in deduction.jump_columns else None)
                      for e, el in enumerate(topology.elements))
@@ -418,6 +418,8 @@ def _table(records: list[tuple], width: int) -> np.ndarray:
 
 def _kept(order: int, released: np.ndarray) -> np.ndarray:
     """(order - released,) int64: 0..order-1, less the indices ``released``, ascending."""
+    if not released.size:  # nothing released (most models)
+        return np.arange(order, dtype=np.int64)
     kept = np.ones(order, dtype=bool)
     kept[released] = False
     return np.flatnonzero(kept).astype(np.int64, copy=False)

@@ -276,3 +276,24 @@ def test_the_first_probe_alone_releases_what_all_three_did(monkeypatch):
                 screened += 1
                 assert np.isfinite(samples).all(), model.name
     assert releasing >= 8 and screened >= 200
+
+
+def test_the_compiled_balance_is_the_equilibration():
+    """_balance_kernels.balanced, which the screen reads, balances as equilibration does
+    (the same scales, the balanced matrix bit for bit) and bounds its largest singular
+    value by √(‖B‖₁ ‖B‖∞) as _well_above does (to rounding: its sums run in another order)."""
+    from linmstmm._balance_kernels import balanced
+    from linmstmm.nullspace import EQUILIBRATION_SWEEPS
+
+    rng = np.random.default_rng(17)
+    for trial in range(400):
+        shape = tuple(rng.integers(1, 70, 2)) if trial % 3 else (int(rng.integers(1, 70)),) * 2
+        matrix = rng.standard_normal(shape) * 10.0 ** rng.integers(-150, 150, shape) * (rng.random(shape) < 0.6)
+        start = (rng.uniform(1e-5, 1e5, shape[0]), rng.uniform(1e-5, 1e5, shape[1])) if trial % 2 else \
+            (np.ones(shape[0]), np.ones(shape[1]))
+        rows, cols = equilibration(matrix, start=start)
+        ours, bound = balanced(matrix, *start, EQUILIBRATION_SWEEPS)
+        assert np.array_equal(ours, rows[:, None] * matrix * cols)
+        size = np.abs(ours)
+        np.testing.assert_allclose(bound, np.sqrt(size.sum(axis=0).max()) * np.sqrt(size.sum(axis=1).max()),
+                                   rtol=1e-13)

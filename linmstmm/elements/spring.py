@@ -48,9 +48,28 @@ def spring_compliance(k, axes, release=None) -> tuple[np.ndarray, np.ndarray]:
         compliance[free] = 0 * k[free]
     diagonal = np.zeros(k.shape[:-1] + (2, 9), dtype=k.dtype)  # translational, rotational: diag of each
     diagonal[..., ::4] = compliance.reshape(k.shape[:-1] + (2, 3))
-    axes = axes[..., None, :, :]
-    both = np.swapaxes(axes, -1, -2) @ diagonal.reshape(k.shape[:-1] + (2, 3, 3)) @ axes
+    both = rotated(axes, diagonal.reshape(k.shape[:-1] + (2, 3, 3)))
     return both[..., 0, :, :], both[..., 1, :, :]
+
+
+def rotated(axes: np.ndarray, diagonal: np.ndarray) -> np.ndarray:
+    """``axesᵀ D axes`` for each of a spring's two compliances D (in its own axes).
+
+    Parameters
+    ----------
+    axes : (..., 3, 3) float
+        Rows = the springs' local axes.
+    diagonal : (..., 2, 3, 3)
+        Translational (m/N) and rotational (rad/(N m)) compliances in the local axes.
+
+    Returns
+    -------
+    (..., 2, 3, 3)
+        The same in the inertial frame (the program's constants take them from here:
+        :mod:`linmstmm._constants_kernels`).
+    """
+    axes = axes[..., None, :, :]
+    return np.swapaxes(axes, -1, -2) @ diagonal @ axes
 
 
 def spring_constant_transfer(k, axes, release=None) -> np.ndarray:

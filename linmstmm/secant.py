@@ -9,8 +9,13 @@ from __future__ import annotations
 
 import numpy as np
 
-#: Relative size of the secant's first step (its second point).
-FIRST_STEP = 1e-7
+#: Relative size of the secant's first step (its second point): downward, since the
+#: coarse model's frequencies lie above the natural frequencies they predict (a
+#: Rayleigh–Ritz model: the launchers' lowest 20 by 5e-9 to 7e-4), so the second
+#: point lies nearer the root than the first, and so does the first secant point:
+#: a few evaluations fewer (2,664 against 2,678 upward, over twenty solves of the
+#: bundled launchers and tip-mass cantilever, 10 to 100 modes).
+FIRST_STEP = -1e-7
 #: Secant steps before a root that has not settled is handed to the pencil.
 SECANT_STEPS = 12
 
@@ -19,7 +24,7 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
     """Simple real roots of det near ``starts`` (rad/s) by the secant method on det.
 
     log_det : callable ω (n,) -> (sign (n,), log|det| (n,)). xtol : relative
-    step that ends the iteration; floor : a step below this (relative) that no
+    step that ends the iteration. floor : a step below this (relative) that no
     longer shrinks has reached the rounding floor of det, and is accepted with
     that step as its uncertainty.
     Each step evaluates det once per root still moving, all in one call;
@@ -38,6 +43,7 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
     steps = np.full(x.size, np.inf)
     active = np.arange(x.size)
     previous = before = np.full(x.size, np.inf)
+    oldest = np.full(x.size, np.nan)  # the point evaluated before x_old (none yet)
     for _ in range(SECANT_STEPS):
         with np.errstate(divide="ignore", invalid="ignore"):  # sign 0: det exactly 0, x is a root
             ratio = (sign_old / sign).real * np.exp(np.clip(log_old - log_abs, -700, 700))  # det(x_old)/det(x)
@@ -45,9 +51,14 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
         step = np.where(np.isfinite(step), step, 0.0)
         new = x + step
         size = np.abs(step) / np.abs(new)
-        # The secant converges superlinearly (order 1.6): after a step s_k that
-        # followed s_(k-1), the error left is about s_k^2 / s_(k-1), so a step whose
-        # square is xtol/10 of the one before needs no evaluation to confirm it.
+        # The secant converges superlinearly (order 1.6): the error of a point from
+        # x_k and x_(k-1) is C e_k e_(k-1), and that of x_k was C e_(k-1) e_(k-2), so
+        # with the step s_k measuring e_k, the error left is about s_k^2 / e_(k-2),
+        # e_(k-2) the distance of the new point from the point x_(k-2) (the reach):
+        # a step whose square is xtol/10 of that reach needs no evaluation to
+        # confirm it. (s_k^2 / s_(k-1), taken before, is larger by e_(k-2)/e_(k-1):
+        # the launchers' first 100 took 513 and 492 evaluations so, against 496 and
+        # 469 with the reach and FIRST_STEP.)
         # A step measures the error only while the secant converges: the first one
         # (from two points FIRST_STEP apart, a Newton step), or one shorter than the
         # step before, itself at most half of the one before it. From a point far
@@ -56,15 +67,16 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
         # cantilever's pair 2.5e-6 apart the step of 1.4e-9 after two of 1.1e-3
         # stopped the secant between the two roots, at det's extremum.
         converging = ~np.isfinite(previous) | ((size < previous) & (previous <= before / 2))
-        ahead = np.where(converging & np.isfinite(previous), size * size / previous, np.inf)
-        done = (((size <= xtol) & converging) | (ahead <= xtol / 10) | ((size >= previous / 2) & (size <= floor))
-                | (sign == 0))
+        reach = np.abs(new - oldest) / np.abs(new)
+        ahead = np.where(converging & np.isfinite(previous) & np.isfinite(reach), size * size / reach, np.inf)
+        done = (((size <= xtol) & converging) | (ahead <= xtol / 10)
+                | ((size >= previous / 2) & (size <= floor)) | (sign == 0))
         roots[active[done]] = np.where(sign[done] == 0, x[done], new[done])
         steps[active[done]] = np.minimum(size[done], ahead[done])
         keep = ~done
         if not keep.any():
             break
-        active, previous, before = active[keep], size[keep], previous[keep]
+        active, previous, before, oldest = active[keep], size[keep], previous[keep], x_old[keep]
         x_old, sign_old, log_old = x[keep], sign[keep], log_abs[keep]
         x = new[keep]
         sign, log_abs = log_det(x)

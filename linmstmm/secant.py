@@ -20,13 +20,13 @@ FIRST_STEP = -1e-7
 SECANT_STEPS = 12
 
 
-def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
+def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: float):
     """Simple real roots of det near ``starts`` (rad/s) by the secant method on det.
 
     log_det : callable ω (n,) -> (sign (n,), log|det| (n,)). xtol : relative
-    step that ends the iteration. floor : a step below this (relative) that no
-    longer shrinks has reached the rounding floor of det, and is accepted with
-    that step as its uncertainty.
+    step that ends the iteration, one for all or (n,) one per start. floor : a
+    step below this (relative) that no longer shrinks has reached the rounding
+    floor of det, and is accepted with that step as its uncertainty.
     Each step evaluates det once per root still moving, all in one call;
     det's ratio at two points is formed from the log magnitudes, so no value
     overflows. Returns (roots, last relative steps); a root that did not
@@ -35,6 +35,7 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
     x_old = np.asarray(starts, dtype=float)
     if not x_old.size:
         return np.zeros(0), np.zeros(0)
+    tolerance = np.broadcast_to(np.asarray(xtol, dtype=float), x_old.shape).copy()
     x = x_old * (1 + FIRST_STEP)
     # both starting points in one batch (each frequency is evaluated on its own: the same numbers)
     signs, logs = log_det(np.concatenate([x_old, x]))
@@ -68,8 +69,9 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
         # stopped the secant between the two roots, at det's extremum.
         converging = ~np.isfinite(previous) | ((size < previous) & (previous <= before / 2))
         reach = np.abs(new - oldest) / np.abs(new)
-        ahead = np.where(converging & np.isfinite(previous) & np.isfinite(reach), size * size / reach, np.inf)
-        done = (((size <= xtol) & converging) | (ahead <= xtol / 10)
+        measured = converging & np.isfinite(previous) & np.isfinite(reach) & (reach > 0)  # none before two steps
+        ahead = np.where(measured, size * size / np.where(measured, reach, 1.0), np.inf)
+        done = (((size <= tolerance) & converging) | (ahead <= tolerance / 10)
                 | ((size >= previous / 2) & (size <= floor)) | (sign == 0))
         roots[active[done]] = np.where(sign[done] == 0, x[done], new[done])
         steps[active[done]] = np.minimum(size[done], ahead[done])
@@ -77,6 +79,7 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
         if not keep.any():
             break
         active, previous, before, oldest = active[keep], size[keep], previous[keep], x_old[keep]
+        tolerance = tolerance[keep]
         x_old, sign_old, log_old = x[keep], sign[keep], log_abs[keep]
         x = new[keep]
         sign, log_abs = log_det(x)

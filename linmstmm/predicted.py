@@ -53,6 +53,10 @@ NEAR_KNOWN = 1e-5
 #: the others only place the certifying count's upper end in the gap above it
 #: (the coarse model is within about 1e-2 of every root it predicts).
 NEAR_COUNT = 2e-2
+#: Relative step to which the secant polishes a prediction above the roots wanted that
+#: only places the certifying count's upper end (:func:`_secant_polished`): a tenth of
+#: CLUSTER, the least distance above the roots wanted at which such a value stands.
+PLACING = 1e-4
 #: Predictions this close (relative) are one multiple root's (:func:`_coincident`).
 COINCIDENT = 1e-10
 #: From this rtol up, each prediction with no other within CLUSTER is first tried as
@@ -117,11 +121,11 @@ def _certified(finder, predictions: np.ndarray, count: int, stand: bool) -> tupl
     their certifying count, rad/s): from ``predictions`` (ascending, positive),
     with those that counts certify as they stand taken so if ``stand``."""
     wanted = int(np.searchsorted(predictions, predictions[count - 1] * (1 + NEAR_COUNT), side="right"))
-    roots = _polished(finder, predictions, [], 0, wanted, stand)
+    roots = _polished(finder, predictions, [], 0, wanted, stand, count)
     if roots is not None and len(roots) < count < predictions.size:  # some predicted twice: as many more
         more = min(wanted + count - len(roots), predictions.size)
         more = int(np.searchsorted(predictions, predictions[more - 1] * (1 + NEAR_COUNT), side="right"))
-        roots = _polished(finder, predictions, roots, wanted, more, stand)
+        roots = _polished(finder, predictions, roots, wanted, more, stand, more)
         wanted = more
     if roots is None:
         return None, np.nan
@@ -151,7 +155,8 @@ def _certified(finder, predictions: np.ndarray, count: int, stand: bool) -> tupl
     return [r for r in roots if r <= upper], upper
 
 
-def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, stop: int, stand: bool):
+def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, stop: int, stand: bool,
+              wanted: int):
     """``roots`` (rad/s) and the roots of ``predictions[start:stop]``, ascending: as they
     stand where counts certify them to a loose rtol (if ``stand``), else by the secant, then the
     pencil, then the segment search around those both left troubled. None where a
@@ -162,7 +167,7 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
     leaders, followers = _coincident(predictions, indices)
     coincident = {*leaders.tolist(), *followers.tolist()}
     alone = np.array([i for i in indices.tolist() if i not in coincident], dtype=np.int64)
-    found, unsettled = _secant_polished(finder, predictions, in_cluster, alone, list(roots) + standing)
+    found, unsettled = _secant_polished(finder, predictions, in_cluster, alone, list(roots) + standing, wanted)
     found, troubled = _pencil_polished(finder, list(roots) + standing + found,
                                        unsettled + [float(p) for p in predictions[leaders]])
     found, troubled = _deflated_polished(finder, found, troubled, predictions)
@@ -237,7 +242,7 @@ def _counted_predictions(finder, predictions: np.ndarray, in_cluster: list[bool]
 
 
 def _secant_polished(finder, predictions: np.ndarray, in_cluster: list[bool], indices: np.ndarray,
-                     known: list[float]) -> tuple[list[float], list[float]]:
+                     known: list[float], wanted: int) -> tuple[list[float], list[float]]:
     """(roots, unsettled predictions): ``predictions[indices]`` by the secant on det
     (the others are their neighbours only; ``in_cluster``: :func:`_in_cluster` of
     ``predictions``); one that lands on a ``known`` root (rad/s) is unsettled.
@@ -249,24 +254,54 @@ def _secant_polished(finder, predictions: np.ndarray, in_cluster: list[bool], in
     root's det keeps its sign: the secant creeps to the rounding floor there), to
     the finder's rtol for the others (a secant that stalled above it on a noisy det,
     1.3e-9 on a ring's 10th root with the default rtol, goes to the pencil).
+
+    A prediction from the ``wanted``-th up (index ``wanted`` or more) alone in no
+    cluster only places the certifying count's upper end in the gap above the roots
+    wanted (:func:`_gap_above`): it is polished to PLACING only, and stands so where
+    it lies more than CLUSTER above every root polished in full (and ``known``),
+    which all settled; otherwise it is polished again in full, from where it came (the
+    secant's steps are the same to either tolerance: one that does not settle to
+    PLACING would not to xtol either).
     """
     if not indices.size:  # every prediction stood, or went to the pencil
         return [], []
-    found, steps = secant_roots(finder.log_det, predictions[indices], finder.xtol, finder.UNCERTAIN)
+    placing = np.array([i >= wanted and not in_cluster[i] for i in indices.tolist()])
+    found, steps = secant_roots(finder.log_det, predictions[indices],
+                                np.where(placing, PLACING, finder.xtol), finder.UNCERTAIN)
+    settled = _settled(finder, predictions, in_cluster, indices, found, steps, placing, known)
+    if placing.any():
+        full = ~placing
+        top = max([*found[full & settled].tolist(), *known], default=0.0)
+        clear = found > top * (1 + CLUSTER) if settled[full].all() else np.zeros(found.size, dtype=bool)
+        redo = placing & settled & ~clear
+        if redo.any():
+            found[redo], steps[redo] = secant_roots(finder.log_det, found[redo], finder.xtol, finder.UNCERTAIN)
+            placing &= ~redo
+            settled = _settled(finder, predictions, in_cluster, indices, found, steps, placing, known)
+    kept = np.flatnonzero(settled)
+    for k in kept:
+        finder.last_step[found[k]] = steps[k]
+    return [found[k] for k in kept], [float(predictions[i]) for i, stands in zip(indices, settled) if not stands]
+
+
+def _settled(finder, predictions: np.ndarray, in_cluster: list[bool], indices: np.ndarray, found: np.ndarray,
+             steps: np.ndarray, placing: np.ndarray, known: list[float]) -> np.ndarray:
+    """(n,) bool: which secant results ``found`` (rad/s) of ``predictions[indices]``, with
+    their last relative ``steps``, stand (:func:`_secant_polished`; ``placing``: those
+    polished to PLACING only)."""
     values, same = predictions.tolist(), _same_root(finder)
     roots = found.tolist()
+    bounds = [PLACING if loose else finder.xtol if in_cluster[i] else finder.rtol
+              for i, loose in zip(indices.tolist(), placing.tolist())]
     settled = [not math.isnan(root) and abs(root - values[i]) <= 0.5 * _gap(values, i)
-               and step <= (finder.xtol if in_cluster[i] else finder.rtol) and not _known(root, known, same)
-               for i, root, step in zip(indices.tolist(), roots, steps.tolist())]
+               and step <= bound and not _known(root, known, same)
+               for i, root, step, bound in zip(indices.tolist(), roots, steps.tolist(), bounds)]
     for i in [k for k, stands in enumerate(settled) if stands]:  # two that settled on one root: neither stands
         twins = [k for k, stands in enumerate(settled) if stands and abs(roots[k] - roots[i]) <= same * roots[i]]
         if len(twins) > 1:
             for k in twins:
                 settled[k] = False
-    kept = np.flatnonzero(settled)
-    for k in kept:
-        finder.last_step[found[k]] = steps[k]
-    return [found[k] for k in kept], [values[i] for i, stands in zip(indices, settled) if not stands]
+    return np.array(settled, dtype=bool)
 
 
 def _completed_by_counts(finder, found: list[float], lo: float, hi: float):

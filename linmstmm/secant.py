@@ -2,26 +2,35 @@
 
 One evaluation per step and per root still moving, all in one call (a batch
 the kernels share among the cores), superlinear (order 1.6) near a simple
-root; det's ratio at two points is formed from the log magnitudes, so no
-value overflows. :mod:`linmstmm.predicted` polishes its predictions so.
+root, and faster (order 1.8) from the third point on, where inverse quadratic
+interpolation through the last three points refines the secant's step (the
+launchers' first 20 in 71 and 64 evaluations, against 75 and 66 by the secant
+alone; their first 100 in 455 and 428, against 496 and 469); det's ratio at
+two points is formed from the log magnitudes, so no value overflows.
+:mod:`linmstmm.predicted` polishes its predictions so.
 """
 from __future__ import annotations
 
 import numpy as np
 
-#: Relative size of the secant's first step (its second point).
-FIRST_STEP = 1e-7
+#: Relative size of the secant's first step (its second point): downward, since the
+#: coarse model's frequencies lie above the natural frequencies they predict (a
+#: Rayleigh–Ritz model: the launchers' lowest 20 by 5e-9 to 7e-4), so the second
+#: point lies nearer the root than the first, and so does the first secant point:
+#: a few evaluations fewer (2,664 against 2,678 upward, over twenty solves of the
+#: bundled launchers and tip-mass cantilever, 10 to 100 modes).
+FIRST_STEP = -1e-7
 #: Secant steps before a root that has not settled is handed to the pencil.
 SECANT_STEPS = 12
 
 
-def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
+def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: float):
     """Simple real roots of det near ``starts`` (rad/s) by the secant method on det.
 
     log_det : callable ω (n,) -> (sign (n,), log|det| (n,)). xtol : relative
-    step that ends the iteration; floor : a step below this (relative) that no
-    longer shrinks has reached the rounding floor of det, and is accepted with
-    that step as its uncertainty.
+    step that ends the iteration, one for all or (n,) one per start. floor : a
+    step below this (relative) that no longer shrinks has reached the rounding
+    floor of det, and is accepted with that step as its uncertainty.
     Each step evaluates det once per root still moving, all in one call;
     det's ratio at two points is formed from the log magnitudes, so no value
     overflows. Returns (roots, last relative steps); a root that did not
@@ -30,6 +39,7 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
     x_old = np.asarray(starts, dtype=float)
     if not x_old.size:
         return np.zeros(0), np.zeros(0)
+    tolerance = np.broadcast_to(np.asarray(xtol, dtype=float), x_old.shape).copy()
     x = x_old * (1 + FIRST_STEP)
     # both starting points in one batch (each frequency is evaluated on its own: the same numbers)
     signs, logs = log_det(np.concatenate([x_old, x]))
@@ -38,16 +48,33 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
     steps = np.full(x.size, np.inf)
     active = np.arange(x.size)
     previous = before = np.full(x.size, np.inf)
+    oldest = np.full(x.size, np.nan)  # the point evaluated before x_old (none yet)
+    sign_oldest, log_oldest = np.full(x.size, np.nan), np.full(x.size, np.nan)
     for _ in range(SECANT_STEPS):
-        with np.errstate(divide="ignore", invalid="ignore"):  # sign 0: det exactly 0, x is a root
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # sign 0: det exactly 0, x is a root
             ratio = (sign_old / sign).real * np.exp(np.clip(log_old - log_abs, -700, 700))  # det(x_old)/det(x)
             step = -(x - x_old) / (1 - ratio)
+            # From the third point on, inverse quadratic interpolation through the last
+            # three (far = det(oldest)/det(x)), taken where it corrects the secant step by
+            # at most half that step (the two agree near a simple root; far off, or on a
+            # noisy det, the secant's step stands)
+            far = (sign_oldest / sign).real * np.exp(np.clip(log_oldest - log_abs, -700, 700))
+            quadratic = ((oldest - x) * ratio / ((far - ratio) * (far - 1))
+                         + (x_old - x) * far / ((ratio - far) * (ratio - 1)))
         step = np.where(np.isfinite(step), step, 0.0)
+        correction = np.abs(quadratic - step)
+        interpolated = np.isfinite(quadratic) & (correction <= 0.5 * np.abs(step))
+        step = np.where(interpolated, quadratic, step)
         new = x + step
         size = np.abs(step) / np.abs(new)
-        # The secant converges superlinearly (order 1.6): after a step s_k that
-        # followed s_(k-1), the error left is about s_k^2 / s_(k-1), so a step whose
-        # square is xtol/10 of the one before needs no evaluation to confirm it.
+        # The secant converges superlinearly (order 1.6): the error of a point from
+        # x_k and x_(k-1) is C e_k e_(k-1), and that of x_k was C e_(k-1) e_(k-2), so
+        # with the step s_k measuring e_k, the error left is about s_k^2 / e_(k-2),
+        # e_(k-2) the distance of the new point from the point x_(k-2) (the reach):
+        # a step whose square is xtol/10 of that reach needs no evaluation to
+        # confirm it. (s_k^2 / s_(k-1), taken before, is larger by e_(k-2)/e_(k-1):
+        # the launchers' first 100 took 513 and 492 evaluations so, against 496 and
+        # 469 with the reach and FIRST_STEP.)
         # A step measures the error only while the secant converges: the first one
         # (from two points FIRST_STEP apart, a Newton step), or one shorter than the
         # step before, itself at most half of the one before it. From a point far
@@ -56,15 +83,24 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float, floor: float):
         # cantilever's pair 2.5e-6 apart the step of 1.4e-9 after two of 1.1e-3
         # stopped the secant between the two roots, at det's extremum.
         converging = ~np.isfinite(previous) | ((size < previous) & (previous <= before / 2))
-        ahead = np.where(converging & np.isfinite(previous), size * size / previous, np.inf)
-        done = (((size <= xtol) & converging) | (ahead <= xtol / 10) | ((size >= previous / 2) & (size <= floor))
-                | (sign == 0))
+        reach = np.abs(new - oldest) / np.abs(new)
+        measured = converging & np.isfinite(previous) & np.isfinite(reach) & (reach > 0)  # none before two steps
+        ahead = np.where(measured, size * size / np.where(measured, reach, 1.0), np.inf)
+        # The interpolated point's error is the secant point's (ahead, which the
+        # correction measures) times C e_(k-2) = e_k / e_(k-1), the last contraction,
+        # where the correction bears that estimate out (within a factor of 10).
+        agree = interpolated & measured & (correction <= 10 * ahead * np.abs(new))
+        ahead = np.where(agree, ahead * np.minimum(size / np.where(agree, previous, 1.0), 1.0), ahead)
+        done = (((size <= tolerance) & converging) | (ahead <= tolerance / 10)
+                | ((size >= previous / 2) & (size <= floor)) | (sign == 0))
         roots[active[done]] = np.where(sign[done] == 0, x[done], new[done])
         steps[active[done]] = np.minimum(size[done], ahead[done])
         keep = ~done
         if not keep.any():
             break
-        active, previous, before = active[keep], size[keep], previous[keep]
+        active, previous, before, oldest = active[keep], size[keep], previous[keep], x_old[keep]
+        sign_oldest, log_oldest = sign_old[keep], log_old[keep]
+        tolerance = tolerance[keep]
         x_old, sign_old, log_old = x[keep], sign[keep], log_abs[keep]
         x = new[keep]
         sign, log_abs = log_det(x)

@@ -168,6 +168,25 @@ class ModeCounter:
             self._count_now([omega])
         return self._answers[omega]
 
+    def at(self, omegas) -> list[int | None]:
+        """:meth:`__call__` at each of ``omegas`` (rad/s), those not counted yet counted
+        together (:meth:`prefetch`).
+
+        Parameters
+        ----------
+        omegas : iterable of float
+            rad/s.
+
+        Returns
+        -------
+        list of int or None
+            J(ω) at each, None where float64 cannot decide it.
+        """
+        omegas = [float(omega) for omega in omegas]
+        self.prefetch(omegas)
+        answers = self._answers
+        return [answers[omega] for omega in omegas]
+
     def _numpy_at(self, omegas) -> list[int | None]:
         """:meth:`__call__` at each of ``omegas`` (rad/s) by the numpy reference, J₀ and
         D(ω) formed for all of them at once (the same numbers as one at a time)."""

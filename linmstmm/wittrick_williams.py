@@ -33,7 +33,6 @@ the count answers None, and callers count another way.
 """
 from __future__ import annotations
 
-import copy
 import functools
 
 import numpy as np
@@ -157,9 +156,8 @@ class ModeCounter:
         """
         if self.engine == "compiled":
             self._beam_table()
-        twin = copy.copy(self)
-        twin._answers = {}
-        twin._scratch = None
+        twin = object.__new__(type(self))  # a shallow copy, with its own answers and buffers
+        twin.__dict__.update(self.__dict__, _answers={}, _scratch=None)
         return twin
 
     def __call__(self, omega: float) -> int | None:

@@ -185,7 +185,7 @@ def stiffness_other_zeros(finder, known: list[float], lo: float | None, hi: floa
     start, ordered = 0.0 if lo is None else lo, sorted(known)
     roots, near = sorted({r for r in known if start < r < hi}), near_widths(finder.rtol)
     opening = _opening(ordered, [(root, _widths(finder, root, ordered, near)) for root in roots])
-    _counted_at(finder.counter, [hi, *([] if lo is None else [lo]), *map(_end, opening)])
+    _counted_at(finder.counter, [hi, *([] if lo is None else [lo]), *_ends(opening)])
     counted = stiffness_count(finder, known, lo, hi)
     if counted is None or counted != 0:
         return counted
@@ -232,7 +232,7 @@ def _counted_widths(finder, ordered: list[float], opening: list[tuple]) -> tuple
     not counted."""
     first, held, pending = {}, {}, opening
     while pending:
-        counts = _counted_at(finder.counter, list(map(_end, pending)))
+        counts = _counted_at(finder.counter, _ends(pending))
         following = []
         for (root, widths, level, below), count in zip(pending, counts):
             if count is not None and below is None:  # the lower end decided: the upper end next
@@ -254,21 +254,22 @@ def _opening(ordered: list[float], across: list[tuple[float, list[float]]], leve
     relative, narrowest first: :func:`_widths`), at the narrowest of its widths from
     ``level`` on with no known root of ``ordered`` (rad/s, ascending) on an end
     (:func:`_on_an_end`): (root, widths, that width's index, None) for J at its
-    lower end (:func:`_end`); none for a root without such a width."""
+    lower end (:func:`_ends`); none for a root without such a width."""
     opening = []
     for root, widths in across:
-        clear = next((k for k in range(level, len(widths)) if not _on_an_end(ordered, root, widths[k])), None)
-        if clear is not None:
-            opening.append((root, widths, clear, None))
+        for clear in range(level, len(widths)):
+            if not _on_an_end(ordered, root, widths[clear]):
+                opening.append((root, widths, clear, None))
+                break
     return opening
 
 
-def _end(state: tuple) -> float:
-    """Where (rad/s) the count ``state`` (root, widths, level, J at the lower end or None
-    before it is counted: :func:`_opening`) counts next: the lower end of its width,
-    then the upper end."""
-    root, widths, level, below = state
-    return root * (1 - widths[level]) if below is None else root * (1 + widths[level])
+def _ends(pending: list[tuple]) -> list[float]:
+    """Where (rad/s) each count of ``pending`` (root, widths, level, J at the lower end or
+    None before it is counted: :func:`_opening`) counts next: the lower end of its
+    width, then the upper end."""
+    return [root * (1 - widths[level]) if below is None else root * (1 + widths[level])
+            for root, widths, level, below in pending]
 
 
 def _counted_at(counter, omegas: list[float]) -> list[int | None]:

@@ -63,8 +63,8 @@ WORK_PER_UNKNOWN = 64
 def beam_columns(beams) -> np.ndarray:
     """(n_beams, 9) float64 table of a :class:`~linmstmm.dynamic_stiffness.BeamTable`
     in the column order EA … TORSION above (flags as 0.0 / 1.0)."""
-    return np.column_stack([beams.EA, beams.GJ, beams.EIy, beams.EIz, beams.rhoA, beams.rhoIp,
-                            beams.L, beams.axial.astype(float), beams.torsion.astype(float)])
+    columns = [beams.EA, beams.GJ, beams.EIy, beams.EIz, beams.rhoA, beams.rhoIp, beams.L, beams.axial, beams.torsion]
+    return np.array(columns, dtype=float).T.copy()
 
 
 @njit(cache=True)

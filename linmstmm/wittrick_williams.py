@@ -33,7 +33,6 @@ the count answers None, and callers count another way.
 """
 from __future__ import annotations
 
-import copy
 import functools
 
 import numpy as np
@@ -157,9 +156,8 @@ class ModeCounter:
         """
         if self.engine == "compiled":
             self._beam_table()
-        twin = copy.copy(self)
-        twin._answers = {}
-        twin._scratch = None
+        twin = object.__new__(type(self))  # a shallow copy, with its own answers and buffers
+        twin.__dict__.update(self.__dict__, _answers={}, _scratch=None)
         return twin
 
     def __call__(self, omega: float) -> int | None:
@@ -167,6 +165,25 @@ class ModeCounter:
         if omega not in self._answers:  # the certifying steps ask at the same ω more than once
             self._count_now([omega])
         return self._answers[omega]
+
+    def at(self, omegas) -> list[int | None]:
+        """:meth:`__call__` at each of ``omegas`` (rad/s), those not counted yet counted
+        together (:meth:`prefetch`).
+
+        Parameters
+        ----------
+        omegas : iterable of float
+            rad/s.
+
+        Returns
+        -------
+        list of int or None
+            J(ω) at each, None where float64 cannot decide it.
+        """
+        omegas = [float(omega) for omega in omegas]
+        self.prefetch(omegas)
+        answers = self._answers
+        return [answers[omega] for omega in omegas]
 
     def _numpy_at(self, omegas) -> list[int | None]:
         """:meth:`__call__` at each of ``omegas`` (rad/s) by the numpy reference, J₀ and

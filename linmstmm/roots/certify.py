@@ -174,28 +174,38 @@ def other_zeros(finder, known: list[float], lo: float | None, hi: float) -> int 
 
 
 def stiffness_other_zeros(finder, known: list[float], lo: float | None, hi: float) -> int | None:
-    """:func:`other_zeros` by Wittrick–Williams counts alone; None where they cannot decide."""
+    """:func:`other_zeros` by Wittrick–Williams counts alone; None where they cannot decide.
+
+    The count over (lo, hi) is made in one batch with the first counts across each
+    known root there (:func:`misplaced`): those are needed wherever it finds none
+    missing, as it nearly always does, and where it does not, a later count across
+    the same roots takes them."""
+    if finder.counter is None:
+        return None
+    start, ordered = 0.0 if lo is None else lo, sorted(known)
+    roots, near = sorted({r for r in known if start < r < hi}), near_widths(finder.rtol)
+    opening = _opening(ordered, [(root, _widths(finder, root, ordered, near)) for root in roots])
+    _counted_at(finder.counter, [hi, *([] if lo is None else [lo]), *_ends(opening)])
     counted = stiffness_count(finder, known, lo, hi)
     if counted is None or counted != 0:
         return counted
-    wrong = misplaced(finder, known, lo, hi)
+    wrong = misplaced(finder, ordered, roots, opening)
     return None if wrong is None else -wrong
 
 
-def misplaced(finder, known: list[float], lo: float | None, hi: float) -> int | None:
-    """How far the multiplicities of the ``known`` roots in (lo, hi) are from the
-    Wittrick–Williams counts across each (:func:`_counts_near`; a value that is no
-    root has none): the sum of the differences at the narrowest width the count
-    decides, 0 when every one holds at some width. None where a count cannot
-    decide. A root that a narrower count contradicts and a wider one holds lies
-    that far from where float64 put it, whatever its last step said: that width
-    becomes its last step (:attr:`RootFinder.last_step`), and the caller refines it in mpmath
-    (a root of the second launcher at 13.25 krad/s, polished 1.5e-9 high, was
-    reported as certified before)."""
-    start, wrong = 0.0 if lo is None else lo, 0
-    roots = sorted({r for r in known if start < r < hi})
-    ordered = sorted(known)
-    first, held = _counted_widths(finder, ordered, roots)
+def misplaced(finder, ordered: list[float], roots: list[float], opening: list[tuple]) -> int | None:
+    """How far the multiplicities of the known roots ``ordered`` (rad/s, ascending, with
+    repeats) are from the Wittrick–Williams counts across each of ``roots`` (distinct,
+    ascending; a value that is no root has none), whose first counts are ``opening``
+    (:func:`_opening`): the sum of the differences at the narrowest width the count
+    decides, 0 when every one holds at some width. None where a count cannot decide. A
+    root that a narrower count contradicts and a wider one holds lies that far from where
+    float64 put it, whatever its last step said: that width becomes its last step
+    (:attr:`RootFinder.last_step`), and the caller refines it in mpmath (a root of the
+    second launcher at 13.25 krad/s, polished 1.5e-9 high, was reported as certified
+    before)."""
+    wrong = 0
+    first, held = _counted_widths(finder, ordered, opening)
     for root in roots:
         if root not in first:
             return None
@@ -206,36 +216,69 @@ def misplaced(finder, known: list[float], lo: float | None, hi: float) -> int | 
     return wrong
 
 
-def _counted_widths(finder, ordered: list[float], roots: list[float]) -> tuple[dict, dict]:
+def _counted_widths(finder, ordered: list[float], opening: list[tuple]) -> tuple[dict, dict]:
     """({root: (count, width)} at the narrowest width where the count across it decides,
     {root: width} at the narrowest where it holds the known roots ``ordered`` (rad/s,
-    ascending, with repeats) there), over
-    each root's :func:`_widths`, narrowest first, until one holds: what
-    :func:`_counts_near` gives root by root, counted here width by width so that
-    each width's counts for all the roots are made together
-    (:meth:`~linmstmm.wittrick_williams.ModeCounter.prefetch`, shared among the cores)."""
-    counter, near = finder.counter, near_widths(finder.rtol)
-    pending = [(root, _widths(finder, root, ordered, near)) for root in roots]
-    first, held, level = {}, {}, 0
-    prefetch = getattr(counter, "prefetch", None)
+    ascending, with repeats) there), for each root over its widths (:func:`_widths`),
+    narrowest first, until one holds, from its first count in ``opening``
+    (:func:`_opening`): what :func:`_counts_near` gives root by root.
+
+    A count across a root is made as two, J at its lower end and then at its upper
+    end, each a batch for all the roots at that step (:func:`_counted_at`); where J
+    at the lower end cannot be decided, the upper end is not counted, and the
+    root's next width is (the second launcher's lowest root: its counts at ±1e-9
+    are both undecided, each after the dense factorisation too, 0.1 ms apiece).
+    Widths with a known root on an end (:func:`_on_an_end`) say nothing and are
+    not counted."""
+    first, held, pending = {}, {}, opening
     while pending:
-        pending = [(root, widths) for root, widths in pending if level < len(widths)]
-        if prefetch is not None:
-            prefetch([root * (1 + sign * widths[level]) for root, widths in pending for sign in (-1, 1)])
-        unheld = []
-        for root, widths in pending:
-            width = widths[level]
-            below, above = counter(root * (1 - width)), counter(root * (1 + width))
-            if below is None or above is None or _on_an_end(ordered, root, width):
-                unheld.append((root, widths))
+        counts = _counted_at(finder.counter, _ends(pending))
+        following = []
+        for (root, widths, level, below), count in zip(pending, counts):
+            if count is not None and below is None:  # the lower end decided: the upper end next
+                following.append((root, widths, level, count))
                 continue
-            first.setdefault(root, (above - below, width))
-            if above - below == _known_within(ordered, root, width):
-                held[root] = width
-            else:
-                unheld.append((root, widths))
-        pending, level = unheld, level + 1
+            if count is not None:
+                width = widths[level]
+                first.setdefault(root, (count - below, width))
+                if count - below == _known_within(ordered, root, width):
+                    held[root] = width
+                    continue
+            following += _opening(ordered, [(root, widths)], level + 1)
+        pending = following
     return first, held
+
+
+def _opening(ordered: list[float], across: list[tuple[float, list[float]]], level: int = 0) -> list[tuple]:
+    """The first count still to make across each (root, widths) of ``across`` (rad/s;
+    relative, narrowest first: :func:`_widths`), at the narrowest of its widths from
+    ``level`` on with no known root of ``ordered`` (rad/s, ascending) on an end
+    (:func:`_on_an_end`): (root, widths, that width's index, None) for J at its
+    lower end (:func:`_ends`); none for a root without such a width."""
+    opening = []
+    for root, widths in across:
+        for clear in range(level, len(widths)):
+            if not _on_an_end(ordered, root, widths[clear]):
+                opening.append((root, widths, clear, None))
+                break
+    return opening
+
+
+def _ends(pending: list[tuple]) -> list[float]:
+    """Where (rad/s) each count of ``pending`` (root, widths, level, J at the lower end or
+    None before it is counted: :func:`_opening`) counts next: the lower end of its
+    width, then the upper end."""
+    return [root * (1 - widths[level]) if below is None else root * (1 + widths[level])
+            for root, widths, level, below in pending]
+
+
+def _counted_at(counter, omegas: list[float]) -> list[int | None]:
+    """``counter``'s answers at each of ``omegas`` (rad/s): a
+    :class:`~linmstmm.wittrick_williams.ModeCounter` counts those not counted yet in one
+    batch (:meth:`~linmstmm.wittrick_williams.ModeCounter.at`), another callable is
+    asked one by one."""
+    at = getattr(counter, "at", None)
+    return at(omegas) if at is not None else [counter(omega) for omega in omegas]
 
 
 def _clear_of_neighbours(ordered: list[float], root: float, widths: list[float], least: float) -> list[float]:

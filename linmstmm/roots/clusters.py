@@ -175,11 +175,13 @@ def separated(finder, roots: list[float]) -> list[float]:
     into them where a count that leaves that root out finds fewer copies
     (:func:`_apart_by_offsets`).
     """
-    roots = _apart_by_offsets(finder, roots)
     tally = Counter(roots)
-    distinct = sorted(tally)
-    # (a list cut at a count may hold one copy of a root counted as multiple)
-    multiple = [r for r in distinct if max(tally[r], finder._counted.get(r, 1)) > 1]
+    multiple = _multiple(finder, tally)
+    if not multiple:  # every root simple: nothing to split
+        return roots
+    roots = _apart_by_offsets(finder, roots, {r: max(tally[r], finder._counted.get(r, 1)) for r in multiple})
+    tally = Counter(roots)
+    distinct, multiple = sorted(tally), _multiple(finder, tally)
     if not multiple:
         return roots
     radii = [finder._circle_radius(r, distinct) for r in multiple]
@@ -227,16 +229,14 @@ def beside(finder, polished) -> list[list[float]]:
     return near
 
 
-def _apart_by_offsets(finder, roots: list[float]) -> list[float]:
+def _apart_by_offsets(finder, roots: list[float], copies: dict[float, int]) -> list[float]:
     """``roots`` with each multiple one whose pencil shows a distinct root beside it
     (:func:`beside`) split: that root takes one of its copies, unless a count across
     the multiple root that leaves it out finds all the copies there
     (:func:`_holds_its_copies`): it is then a root beside it, not one of them. The
-    counts of :func:`separated` only say how many roots a circle holds."""
-    copies = {r: max(m, finder._counted.get(r, 1)) for r, m in Counter(roots).items()}
-    multiple = sorted(r for r, m in copies.items() if m > 1)
-    if not multiple:
-        return roots
+    counts of :func:`separated` only say how many roots a circle holds. ``copies``:
+    each multiple root of ``roots`` (:func:`_multiple`) -> how many roots sit there."""
+    multiple = sorted(copies)
     known = [r for r in multiple if finder.offsets_at.get(r, np.zeros(0)).size >= copies[r]]
     missing = [r for r in multiple if r not in known]
     offsets = dict(zip(missing, finder._offsets(np.array(missing)) if missing else []))
@@ -252,6 +252,14 @@ def _apart_by_offsets(finder, roots: list[float]) -> list[float]:
             finder._counted[r] = max(finder._counted.get(r, 1) - 1, 1)
             split.append(member)
     return sorted(split)
+
+
+def _multiple(finder, tally: Counter) -> list[float]:
+    """The roots of ``tally`` (root rad/s -> how often a list holds it) that are multiple,
+    ascending: held more than once, or counted so over a circle (:attr:`RootFinder._counted`:
+    a list cut at a count may hold one copy of a root counted as multiple)."""
+    counted = finder._counted
+    return sorted(r for r, m in tally.items() if m > 1 or counted.get(r, 1) > 1)
 
 
 def _holds_its_copies(finder, root: float, copies: int, near: list[float]) -> bool:

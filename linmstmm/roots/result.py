@@ -87,7 +87,7 @@ def search_result(finder, roots: list[float]) -> RootSearchResult:
         the first).
     """
     tally = Counter(map(float, roots))
-    distinct = sorted(tally)
+    distinct, steps = sorted(tally), finder.last_step
     counter = finder.determinant
     evaluations = None if counter is None else counter.evaluations - finder._evaluations_reported
     if counter is not None:
@@ -95,7 +95,7 @@ def search_result(finder, roots: list[float]) -> RootSearchResult:
     return RootSearchResult(
         roots=roots,
         multiplicities={root: tally[root] for root in distinct},
-        last_steps={r: finder.last_step.get(r, np.nan) for r in distinct},
+        last_steps={r: steps.get(r, np.nan) for r in distinct},
         unseparated=finder.unseparated_among(distinct),
         note=finder.note,
         rigid_body_modes=finder.rigid_body_modes(),

@@ -90,7 +90,7 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: f
         # correction measures) times C e_(k-2) = e_k / e_(k-1), the last contraction,
         # where the correction bears that estimate out (within a factor of 10).
         agree = interpolated & measured & (correction <= 10 * ahead * np.abs(new))
-        ahead = np.where(agree, ahead * np.minimum(size / np.where(agree, previous, 1.0), 1.0), ahead)
+        ahead[agree] *= np.minimum(size[agree] / previous[agree], 1.0)
         done = (((size <= tolerance) & converging) | (ahead <= tolerance / 10)
                 | ((size >= previous / 2) & (size <= floor)) | (sign == 0))
         roots[active[done]] = np.where(sign[done] == 0, x[done], new[done])

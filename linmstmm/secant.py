@@ -2,12 +2,8 @@
 
 One evaluation per step and per root still moving, all in one call (a batch
 the kernels share among the cores), superlinear (order 1.6) near a simple
-root, and faster (order 1.8) from the third point on, where inverse quadratic
-interpolation through the last three points refines the secant's step (the
-launchers' first 20 in 71 and 64 evaluations, against 75 and 66 by the secant
-alone; their first 100 in 455 and 428, against 496 and 469); det's ratio at
-two points is formed from the log magnitudes, so no value overflows.
-:mod:`linmstmm.predicted` polishes its predictions so.
+root; det's ratio at two points is formed from the log magnitudes, so no
+value overflows. :mod:`linmstmm.predicted` polishes its predictions so.
 """
 from __future__ import annotations
 
@@ -49,22 +45,11 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: f
     active = np.arange(x.size)
     previous = before = np.full(x.size, np.inf)
     oldest = np.full(x.size, np.nan)  # the point evaluated before x_old (none yet)
-    sign_oldest, log_oldest = np.full(x.size, np.nan), np.full(x.size, np.nan)
     for _ in range(SECANT_STEPS):
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # sign 0: det exactly 0, x is a root
+        with np.errstate(divide="ignore", invalid="ignore"):  # sign 0: det exactly 0, x is a root
             ratio = (sign_old / sign).real * np.exp(np.clip(log_old - log_abs, -700, 700))  # det(x_old)/det(x)
             step = -(x - x_old) / (1 - ratio)
-            # From the third point on, inverse quadratic interpolation through the last
-            # three (far = det(oldest)/det(x)), taken where it corrects the secant step by
-            # at most half that step (the two agree near a simple root; far off, or on a
-            # noisy det, the secant's step stands)
-            far = (sign_oldest / sign).real * np.exp(np.clip(log_oldest - log_abs, -700, 700))
-            quadratic = ((oldest - x) * ratio / ((far - ratio) * (far - 1))
-                         + (x_old - x) * far / ((ratio - far) * (ratio - 1)))
         step = np.where(np.isfinite(step), step, 0.0)
-        correction = np.abs(quadratic - step)
-        interpolated = np.isfinite(quadratic) & (correction <= 0.5 * np.abs(step))
-        step = np.where(interpolated, quadratic, step)
         new = x + step
         size = np.abs(step) / np.abs(new)
         # The secant converges superlinearly (order 1.6): the error of a point from
@@ -86,11 +71,6 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: f
         reach = np.abs(new - oldest) / np.abs(new)
         measured = converging & np.isfinite(previous) & np.isfinite(reach) & (reach > 0)  # none before two steps
         ahead = np.where(measured, size * size / np.where(measured, reach, 1.0), np.inf)
-        # The interpolated point's error is the secant point's (ahead, which the
-        # correction measures) times C e_(k-2) = e_k / e_(k-1), the last contraction,
-        # where the correction bears that estimate out (within a factor of 10).
-        agree = interpolated & measured & (correction <= 10 * ahead * np.abs(new))
-        ahead[agree] *= np.minimum(size[agree] / previous[agree], 1.0)
         done = (((size <= tolerance) & converging) | (ahead <= tolerance / 10)
                 | ((size >= previous / 2) & (size <= floor)) | (sign == 0))
         roots[active[done]] = np.where(sign[done] == 0, x[done], new[done])
@@ -99,7 +79,6 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: f
         if not keep.any():
             break
         active, previous, before, oldest = active[keep], size[keep], previous[keep], x_old[keep]
-        sign_oldest, log_oldest = sign_old[keep], log_old[keep]
         tolerance = tolerance[keep]
         x_old, sign_old, log_old = x[keep], sign[keep], log_abs[keep]
         x = new[keep]

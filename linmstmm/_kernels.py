@@ -47,11 +47,9 @@ from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, STAT
 
 announce_compiles()  # one line on stderr if this run compiles (linmstmm._compile_notice)
 
-#: See linmstmm.deduction: beam pieces, growth between orthonormalisations, the βL of a
-#: piece the state is orthonormalised after grown or not, far scale.
+#: See linmstmm.deduction: beam pieces, growth between orthonormalisations, far scale.
 BEAM_PIECE_BETA_L = 4.0
 GROWTH = 1e2
-BEAM_SPREAD_BETA_L = math.log(GROWTH) / 2
 FAR = 1e100
 _SERIES_LIMIT4 = 16.0  # |w| below 2**4: Krylov functions by their power series
 _SERIES_TERMS = 14
@@ -496,13 +494,6 @@ def _orthonormalise(program, index, work, reference, log_scale, group, scratch):
 
 
 @njit(cache=True)
-def _beta_L(beam, omega):
-    """βL of ``beam`` (its record in Program.beams) at ``omega`` (rad/s, ≥ 0) in its softer
-    bending plane: see linmstmm.elements.beam.bending_wavenumber."""
-    return (beam[2] * beam[3] * omega ** 2 / (beam[0] * min(beam[4], beam[5]))) ** 0.25 * beam[8]
-
-
-@njit(cache=True)
 def _beam_scratch(program, group, like):
     """Workspace of the beams' carries in :func:`_run` for ``group`` frequencies of the type
     of the array ``like``: (pieces (nb,), each beam's piece per frequency (nb, g, 12, 12),
@@ -588,7 +579,9 @@ def _run(program, omegas, work, reference, log_scale, ortho_scratch, beam_scratc
         if code == BEAM:
             beam = beams[b]
             if c == 1:
-                pieces[b] = max(int(math.ceil(_beta_L(beam, largest) / BEAM_PIECE_BETA_L)), 1)
+                softer = min(beam[4], beam[5])
+                beta_L = (beam[2] * beam[3] * largest ** 2 / (beam[0] * softer)) ** 0.25 * beam[8]
+                pieces[b] = max(int(math.ceil(beta_L / BEAM_PIECE_BETA_L)), 1)
                 for m in range(group):
                     beam_piece(beam, rotations[b], omegas[m], beam[8] / pieces[b], piece[b, m], local, functions,
                                turned)
@@ -598,8 +591,6 @@ def _run(program, omegas, work, reference, log_scale, ortho_scratch, beam_scratc
                     before = _view(carried, 0, 12, slot_width[a])
                     before[:, :] = state
                     np.dot(piece[b, m], before, state)  # BLAS's product, as numpy's
-                    if _beta_L(beam, largest) / pieces[b] >= BEAM_SPREAD_BETA_L:
-                        reference[m, a] = np.nan  # orthonormalised next, grown or not
                 if c == 0 and d >= 0:
                     _orthonormalise(ortho_program, d, work, reference, log_scale, group, ortho_scratch)
 

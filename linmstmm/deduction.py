@@ -45,12 +45,10 @@ from linmstmm.periodic import carry_run, find_runs
 from linmstmm.topology import Topology
 from linmstmm.unknowns import boundary_state_rows, column_labels
 
-#: Largest βL of one beam piece in the stable evaluation: the piece's own closed form is exact
-#: to rounding, and growth e^4 ≈ 55 between orthonormalisations costs under two digits of the decaying solutions.
+#: Largest βL of one beam piece in the stable evaluation: the piece's own
+#: closed form is exact to rounding, and growth e^4 ≈ 55 between
+#: orthonormalisations costs under two digits of the decaying solutions.
 _BEAM_PIECE_BETA_L = 4.0
-#: βL of a beam piece after which the state is orthonormalised, grown or not: a piece parts its
-#: solutions by e^{2βL}, the state's size by e^{βL} at most (GROWTH let two pieces of βL 4 pass).
-_BEAM_SPREAD_BETA_L = np.log(_Orthonormaliser.GROWTH) / 2
 _CUT_SIGN = np.diag(np.r_[np.ones(6), -np.ones(6)])
 #: Kind of the row a released direction adds, for the orthonormaliser's row
 #: scales (:meth:`_Orthonormaliser._unit_scale`): a force (3) or a moment (2).
@@ -410,14 +408,13 @@ class Deduction:
         return cell
 
     def _carry_through_beam(self, element, omega, state, normaliser, rows, open_states):
-        """The state carried along a beam piece by piece, orthonormalised after each (_BEAM_SPREAD_BETA_L)."""
+        """The state carried along a beam piece by piece, orthonormalised between pieces."""
         beam = element.record
         beta_L = bending_wavenumber(beam, np.max(np.abs(omega))) * beam.length
         pieces = max(int(np.ceil(beta_L / _BEAM_PIECE_BETA_L)), 1)
         piece = beam_transfer(beam, omega, reverse=element.inputs[0] == 1, length=beam.length / pieces)
-        for _ in range(pieces):  # (a reference of None: orthonormalised, grown or not)
-            state = PortState(state.columns, piece @ state.matrix,
-                              None if beta_L / pieces >= _BEAM_SPREAD_BETA_L else state.reference)
+        for _ in range(pieces):
+            state = PortState(state.columns, piece @ state.matrix, state.reference)
             state = normaliser.apply(state, rows, open_states)
         return state
 

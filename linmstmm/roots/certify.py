@@ -10,6 +10,7 @@ from collections import Counter
 import numpy as np
 
 from linmstmm.counting import count_zeros, count_zeros_many, deflated
+from linmstmm.roots.listed_zeros import not_zeros
 from linmstmm.roots.settings import DEFLATED_MAX_POINTS, DEFLATED_POINTS
 
 #: Relative half-widths, narrowest first, of the counts that give a root's
@@ -167,10 +168,18 @@ def other_zeros(finder, known: list[float], lo: float | None, hi: float) -> int 
     if counted is not None:
         return counted
     try:
-        return count_zeros(deflated(finder.log_det, known), finder.floor if lo is None else lo, hi,
-                           max_points=DEFLATED_MAX_POINTS, initial_points=DEFLATED_POINTS)
+        extra = count_zeros(deflated(finder.log_det, known), finder.floor if lo is None else lo, hi,
+                            max_points=DEFLATED_MAX_POINTS, initial_points=DEFLATED_POINTS)
     except RuntimeError:
         return None
+    if extra != 0:
+        return extra
+    # The count is (zeros missing) − (known values that are no zeros): a value that is no
+    # root (a secant stopped at an extremum of det, no sign change across it) cancels a
+    # missing root, and the list passed with a root replaced by it. Each known value is
+    # checked, as misplaced() checks them in the Wittrick–Williams branch.
+    wrong = not_zeros(finder, known, lo, hi, near_widths(finder.rtol)[0])
+    return None if wrong is None else -wrong
 
 
 def stiffness_other_zeros(finder, known: list[float], lo: float | None, hi: float) -> int | None:

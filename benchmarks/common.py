@@ -136,15 +136,19 @@ def mstmm_solve(model: Model, count: int, **options) -> np.ndarray:
     explicitly, and no mpmath escalation: a loose ``xtol`` would otherwise
     send every root to mpmath (natural_frequencies refines every root whose
     last Newton step exceeds CERTIFIED_STEP = 1e-9), which is the opposite
-    of what a user loosening the tolerance asks for. Like ``natural_frequencies`` it
-    runs with one BLAS thread: with the machine's threads, a busy two-core machine made
-    these runs about 20 times slower than the solves they are set beside.
+    of what a user loosening the tolerance asks for.
     """
-    from linmstmm.solve import frequency_finder
-    from linmstmm.threads import one_blas_thread
-    with one_blas_thread():
+    try:
+        from linmstmm.solve import frequency_finder
         _, finder, _ = frequency_finder(model, **options)
-        return finder.find(count, None).roots / (2 * np.pi)
+    except ImportError:  # older tree: build it like solve.py does
+        from linmstmm.deduction import Deduction
+        from linmstmm.nullspace import release_indeterminate
+        from linmstmm.topology import build_topology
+        deduction = Deduction(build_topology(model))
+        release_indeterminate(deduction)
+        finder = RootFinder(deduction.log_det, lambda w: deduction.matrix(w, stable=True)[0], **options)
+    return finder.find(count, None).roots / (2 * np.pi)
 
 
 # --------------------------------------------------------------------------

@@ -14,7 +14,7 @@ from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
 from linmstmm.precision import refine_roots, separated_cluster
 from linmstmm.results import Result, decode_array
-from linmstmm.roots import MAX_XTOL, RootFinder, RootSearchResult
+from linmstmm.roots import CERTIFIED_STEP, MAX_XTOL, RootFinder, RootSearchResult
 from linmstmm.stages import report
 from linmstmm.threads import single_blas_thread
 from linmstmm.wording import counted
@@ -261,12 +261,20 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
     accuracy = {} if rtol is None else {"rtol": rtol, "xtol": min(max(XTOL_PER_RTOL * rtol, 1e-14), MAX_XTOL)}
     deduction, finder, released = frequency_finder(model, root, engine=engine, **accuracy)
     report("finding roots")
-    if fmax is not None:
-        search = search_up_to(finder, count, fmax)
-    elif guess_hz is not None and count is not None:
-        search = finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count)
-    else:
-        search = finder.find(count, None)
+    abandoned = 0  # evaluations of a search made again at the default accuracy
+    try:
+        search = _searched(finder, count, fmax, guess_hz)
+    except RuntimeError:
+        if rtol is None or rtol <= CERTIFIED_STEP:
+            raise
+        # A looser rtol asks for less work, not for an answer that cannot be certified: where
+        # the search at it cannot certify (a varied test model with stiffnesses 4e10 apart at
+        # rtol 1e-4: two secant values at extrema of det, 4e-4 from their roots, then no
+        # count by the argument principle), the search is made again at the default accuracy.
+        report("searching again at the default accuracy")
+        abandoned = finder.determinant.evaluations
+        deduction, finder, released = frequency_finder(model, root, engine=engine)
+        search = _searched(finder, count, fmax, guess_hz)
     omegas, unseparated = search.roots, dict(search.unseparated)
     # (a root no Newton step reached has a NaN step: it is in unseparated)
     uncertain = sorted({w for w, step in search.last_steps.items() if step > finder.rtol} - set(unseparated))
@@ -274,14 +282,23 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
     wanted = digits if every else (ESCALATION_DIGITS if uncertain or unseparated else None)
     if not wanted:
         return RootSolution(deduction, finder, search, released, omegas, unseparated=unseparated,
-                            evaluations=search.evaluations)
+                            evaluations=abandoned + search.evaluations)
     report(f"refining in mpmath to {wanted} digits")
     before = finder.determinant.evaluations
     omegas, precision, text, omega_text = _refined_in_mpmath(
         deduction, model, finder, omegas, [w for w in omegas if w not in unseparated and (every or w in uncertain)],
         unseparated, wanted, cut_by_count=count is not None)
     return RootSolution(deduction, finder, search, released, omegas, precision, text, omega_text, unseparated,
-                        search.evaluations + finder.determinant.evaluations - before)
+                        abandoned + search.evaluations + finder.determinant.evaluations - before)
+
+
+def _searched(finder: RootFinder, count: int | None, fmax: float | None, guess_hz) -> RootSearchResult:
+    """The roots of :func:`solve_roots` (arguments as there) found by ``finder``."""
+    if fmax is not None:
+        return search_up_to(finder, count, fmax)
+    if guess_hz is not None and count is not None:
+        return finder.find_near(2 * np.pi * np.asarray(guess_hz, dtype=float), count)
+    return finder.find(count, None)
 
 
 @single_blas_thread

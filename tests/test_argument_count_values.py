@@ -24,10 +24,12 @@ def test_a_value_that_is_no_root_does_not_stand_for_a_missing_one():
     assert not finder.confirm_no_other_zeros(sorted(listed), upper)
 
 
-@pytest.mark.parametrize("seed, count, rtol", [(35, 25, 1e-6), (98, 20, 1e-4)])
+@pytest.mark.parametrize("seed, count, rtol", [(35, 25, 1e-6), (98, 20, 1e-4), (108, 25, 1e-4)])
 def test_the_frequencies_are_within_rtol_of_the_fe_route(seed, count, rtol):
-    """Each case came out with one frequency beyond its rtol (5.9e-6 at 1e-6, 2.1e-2 at
-    1e-4), labelled float64 with no note."""
+    """Each case came out with one frequency beyond its rtol (5.9e-6 at 1e-6, 2.1e-2 and
+    4.3e-4 at 1e-4), labelled float64 with no note. Model 108 (stiffnesses 4e10 apart)
+    cannot be certified at rtol 1e-4 once its false values are seen (no count by the
+    argument principle): it is searched again at the default accuracy."""
     model = varied_model(seed)[0]
     found = natural_frequencies(model, count, engine="compiled", rtol=rtol).frequencies_hz
     fe = fe_frequencies(model, count, rtol=1e-10).frequencies_hz

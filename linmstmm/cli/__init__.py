@@ -1,11 +1,12 @@
 """The ``linmstmm`` command line (every command and its JSON: ``docs/cli.md``).
 
 One module per command (``linmstmm/cli/<command>.py``), each with one
-``add_<command>_command(subparsers)``; :data:`COMMANDS` lists them in the
-order ``linmstmm -h`` shows them. To add a command: write its module, import
-its ``add_..._command`` here, append it to COMMANDS and give one example in
-COMMAND_EXAMPLES. The command modules use the public API only (``linmstmm``
-and the modules ``docs/api.md`` documents).
+``add_<command>_command(subparsers)``; :data:`COMMANDS` names them in the
+order ``linmstmm -h`` shows them. A run imports the module of its own command
+only (the help, all of them): what the other commands import is not the
+start-up of this one. To add a command: write its module, add its name to
+COMMANDS and give one example in COMMAND_EXAMPLES. The command modules use
+the public API only (``linmstmm`` and the modules ``docs/api.md`` documents).
 
 Exit status: 0 done; 1 the computation itself failed (clear message);
 2 bad model file, bad option or impossible request (one line on stderr,
@@ -14,32 +15,15 @@ naming file, element and key; no traceback).
 from __future__ import annotations
 
 import argparse
+import importlib
 import sys
 
 from linmstmm import ModelError, __version__
-from linmstmm.cli.check import add_check_command
 from linmstmm.cli.common import ComputationError, UsageError
-from linmstmm.cli.fe import add_fe_command
-from linmstmm.cli.fit import add_fit_command
-from linmstmm.cli.freqs import add_freqs_command
-from linmstmm.cli.frf import add_frf_command
-from linmstmm.cli.modes import add_modes_command
-from linmstmm.cli.response import add_response_command
-from linmstmm.cli.scan import add_scan_command
-from linmstmm.cli.sweep import add_sweep_command
 
-#: The commands, each registered by its ``add_..._command(subparsers)``.
-COMMANDS = [
-    add_freqs_command,
-    add_check_command,
-    add_fe_command,
-    add_modes_command,
-    add_scan_command,
-    add_response_command,
-    add_frf_command,
-    add_sweep_command,
-    add_fit_command,
-]
+#: The commands, in the order ``linmstmm -h`` lists them: each is registered by
+#: ``add_<name>_command(subparsers)`` of its module ``linmstmm.cli.<name>``.
+COMMANDS = ["freqs", "check", "fe", "modes", "scan", "response", "frf", "sweep", "fit"]
 
 #: Every command with one example on the bundled models (shown by ``linmstmm -h``).
 COMMAND_EXAMPLES = {
@@ -70,8 +54,13 @@ def _examples() -> str:
                       "'linmstmm COMMAND -h' lists a command's options; the guides are in docs/."])
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser of every command in COMMANDS (each sets ``run`` to its function).
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The argument parser of the commands in COMMANDS (each sets ``run`` to its function).
+
+    Parameters
+    ----------
+    command : str or None
+        The one command to register (its module alone is imported); None: all of them.
 
     Returns
     -------
@@ -83,8 +72,9 @@ def build_parser() -> argparse.ArgumentParser:
                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--version", action="version", version=f"linmstmm {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    for add_command in COMMANDS:
-        add_command(sub)
+    for name in COMMANDS if command is None else [command]:
+        module = importlib.import_module(f"linmstmm.cli.{name}")
+        getattr(module, f"add_{name}_command")(sub)
     return parser
 
 
@@ -106,7 +96,8 @@ def main(argv=None) -> int:
         if not argv:  # bare ``linmstmm``: what there is to do
             build_parser().print_help()
             return 0
-        args = build_parser().parse_args(argv)
+        command = argv[0] if argv[0] in COMMANDS else None  # else: help, version or a misspelling
+        args = build_parser(command).parse_args(argv)
         return args.run(args)
     except (ModelError, UsageError) as error:
         print(f"linmstmm: error: {error}", file=sys.stderr)

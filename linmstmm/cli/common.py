@@ -15,7 +15,6 @@ import sys
 from contextlib import contextmanager
 
 from linmstmm import ModelError
-from linmstmm.response import DampingRatioError
 from linmstmm.stages import listening
 
 
@@ -158,12 +157,18 @@ def as_options(model, *parameters: str):
     """
     try:
         yield
-    except DampingRatioError as error:
-        raise ModelError(source(model), str(error), key="--zeta") from error
     except ModelError as error:
         if error.key not in parameters:
             raise
         raise ModelError(error.file, error.message, error.element, key=option_of(error.key)) from error
+    except ValueError as error:
+        # here, not at the top: a command that raises it has loaded linmstmm.response, which
+        # freqs, check and fe start without
+        from linmstmm.response import DampingRatioError
+
+        if not isinstance(error, DampingRatioError):
+            raise
+        raise ModelError(source(model), str(error), key="--zeta") from error
 
 
 def emit(args, model, data: dict, table, csv_table=None) -> None:

@@ -10,7 +10,7 @@ keys in ``docs/cli.md``.
 """
 from __future__ import annotations
 
-from linmstmm import ModelError, damped_frequencies, load_model
+from linmstmm import ModelError, load_model
 from linmstmm.cli.common import as_options, emit, request, source, stages
 
 
@@ -29,6 +29,8 @@ def add_damped_option(freqs) -> None:
 
 def run_damped(args) -> int:
     """Run ``linmstmm freqs --damped``; returns the exit status 0."""
+    from linmstmm import damped_frequencies  # here: freqs without --damped starts without it
+
     model = load_model(args.model)
     if args.digits is not None:
         raise ModelError(source(model), "the damped roots are computed in float64 only; "

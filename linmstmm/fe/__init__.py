@@ -115,23 +115,43 @@ Modules
 * :mod:`~linmstmm.fe.frequencies` — :func:`fe_frequencies`, mesh refinement;
 * :mod:`~linmstmm.fe.result` — :class:`FEResult`;
 * :mod:`~linmstmm.fe.damping` — dashpots, direct receptance, complex roots.
+
+The names below are imported from their module on first use, so that a module
+of the route (``linmstmm.fe.node_constraints``, which the transfer-matrix
+code's coarse prediction and counter share) loads without the rest of it.
 """
 
 from __future__ import annotations
 
-from linmstmm.fe.assembly import FEModel, assemble
-from linmstmm.fe.condensation import MASS_RANK, UNRESOLVED_STIFFNESS
-from linmstmm.fe.constraints import NEGLIGIBLE_ENTRY, REDUNDANT_CONSTRAINT
-from linmstmm.fe.damping import damped_roots, dashpot_matrix, harmonic_receptance
-from linmstmm.fe.eigensolver import DENSE_LIMIT, SWEEP_TOLERANCE, fe_modes
-from linmstmm.fe.elements import UNRESOLVED_WAVE, beam_element, dispersion_error
-from linmstmm.fe.flexibility import static_displacements
-from linmstmm.fe.frequencies import ROUNDOFF, UNSETTLED, fe_frequencies
-from linmstmm.fe.layout import DofIndex
-from linmstmm.fe.masses import MASSLESS
-from linmstmm.fe.result import FEResult
+import importlib
 
-__all__ = ["DENSE_LIMIT", "MASSLESS", "MASS_RANK", "NEGLIGIBLE_ENTRY", "REDUNDANT_CONSTRAINT", "ROUNDOFF",
-           "SWEEP_TOLERANCE", "UNRESOLVED_STIFFNESS", "UNRESOLVED_WAVE", "UNSETTLED",
-           "DofIndex", "FEModel", "FEResult", "assemble", "beam_element", "damped_roots", "dashpot_matrix",
-           "dispersion_error", "fe_frequencies", "fe_modes", "harmonic_receptance", "static_displacements"]
+#: Public name -> the module of the route that defines it.
+_SOURCES = {
+    "FEModel": "assembly", "assemble": "assembly",
+    "MASS_RANK": "condensation", "UNRESOLVED_STIFFNESS": "condensation",
+    "NEGLIGIBLE_ENTRY": "constraints", "REDUNDANT_CONSTRAINT": "constraints",
+    "damped_roots": "damping", "dashpot_matrix": "damping", "harmonic_receptance": "damping",
+    "DENSE_LIMIT": "eigensolver", "SWEEP_TOLERANCE": "eigensolver", "fe_modes": "eigensolver",
+    "UNRESOLVED_WAVE": "elements", "beam_element": "elements", "dispersion_error": "elements",
+    "static_displacements": "flexibility",
+    "ROUNDOFF": "frequencies", "UNSETTLED": "frequencies", "fe_frequencies": "frequencies",
+    "DofIndex": "layout",
+    "MASSLESS": "masses",
+    "FEResult": "result",
+}
+
+__all__ = sorted(_SOURCES)
+
+
+def __getattr__(name: str):
+    """Import a public name from its module on first use (PEP 562)."""
+    if name not in _SOURCES:
+        raise AttributeError(f"module 'linmstmm.fe' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"linmstmm.fe.{_SOURCES[name]}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    """The module's names, the public ones included before their first use."""
+    return sorted(set(globals()) | set(__all__))

@@ -5,17 +5,15 @@
 * object arrays of ``mpmath.mpf``/``mpc``: the arbitrary-precision path.
 
 The element modules call these instead of ``np.cos`` etc. so the same code
-serves all three.
+serves all three. mpmath is imported by the branches that meet its numbers
+(which exist only once it is loaded): a float64 solve starts without it.
 """
 from __future__ import annotations
 
+import functools
 import math
 
-import mpmath
 import numpy as np
-
-_MP_FUNCTIONS = {name: np.frompyfunc(getattr(mpmath, name), 1, 1)
-                 for name in ("cos", "sin", "cosh", "sinh", "sqrt")}
 
 
 def is_mp(x) -> bool:
@@ -36,7 +34,11 @@ def numbers(x, exact: bool = False) -> np.ndarray:
     converted exactly), so that quantities derived from model data (1/k, lever
     arms, m·r) are formed at the working precision of the mpmath path."""
     x = np.asarray(x, dtype=float)
-    return np.vectorize(mpmath.mpf, otypes=[object])(x) if exact else x
+    if not exact:
+        return x
+    import mpmath
+
+    return np.vectorize(mpmath.mpf, otypes=[object])(x)
 
 
 def number_type(*arrays):
@@ -49,12 +51,19 @@ def result_dtype(omega):
     return object if is_mp(omega) else np.result_type(omega, np.float64)
 
 
+@functools.cache
+def _mp_function(name: str):
+    """mpmath's function ``name`` elementwise over an object array."""
+    import mpmath
+
+    return np.frompyfunc(getattr(mpmath, name), 1, 1)
+
+
 def _elementwise(name):
     float_function = getattr(np, name)
-    mp_function = _MP_FUNCTIONS[name]
 
     def apply(x):
-        return mp_function(x) if is_mp(x) else float_function(x)
+        return _mp_function(name)(x) if is_mp(x) else float_function(x)
 
     apply.__name__ = name
     apply.__doc__ = f"Elementwise {name} for float, complex or mpmath arrays."
@@ -78,7 +87,7 @@ def size_estimate(x: np.ndarray) -> np.ndarray:
 def sin_over(x):
     """sin(x)/x with the value 1 at 0."""
     if is_mp(x):
-        return np.frompyfunc(lambda v: mpmath.sinc(v), 1, 1)(x)
+        return _mp_function("sinc")(x)
     return np.sinc(x / np.pi)
 
 
@@ -100,6 +109,8 @@ def zeros_like_stack(omega, shape) -> np.ndarray:
     dtype = result_dtype(omega)
     out = np.zeros((omega.size,) + tuple(shape), dtype=dtype)
     if dtype == object:
+        import mpmath
+
         out[...] = mpmath.mpf(0)
     return out
 
@@ -114,6 +125,8 @@ def constant_times(constant: np.ndarray, stack: np.ndarray) -> np.ndarray:
     """
     if not is_mp(stack):
         return constant @ stack
+    import mpmath
+
     out = np.empty((stack.shape[0], constant.shape[0], stack.shape[2]), dtype=object)
     for row, entries in enumerate(constant):
         total = np.full((stack.shape[0], stack.shape[2]), mpmath.mpf(0), dtype=object)

@@ -4,7 +4,6 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
-import mpmath
 import numpy as np
 
 from linmstmm.coarse_prediction import predict_frequencies
@@ -12,7 +11,6 @@ from linmstmm.compiled_model import compiled_system
 from linmstmm.deduction import Deduction
 from linmstmm.mode_bound import check_range_request
 from linmstmm.model import Model
-from linmstmm.precision import refine_roots, separated_cluster
 from linmstmm.results import Result, decode_array
 from linmstmm.roots import CERTIFIED_STEP, MAX_XTOL, RootFinder, RootSearchResult
 from linmstmm.stages import report
@@ -397,6 +395,10 @@ def _refined_in_mpmath(deduction, model, finder, omegas, chosen, unseparated, di
     Returns (omegas (n,) float, precision label, frequency texts (Hz), omega texts (rad/s)):
     the texts at ``digits`` where refined, float reprs elsewhere.
     """
+    import mpmath  # here, with the refinement: a float64 solve starts without mpmath
+
+    from linmstmm.precision import refine_roots, separated_cluster
+
     top = [omegas[-1]] if cut_by_count and len(chosen) and max(chosen) == omegas[-1] else []
     cut = {w: finder.multiplicity(w, sorted(set(omegas))) for w in top}
     refined = {}  # root -> its refined values in order (a cluster's members differ)

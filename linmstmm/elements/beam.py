@@ -19,7 +19,6 @@ from __future__ import annotations
 import functools
 import math
 
-import mpmath
 import numpy as np
 
 from linmstmm.elements.frames import state_rotation
@@ -46,6 +45,8 @@ def _series_coefficients(mp: bool) -> np.ndarray:
     """(4, terms) table of 1/(4j + r)!, in mpmath at the working precision if ``mp``."""
     if not mp:
         return _SERIES_COEFFS
+    import mpmath  # loaded already: the numbers of the mpmath path are its own
+
     terms = _SERIES_TERMS + int(mpmath.mp.dps)  # enough for |w| < 16 at any precision
     return np.array([[mpmath.mpf(1) / mpmath.factorial(4 * j + r) for j in range(terms)]
                      for r in range(4)], dtype=object)
@@ -119,7 +120,12 @@ def rod_transfer(stiffness, inertia, L, omega, rigid=False) -> np.ndarray:
         out[:, 0, 0] = out[:, 1, 1] = 1
         out[:, 1, 0] = inertia * omega**2 * L
         return out
-    kL = omega * L * (mpmath.sqrt(inertia / stiffness) if is_mp(omega) else math.sqrt(inertia / stiffness))
+    if is_mp(omega):
+        import mpmath  # loaded already: the numbers of the mpmath path are its own
+
+        kL = omega * L * mpmath.sqrt(inertia / stiffness)
+    else:
+        kL = omega * L * math.sqrt(inertia / stiffness)
     sinc = sin_over(kL)
     out[:, 0, 0] = out[:, 1, 1] = cos(kL)
     out[:, 0, 1] = -L / stiffness * sinc
@@ -135,7 +141,11 @@ def beam_local_transfer(beam, omega, length=None) -> np.ndarray:
     omega = frequencies(omega)
     # In mpmath, products of the section properties are formed at the working
     # precision too (the inputs are exact binary floats).
-    exact = mpmath.mpf if is_mp(omega) else float
+    exact = float
+    if is_mp(omega):
+        import mpmath  # loaded already: the numbers of the mpmath path are its own
+
+        exact = mpmath.mpf
     E, G, rho, A, Iy, Iz, J, Ip = (exact(getattr(beam, name))
                                    for name in ("E", "G", "rho", "A", "Iy", "Iz", "J", "Ip"))
     L = exact(beam.length if length is None else length)

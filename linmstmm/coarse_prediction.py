@@ -71,6 +71,8 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
     if elements_per_beam > _finest_mesh(model):  # a dense solve would cost more than the search it saves
         return np.zeros(0)
     pencil = coarse_pencil(model, elements_per_beam)
+    if pencil.size == 0:  # every point held: no unknown, no mode (LAPACK takes no empty matrix)
+        return np.zeros(0)
     rigid = pencil.rigid_body_modes
     lam = np.sort(_lowest_eigenvalues(pencil, min(count + rigid, pencil.size), shift))[rigid:]
     return np.sqrt(np.maximum(lam[:count], 0.0))

@@ -351,6 +351,18 @@ def test_a_model_without_beams_asked_for_more_modes_than_it_has_says_how_many_we
     assert re.fullmatch(r"only 11 elastic natural frequencies exist below \S+ rad/s", result.note)
 
 
+@pytest.mark.parametrize("engine", ["numpy", "compiled"])
+def test_a_model_held_at_every_point_has_no_mode_and_says_so(engine):
+    """Random tree 138: bodies and springs held so that no unknown is left (the FE route:
+    0 DOF, no mode). The coarse prediction handed LAPACK an empty matrix and the solve
+    ended in a ValueError traceback; now it finds none, and the note says so."""
+    tree = model("tree", 138)
+    assert fe_frequencies(tree, count=5).frequencies_hz.size == 0
+    result = natural_frequencies(tree, 5, engine=engine)
+    assert result.frequencies_hz.size == 0
+    assert re.fullmatch(r"only 0 elastic natural frequencies exist below \S+ rad/s", result.note)
+
+
 def test_a_range_above_the_last_root_is_certified_by_the_stiffness_count():
     """Random ring 5 up to 2e7 Hz (1.26e8 rad/s): the Wittrick–Williams count at the top
     finds the 11 (the FE route's, exact for bodies and springs) and no more, so the

@@ -47,11 +47,9 @@ from linmstmm.program import BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, STAT
 
 announce_compiles()  # one line on stderr if this run compiles (linmstmm._compile_notice)
 
-#: See linmstmm.deduction: beam pieces, growth between orthonormalisations, the βL of a
-#: piece the state is orthonormalised after grown or not, far scale.
+#: See linmstmm.deduction: beam pieces, growth between orthonormalisations, far scale.
 BEAM_PIECE_BETA_L = 4.0
 GROWTH = 1e2
-BEAM_SPREAD_BETA_L = math.log(GROWTH) / 2
 FAR = 1e100
 _SERIES_LIMIT4 = 16.0  # |w| below 2**4: Krylov functions by their power series
 _SERIES_TERMS = 14
@@ -387,11 +385,10 @@ def _scattered(program, index, columns, scale, work_m, reference_m):
         for i in range(rows):
             for c in range(width):
                 target[i, c] = columns[c, row + i] * back[row + i]
+        size = _size(work_m[slot_offset[dst]:slot_offset[dst] + rows * width])
+        peak = max(peak, size)
         if kind == STATE_BLOCK:
-            _kind_sizes(work_m, slot_offset[dst], width, reference_m[dst])
-            peak = max(peak, reference_m[dst].max())
-        else:
-            peak = max(peak, _size(work_m[slot_offset[dst]:slot_offset[dst] + rows * width]))
+            reference_m[dst] = size
         row += rows
     if not (peak > FAR or peak < 1 / FAR):
         return 0.0
@@ -401,7 +398,7 @@ def _scattered(program, index, columns, scale, work_m, reference_m):
         start = slot_offset[dst]
         work_m[start:start + rows * width] *= common
         if kind == STATE_BLOCK:
-            reference_m[dst, :] *= common
+            reference_m[dst] *= common
     return math.log(common)
 
 
@@ -432,42 +429,19 @@ def _padded_rows(orthos, blocks, index):
 
 
 @njit(cache=True)
-def _kind_sizes(work_m, start, width, sizes):
-    """The :func:`_size` of each kind of row (three rows each: displacements, rotations,
-    moments, forces) of the state (12, ``width``) at ``work_m[start:]`` into ``sizes`` (4,):
-    :func:`linmstmm.godunov.kind_sizes`."""
-    for kind in range(4):
-        first = start + 3 * kind * width
-        sizes[kind] = _size(work_m[first:first + 3 * width])
-
-
-@njit(cache=True)
-def _grown(program, index, work, reference, group, sizes):
+def _grown(program, index, work, reference, group):
     """Whether record ``index`` is due: its state grew or shrank by :data:`GROWTH` or more
-    as a whole since its reference in some member of the group, or grew so in one kind
-    of row that was not zero there (or has none): :func:`linmstmm.godunov.grown`.
-    ``sizes`` (4,) is workspace."""
+    since its reference in some member of the group (or has none)."""
     (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
     state_src = blocks[orthos[index, 0] + orthos[index, 2], 0]
     for m in range(group):
         ref = reference[m, state_src]
-        largest = max(max(ref[0], ref[1]), max(ref[2], ref[3]))
-        if math.isnan(ref[0]) or largest == 0.0:  # no reference, or grown from nothing (numpy: inf)
+        if math.isnan(ref) or ref == 0.0:  # no reference, or grown from nothing (numpy: inf)
             return True
-        start, width = slot_offset[state_src], slot_width[state_src]
-        # one size for every kind (a tip's, a merge's): a kind grown by GROWTH has grown the whole
-        each = not (ref[0] == ref[1] and ref[1] == ref[2] and ref[2] == ref[3])
-        if each:
-            _kind_sizes(work[m], start, width, sizes)
-            growth = max(max(sizes[0], sizes[1]), max(sizes[2], sizes[3])) / largest
-        else:
-            growth = _size(work[m, start:start + slot_rows[state_src] * width]) / largest
+        start = slot_offset[state_src]
+        growth = _size(work[m, start:start + slot_rows[state_src] * slot_width[state_src]]) / ref
         if not (growth < GROWTH and growth > 1 / GROWTH):
             return True
-        if each:
-            for kind in range(4):
-                if ref[kind] > 0.0 and not (sizes[kind] / ref[kind] < GROWTH):
-                    return True
     return False
 
 
@@ -487,8 +461,7 @@ def _laid_out(program, index, work, reference, group):
             place = places[places_start[place_index]:places_start[place_index + 1]]
             _place_add(source, target, place, 1.0, rows)
             if blocks[b, 3] == STATE_BLOCK:
-                for kind in range(4):
-                    reference[m, dst, kind] = reference[m, src, kind]
+                reference[m, dst] = reference[m, src]
 
 
 @njit(cache=True)
@@ -498,7 +471,7 @@ def _orthonormalise(program, index, work, reference, log_scale, group, scratch):
     (slot_offset, slot_rows, slot_width, places, places_start, orthos, blocks) = program
     columns_all, kinds_all, scale_all, diagonals, projections, kind_size = scratch
     width, total = orthos[index, 3], _padded_rows(orthos, blocks, index)
-    if orthos[index, 4] != 0 or not _grown(program, index, work, reference, group, kind_size):
+    if orthos[index, 4] != 0 or not _grown(program, index, work, reference, group):
         _laid_out(program, index, work, reference, group)
         return
     kinds = kinds_all[:total]
@@ -518,13 +491,6 @@ def _orthonormalise(program, index, work, reference, log_scale, group, scratch):
             log_scale[m] += math.log(diagonals[m, c])
         log_scale[m] -= _scattered(program, index, _view(columns_all[m], 0, width, total), scale_all[m, :total],
                                    work[m], reference[m]) * width
-
-
-@njit(cache=True)
-def _beta_L(beam, omega):
-    """βL of ``beam`` (its record in Program.beams) at ``omega`` (rad/s, ≥ 0) in its softer
-    bending plane: see linmstmm.elements.beam.bending_wavenumber."""
-    return (beam[2] * beam[3] * omega ** 2 / (beam[0] * min(beam[4], beam[5]))) ** 0.25 * beam[8]
 
 
 @njit(cache=True)
@@ -567,8 +533,7 @@ def _run(program, omegas, work, reference, log_scale, ortho_scratch, beam_scratc
             if code == TIP:
                 target = _view(work[m], slot_offset[a], 12, slot_width[a])
                 target[:, :] = matrices[b, :, :slot_width[a]]
-                for kind in range(4):
-                    reference[m, a, kind] = 1.0
+                reference[m, a] = 1.0
             elif code == CARRY:
                 target = _view(work[m], slot_offset[a], 12, slot_width[a])
                 source = _view(work[m], slot_offset[b], 12, slot_width[b])
@@ -582,8 +547,7 @@ def _run(program, omegas, work, reference, log_scale, ortho_scratch, beam_scratc
                             if coefficient != 0.0:
                                 for k in range(source.shape[1]):
                                     target[i, k] += w2 * coefficient * source[j, k]
-                for kind in range(4):
-                    reference[m, a, kind] = reference[m, b, kind]
+                reference[m, a] = reference[m, b]
             elif code == JOINT:
                 target = _view(work[m], slot_offset[a], slot_rows[a], slot_width[a])
                 _multiply_rows(matrices[c], _view(work[m], slot_offset[b], 12, slot_width[b]), target)
@@ -609,15 +573,15 @@ def _run(program, omegas, work, reference, log_scale, ortho_scratch, beam_scratc
                         _place_add(source, target, place, 1.0, 12)
                     else:
                         _multiply_add(matrices[matrix], source, target, place, 12)
-                    known = known and not math.isnan(reference[m, src, 0])
-                    for kind in range(4):
-                        ref = max(ref, reference[m, src, kind])
-                for kind in range(4):  # columns of units of their own: the whole state's test alone
-                    reference[m, a, kind] = ref if known else np.nan
+                    known = known and not math.isnan(reference[m, src])
+                    ref = max(ref, reference[m, src])
+                reference[m, a] = ref if known else np.nan
         if code == BEAM:
             beam = beams[b]
             if c == 1:
-                pieces[b] = max(int(math.ceil(_beta_L(beam, largest) / BEAM_PIECE_BETA_L)), 1)
+                softer = min(beam[4], beam[5])
+                beta_L = (beam[2] * beam[3] * largest ** 2 / (beam[0] * softer)) ** 0.25 * beam[8]
+                pieces[b] = max(int(math.ceil(beta_L / BEAM_PIECE_BETA_L)), 1)
                 for m in range(group):
                     beam_piece(beam, rotations[b], omegas[m], beam[8] / pieces[b], piece[b, m], local, functions,
                                turned)
@@ -627,8 +591,6 @@ def _run(program, omegas, work, reference, log_scale, ortho_scratch, beam_scratc
                     before = _view(carried, 0, 12, slot_width[a])
                     before[:, :] = state
                     np.dot(piece[b, m], before, state)  # BLAS's product, as numpy's
-                    if _beta_L(beam, largest) / pieces[b] >= BEAM_SPREAD_BETA_L:
-                        reference[m, a, :] = np.nan  # orthonormalised next, grown or not
                 if c == 0 and d >= 0:
                     _orthonormalise(ortho_program, d, work, reference, log_scale, group, ortho_scratch)
 
@@ -694,7 +656,7 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
     largest = min(group, n)
     # every operation writes the whole of its target: the workspace needs no clearing
     whole = np.empty((largest, workspace), dtype=omegas.dtype)
-    references, log_scales = np.empty((largest, n_slots, 4)), np.empty(largest)
+    references, log_scales = np.empty((largest, n_slots)), np.empty(largest)
     orthos, ortho_blocks = program[8], program[9]
     ortho_scratch = _orthonormal_scratch(orthos, ortho_blocks, largest, omegas)
     beam_scratch = _beam_scratch(program, largest, omegas)
@@ -703,7 +665,7 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
         stop = min(start + group, n)
         size = stop - start
         work, reference, log_scale = whole[:size], references[:size], log_scales[:size]
-        reference[:, :, :] = np.nan
+        reference[:, :] = np.nan
         log_scale[:] = 0.0
         _run(program, omegas[start:stop], work, reference, log_scale, ortho_scratch, beam_scratch)
         for m in range(size):

@@ -38,19 +38,17 @@ import numpy as np
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.elements.rigid import force_extraction, position_incidence, rigid_transfer_parts
 from linmstmm.elements.spring import joint_force, joint_jump, spring_constant_transfer
-from linmstmm.godunov import PortState, _Orthonormaliser, _row_kinds, merged_reference
+from linmstmm.godunov import PortState, _Orthonormaliser, _row_kinds
 from linmstmm.load_jumps import _Loads
 from linmstmm.numeric import constant_times, frequencies, is_mp, numbers, zeros_like_stack
 from linmstmm.periodic import carry_run, find_runs
 from linmstmm.topology import Topology
 from linmstmm.unknowns import boundary_state_rows, column_labels
 
-#: Largest βL of one beam piece in the stable evaluation: the piece's own closed form is exact
-#: to rounding, and growth e^4 ≈ 55 between orthonormalisations costs under two digits of the decaying solutions.
+#: Largest βL of one beam piece in the stable evaluation: the piece's own
+#: closed form is exact to rounding, and growth e^4 ≈ 55 between
+#: orthonormalisations costs under two digits of the decaying solutions.
 _BEAM_PIECE_BETA_L = 4.0
-#: βL of a beam piece after which the state is orthonormalised, grown or not: a piece parts its
-#: solutions by e^{2βL}, the state's size by e^{βL} at most (GROWTH let two pieces of βL 4 pass).
-_BEAM_SPREAD_BETA_L = np.log(_Orthonormaliser.GROWTH) / 2
 _CUT_SIGN = np.diag(np.r_[np.ones(6), -np.ones(6)])
 #: Kind of the row a released direction adds, for the orthonormaliser's row
 #: scales (:meth:`_Orthonormaliser._unit_scale`): a force (3) or a moment (2).
@@ -183,7 +181,7 @@ class Deduction:
     def tip_state(self, link, n) -> PortState:
         """State of a boundary end or cut side in terms of its unknowns (less released ones)."""
         columns, selection = self.tip_selection(link)
-        return PortState(columns, np.broadcast_to(selection, (n,) + selection.shape), np.ones((n, 4)))
+        return PortState(columns, np.broadcast_to(selection, (n,) + selection.shape), np.ones(n))
 
     def tip_selection(self, link) -> tuple[np.ndarray, np.ndarray]:
         """(columns (k,), selection (12, k)) of a boundary end or cut side: its state is
@@ -208,7 +206,7 @@ class Deduction:
         """The jumps across the released directions of joint ``e`` as a state:
         ``E Δ`` on their columns (less released ones)."""
         columns, jump = self.jump_selection(e)
-        return PortState(columns, np.broadcast_to(jump, (n,) + jump.shape), np.ones((n, 4)))
+        return PortState(columns, np.broadcast_to(jump, (n,) + jump.shape), np.ones(n))
 
     def jump_selection(self, e) -> tuple[np.ndarray, np.ndarray]:
         """(columns (k,), E (12, k)) of the jumps across the released directions of joint
@@ -368,18 +366,16 @@ class Deduction:
                 terms = [(inputs[0].columns, inputs[0].matrix)]
             else:
                 terms = [(inputs[0].columns, self.carried(e, omega, inputs[0].matrix))]
-            references = [state.reference for state in inputs]
             if e in self.jump_columns:
                 rows.append(self._joint_row(e, inputs[0]))
                 jump = self.jump_state(e, n)
                 terms.append((jump.columns, jump.matrix))
-                references.append(jump.reference)  # (as the kernel's merge: every term's)
             for k, ((label, forces, incidence), state) in enumerate(zip(self._other_inputs(e, is_mp(omega)),
                                                                        inputs[1:])):
                 terms.append((state.columns, constant_times(forces, state.matrix)))
                 rows.append([label, *self._combined((e, k), [(inputs[0].columns, -inputs[0].matrix[:, :6]),
                                                              (state.columns, constant_times(incidence, state.matrix))])])
-            state = PortState(*self._combined((e,), terms), reference=merged_reference(references))
+            state = PortState(*self._combined((e,), terms), reference=_largest([state.reference for state in inputs]))
             state = loads.jumped((e, element.output), state, rows)
             if stable:
                 state = normaliser.apply(state, rows, open_states)
@@ -412,14 +408,13 @@ class Deduction:
         return cell
 
     def _carry_through_beam(self, element, omega, state, normaliser, rows, open_states):
-        """The state carried along a beam piece by piece, orthonormalised after each (_BEAM_SPREAD_BETA_L)."""
+        """The state carried along a beam piece by piece, orthonormalised between pieces."""
         beam = element.record
         beta_L = bending_wavenumber(beam, np.max(np.abs(omega))) * beam.length
         pieces = max(int(np.ceil(beta_L / _BEAM_PIECE_BETA_L)), 1)
         piece = beam_transfer(beam, omega, reverse=element.inputs[0] == 1, length=beam.length / pieces)
-        for _ in range(pieces):  # (a reference of None: orthonormalised, grown or not)
-            state = PortState(state.columns, piece @ state.matrix,
-                              None if beta_L / pieces >= _BEAM_SPREAD_BETA_L else state.reference)
+        for _ in range(pieces):
+            state = PortState(state.columns, piece @ state.matrix, state.reference)
             state = normaliser.apply(state, rows, open_states)
         return state
 
@@ -491,3 +486,9 @@ def _index(columns):
         return slice(int(columns[0]), int(columns[-1]) + 1)
     return columns
 
+
+def _largest(references):
+    """Elementwise largest of the inputs' references, None if any is None."""
+    if any(reference is None for reference in references):
+        return None
+    return references[0] if len(references) == 1 else np.max(references, axis=0)

@@ -16,12 +16,10 @@ from linmstmm.numeric import power_of_two_scale, size_estimate
 class PortState:
     """``Z_port = matrix @ z̄[columns]``; matrix (n, 12, len(columns)).
 
-    reference : (n, 4) max |matrix| of each kind of row (:func:`kind_sizes`) when its
-    columns were last orthonormalised, to tell how much it has grown (:func:`grown`);
-    where its columns are in units of their own (at a tip: 1; at a merge: the
-    largest of the inputs' for all four, their columns are disjoint except a cut's
-    two sides) the whole state's largest entry for every kind, which leaves only
-    the whole state's test; None: unknown, orthonormalise at the next chance.
+    reference : (n,) max |matrix| when its columns were last orthonormalised,
+    to tell how much it has grown: 1 at a tip (its selection is orthonormal),
+    the largest of the inputs' at a merge (their columns are disjoint, except a
+    cut's two sides); None: unknown, orthonormalise at the next chance.
     """
 
     columns: np.ndarray
@@ -46,8 +44,7 @@ class _Orthonormaliser:
     float and complex stacks are handled.
     """
 
-    #: Orthonormalise once a state, or one kind of its rows, has grown (or shrunk) by this
-    #: factor since the last time (:func:`grown`).
+    #: Orthonormalise once a state has grown (or shrunk) by this factor since the last time.
     GROWTH = 1e2
     #: Entries beyond this (or below its inverse) after a QR are scaled back by a
     #: power of two (a chain of 300 cells above its cutoff grows ×400 per cell).
@@ -117,8 +114,10 @@ class _Orthonormaliser:
         keep_columns : only where no block widens the columns (a periodic run's
         powers need the state's own columns).
         """
-        if state.reference is not None and not grown(kind_sizes(state.matrix), state.reference, self.GROWTH).any():
-            return state
+        if state.reference is not None:
+            growth = size_estimate(state.matrix).max(axis=(1, 2)) / state.reference
+            if growth.max() < self.GROWTH and growth.min() > 1 / self.GROWTH:
+                return state
         columns, blocks = self._sharing(state, rows, open_states)
         if keep_columns and columns.size != state.columns.size:
             return state
@@ -150,53 +149,11 @@ class _Orthonormaliser:
             if kind == "row":
                 key[1], key[2] = columns, part
             elif kind == "state":
-                open_states[key] = PortState(columns, part, kind_sizes(part))
+                open_states[key] = PortState(columns, part, size_estimate(part).max(axis=(1, 2)))
             else:
-                self.waiting[key] = PortState(columns, part, kind_sizes(part))
+                self.waiting[key] = PortState(columns, part, size_estimate(part).max(axis=(1, 2)))
         q = q[:, offset:]
-        return PortState(columns, q, kind_sizes(q))
-
-
-def kind_sizes(matrix: np.ndarray) -> np.ndarray:
-    """(n, 4) largest |Re| + |Im| (:func:`~linmstmm.numeric.size_estimate`) of each kind of
-    row of a state ``matrix`` (n, 12, k): displacements, rotations, moments, forces,
-    three rows each."""
-    n, rows, k = matrix.shape
-    return size_estimate(matrix).reshape(n, rows // 3, 3 * k).max(axis=2, initial=0.0)
-
-
-def grown(sizes: np.ndarray, reference: np.ndarray, factor: float) -> np.ndarray:
-    """(n,) bool: whether a state whose :func:`kind_sizes` are ``sizes`` (n, 4) has grown or
-    shrunk by ``factor`` or more as a whole (its largest entry) since ``reference`` (n, 4),
-    or grown by ``factor`` or more in one kind of row that was not zero there.
-
-    Each kind by itself, because the state's largest entry is of the kind largest in the
-    model's units and hides the others: launcher 2's elevating cylinder's soft springs turn
-    moments into rotations that grew ×1e2 and more unseen under its forces, and once every
-    long beam piece was orthonormalised after (:mod:`linmstmm.deduction`) its root near
-    7,634 rad/s came out 2.6e-10 off (det 1e-6 either side 2.7e-4), now 5e-13 (det 5e-7).
-    A kind's growth is a ratio of sizes of that kind on columns of one unit (those of one
-    orthonormalisation), free of the model's units; a reference of the whole state's size
-    for every kind (a tip, a merge: :class:`PortState`) leaves the whole state's test
-    alone. A kind that was zero has no size to grow from, and one that
-    shrinks alone swamps nothing: the whole state's test still watches both."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        whole = sizes.max(axis=1) / reference.max(axis=1)
-        each = np.where(reference > 0, sizes / reference, 1.0)
-    return ~((whole < factor) & (whole > 1 / factor)) | ~(each < factor).all(axis=1)
-
-
-def merged_reference(references):
-    """The reference of a state formed from states of ``references`` (n, 4) each
-    (:class:`PortState`): one's own, or of several the largest of all their kinds for
-    every kind (their columns, each from its own orthonormalisation or tip, are in units
-    of their own: only the whole state's growth tells); None if any is None."""
-    if any(reference is None for reference in references):
-        return None
-    if len(references) == 1:
-        return references[0]
-    largest = np.max(references, axis=(0, 2))
-    return np.repeat(largest[:, None], 4, axis=1)
+        return PortState(columns, q, size_estimate(q).max(axis=(1, 2)))
 
 
 def _row_kinds(block) -> np.ndarray:

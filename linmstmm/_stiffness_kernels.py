@@ -46,7 +46,9 @@ announce_compiles()  # one line on stderr if this run compiles (linmstmm._compil
 EA, GJ, EIY, EIZ, RHO_A, RHO_IP, LENGTH, AXIAL, TORSION = range(9)
 _X_Y = np.array([1, 5, 7, 11])
 _X_Z = np.array([2, 4, 8, 10])
+#: Signs of the bending planes' DOFs: the x–z plane's θ is −θy, the x–y plane's θz as it is.
 _FLIP = np.array([1.0, -1.0, 1.0, -1.0])
+_SAME = np.ones(4)
 #: (12, 12) 1.0 where a beam's local dynamic stiffness may be nonzero: the rods
 #: (axial, torsion) and the two bending planes, each coupling its own DOFs only.
 LOCAL_PATTERN = np.zeros((12, 12))
@@ -89,41 +91,63 @@ def _combinations(lam, out):
 
 
 @njit(cache=True)
-def _bending(stiffness, inertia, length, omega, local, dofs, signs, combos):
-    """Write one plane's 4 × 4 exact bending block (``signs`` flip θ) into ``local``."""
+def _bending_entries(stiffness, inertia, length, omega, combos):
+    """The six distinct entries (K11, K12, K13, K14, K22, K24) of one plane's exact
+    bending block over (v₁, θ₁, v₂, θ₂) (:func:`linmstmm.dynamic_stiffness._bending`),
+    ``combos`` (7,) scratch."""
     beta = (inertia * omega * omega / stiffness) ** 0.25
     series = _combinations(beta * length, combos)
     b1, b2, b3 = (1 / length, 1 / length ** 2, 1 / length ** 3) if series else (beta, beta ** 2, beta ** 3)
     f = stiffness / combos[0]
-    k11, k12, k13, k14 = f * b3 * combos[1], f * b2 * combos[2], -f * b3 * combos[3], f * b2 * combos[4]
-    k22, k24 = f * b1 * combos[5], f * b1 * combos[6]
-    block = np.array([[k11, k12, k13, k14], [k12, k22, -k14, k24],
-                      [k13, -k14, k11, -k12], [k14, k24, -k12, k22]])
-    for i in range(4):
-        for j in range(4):
-            local[dofs[i], dofs[j]] = block[i, j] * signs[i] * signs[j]
+    return (f * b3 * combos[1], f * b2 * combos[2], -f * b3 * combos[3], f * b2 * combos[4], f * b1 * combos[5],
+            f * b1 * combos[6])
 
 
 @njit(cache=True)
-def _rod(stiffness, inertia, length, omega, deformable, local, a, b):
-    """Write one rod's 2 × 2 block at DOFs ``a``, ``b`` into ``local`` (the consistent
-    mass alone where it is rigid)."""
+def _bending(stiffness, inertia, length, omega, local, dofs, signs, combos):
+    """Write one plane's 4 × 4 exact bending block (``signs`` flip θ) into ``local``."""
+    block = _bending_block(_bending_entries(stiffness, inertia, length, omega, combos))
+    for i in range(4):
+        for j in range(4):
+            local[dofs[i], dofs[j]] = block[i][j] * signs[i] * signs[j]
+
+
+@njit(cache=True)
+def _bending_block(entries):
+    """One plane's 4 × 4 bending block, rows as tuples, from its six distinct ``entries``
+    (:func:`_bending_entries`)."""
+    k11, k12, k13, k14, k22, k24 = entries
+    return ((k11, k12, k13, k14), (k12, k22, -k14, k24), (k13, -k14, k11, -k12), (k14, k24, -k12, k22))
+
+
+@njit(cache=True)
+def _rod_entries(stiffness, inertia, length, omega, deformable):
+    """(diagonal, off-diagonal) entries of one rod's 2 × 2 block (the consistent mass
+    alone where it is rigid)."""
     if not deformable:
         m = -omega * omega * inertia * length / 6
-        local[a, a], local[a, b], local[b, a], local[b, b] = 2 * m, m, m, 2 * m
-        return
+        return 2 * m, m
     k = omega * math.sqrt(inertia / stiffness)
     kl = k * length
     if kl < 1e-8:
         scale, diagonal, off = stiffness / length, 1.0 - kl * kl / 3, -1.0 - kl * kl / 6
     else:
         scale, diagonal, off = stiffness * k / math.sin(kl), math.cos(kl), -1.0
-    local[a, a], local[a, b], local[b, a], local[b, b] = scale * diagonal, scale * off, scale * off, scale * diagonal
+    return scale * diagonal, scale * off
 
 
 @njit(cache=True)
-def _clamped(beam, omega):
-    """J₀ of one beam at ``omega``; −1 within POLE of a clamped–clamped frequency."""
+def _rod(stiffness, inertia, length, omega, deformable, local, a, b):
+    """Write one rod's 2 × 2 block at DOFs ``a``, ``b`` into ``local`` (the consistent
+    mass alone where it is rigid)."""
+    diagonal, off = _rod_entries(stiffness, inertia, length, omega, deformable)
+    local[a, a], local[a, b], local[b, a], local[b, b] = diagonal, off, off, diagonal
+
+
+@njit(cache=True)
+def _clamped(beam, omega, combos):
+    """J₀ of one beam at ``omega``; −1 within POLE of a clamped–clamped frequency
+    (``combos`` (7,) scratch)."""
     total = 0
     for stiffness, inertia, flag in ((beam[EA], beam[RHO_A], beam[AXIAL]), (beam[GJ], beam[RHO_IP], beam[TORSION])):
         if flag > 0:
@@ -132,7 +156,6 @@ def _clamped(beam, omega):
             if nearest >= 1 and abs(phase - nearest) < POLE * phase:
                 return -1
             total += int(math.floor(phase))
-    combos = np.empty(7)
     for stiffness in (beam[EIY], beam[EIZ]):
         lam = beam[LENGTH] * (beam[RHO_A] * omega * omega / stiffness) ** 0.25
         if lam >= SERIES_BELOW:
@@ -198,13 +221,13 @@ def _added_beams(omega, beams, maps, places, values, magnitudes):
 def _beam_local(beam, omega, local, combos):
     """J₀ of one beam (:func:`_clamped`, −1 where undecided), with its (12, 12) exact
     dynamic stiffness written into ``local`` (unless undecided)."""
-    count = _clamped(beam, omega)
+    count = _clamped(beam, omega, combos)
     if count < 0:
         return -1
     local[:] = 0.0
     _rod(beam[EA], beam[RHO_A], beam[LENGTH], omega, beam[AXIAL] > 0, local, 0, 6)
     _rod(beam[GJ], beam[RHO_IP], beam[LENGTH], omega, beam[TORSION] > 0, local, 3, 9)
-    _bending(beam[EIZ], beam[RHO_A], beam[LENGTH], omega, local, _X_Y, np.ones(4), combos)
+    _bending(beam[EIZ], beam[RHO_A], beam[LENGTH], omega, local, _X_Y, _SAME, combos)
     _bending(beam[EIY], beam[RHO_A], beam[LENGTH], omega, local, _X_Z, _FLIP, combos)
     return count
 

@@ -25,9 +25,22 @@ the test oracle (tests/test_wittrick_williams.py compares them):
   arguments per frequency was 2.5 of the 10 µs a count took on the launcher).
 
 * :func:`touched_rows` — each beam's rows of T as
-  :func:`linmstmm.wittrick_williams._beam_maps` picks them in numpy.
+  :func:`linmstmm.wittrick_williams._beam_maps` picks them in numpy;
+* :func:`rayleigh_roots` — :func:`linmstmm.rayleigh.rayleigh_values_in_numpy`: Rayleigh
+  quotient iteration on D(ω) from approximate modes, its functional xᵀ D(ω) x
+  (:func:`_form`, from the terms :func:`_form_parts` makes of x:
+  :meth:`~linmstmm.wittrick_williams.ModeCounter.forms`), D′(ω) x by differences
+  (:func:`_difference_applied`: :meth:`~linmstmm.wittrick_williams.ModeCounter.differences`)
+  and the solve of its inverse steps by the LDLᵀ of :func:`ordered_inertia`
+  (:func:`_ordered_solve`); tests/test_rayleigh.py compares them.
 
 The plan of that factorisation is made by :mod:`linmstmm._ordering_kernels`.
+
+Kept whole: numba invalidates a cached kernel when the file that defines it
+changes, not when a kernel it calls in another file does; the count and the
+Rayleigh quotient iteration share the beams' blocks and the sparse factorisation
+here, and split across files an edit to one of those would leave the other's
+callers running the old code from the cache.
 """
 from __future__ import annotations
 
@@ -498,3 +511,234 @@ def counts(omegas, beams, maps, columns, static, mass, singular_pivot, most_grow
         if found == REFUSED:
             found = count(omegas[i], beams, maps, columns, static, mass, singular_pivot, matrix, magnitude, work)
         out[i] = found
+
+
+@njit(cache=True)
+def _form_parts(x, maps, columns, high, low, terms, ends):
+    """(xᵀ S x, xᵀ M x) of the springs' stiffness S and the bodies' mass M (``terms``
+    at the slots (``high``, ``low``), as :func:`_assembled_slots` takes them) for the
+    vector ``x`` (n,) on the reduced DOFs, with each beam's local end displacements
+    ``maps[b] @ x[columns[b]]`` written into ``ends`` (n_beams, 12) (padding: 0)."""
+    n = x.size
+    static, mass = 0.0, 0.0
+    for s in range(high.size):
+        product = x[high[s]] * x[low[s]]
+        static += (terms[0, s] + terms[2, s]) * product
+        mass += (terms[1, s] + terms[3, s]) * product
+    for b in range(maps.shape[0]):
+        for p in range(12):
+            total = 0.0
+            for j in range(columns.shape[1]):
+                if columns[b, j] < n:
+                    total += maps[b, p, j] * x[columns[b, j]]
+            ends[b, p] = total
+    return static, mass
+
+
+@njit(cache=True)
+def _form(omega, beams, ends, static, mass, combos):
+    """xᵀ D(ω) x, the Rayleigh functional's value at ``omega`` (rad/s), from the parts
+    :func:`_form_parts` made of x (not finite at a beam's clamped–clamped frequency)."""
+    total = static - omega * omega * mass
+    forces = np.empty(12)
+    for b in range(beams.shape[0]):
+        _beam_applied(beams[b], omega, ends[b], forces, combos)
+        for p in range(12):
+            total += ends[b, p] * forces[p]
+    return total
+
+
+@njit(cache=True)
+def _beam_applied(beam, omega, ends, forces, combos):
+    """``forces`` (12,) = the beam's exact local dynamic stiffness at ``omega`` (the blocks
+    :func:`_beam_local` writes, without its count) times its ends' local displacements
+    ``ends`` (12,)."""
+    for stiffness, inertia, flag, i, j in ((beam[EA], beam[RHO_A], beam[AXIAL], 0, 6),
+                                           (beam[GJ], beam[RHO_IP], beam[TORSION], 3, 9)):
+        diagonal, off = _rod_entries(stiffness, inertia, beam[LENGTH], omega, flag > 0)
+        forces[i], forces[j] = diagonal * ends[i] + off * ends[j], off * ends[i] + diagonal * ends[j]
+    for stiffness, dofs, signs in ((beam[EIZ], _X_Y, _SAME), (beam[EIY], _X_Z, _FLIP)):
+        block = _bending_block(_bending_entries(stiffness, beam[RHO_A], beam[LENGTH], omega, combos))
+        for i in range(4):
+            total = 0.0
+            for j in range(4):
+                total += block[i][j] * signs[j] * ends[dofs[j]]
+            forces[dofs[i]] = signs[i] * total
+
+
+@njit(cache=True)
+def _form_root(start, first_step, steps, xtol, floor, beams, ends, static, mass, combos):
+    """The root of ω ↦ xᵀ D(ω) x nearest ``start`` (rad/s) by the secant method from
+    ``start`` and ``start`` (1 + ``first_step``), to a relative step below ``xtol``, or
+    where the value is exactly 0 or stalls, or the secant rises after a step below
+    ``floor`` (the functional's rounding); NaN where ``steps`` steps do not reach it, a
+    value is not finite, or the secant rises after a longer step: the functional falls
+    with ω between the beams' clamped–clamped frequencies (D′(ω) is negative
+    definite), so such a secant straddles one of them, where it would converge on the pole."""
+    old, omega = start, start * (1 + first_step)
+    f_old = _form(old, beams, ends, static, mass, combos)
+    f = _form(omega, beams, ends, static, mass, combos)
+    for _ in range(steps):
+        if not (math.isfinite(f_old) and math.isfinite(f)):
+            return math.nan
+        if f == 0.0 or f == f_old:  # a root, or the functional's rounding floor
+            return omega
+        if (f - f_old) * (omega - old) > 0.0:
+            return omega if abs(omega - old) <= floor * omega else math.nan
+        new = omega - f * (omega - old) / (f - f_old)
+        if not (new > 0.0 and math.isfinite(new)):
+            return math.nan
+        if abs(new - omega) <= xtol * new:
+            return new
+        old, f_old, omega = omega, f, new
+        f = _form(omega, beams, ends, static, mass, combos)
+    return math.nan
+
+
+@njit(cache=True)
+def _ordered_solve(values, starts, rows, updates, targets, most_growth, growth, z):
+    """Solve A z' = z in place (``z`` (n,) in elimination order) by the LDLᵀ without
+    pivoting of :func:`ordered_inertia` (``values``, A's lower-triangle slots,
+    overwritten), False where a pivot is exactly zero or not finite, or an entry of
+    diag(|L| |D| |L|ᵀ) is above ``most_growth`` (the factors are not known to be
+    accurate then); a small last pivot is what inverse iteration asks for."""
+    n = starts.size - 1
+    growth[:] = 0.0
+    for k in range(n):
+        pivot = values[starts[k]]
+        growth[k] += abs(pivot)
+        if pivot == 0.0 or not math.isfinite(pivot) or growth[k] > most_growth:
+            return False
+        t = updates[k]
+        for a in range(starts[k] + 1, starts[k + 1]):
+            multiplier = values[a] / pivot
+            growth[rows[a]] += abs(values[a] * multiplier)
+            for b in range(starts[k] + 1, a + 1):
+                values[targets[t]] -= multiplier * values[b]
+                t += 1
+    for k in range(n):  # L y = z, L's column k below the diagonal: values / pivot
+        pivot = values[starts[k]]
+        for a in range(starts[k] + 1, starts[k + 1]):
+            z[rows[a]] -= values[a] / pivot * z[k]
+    for k in range(n):
+        z[k] /= values[starts[k]]
+    for k in range(n - 1, -1, -1):  # Lᵀ z' = y
+        pivot = values[starts[k]]
+        for a in range(starts[k] + 1, starts[k + 1]):
+            z[k] -= values[a] / pivot * z[rows[a]]
+    return True
+
+
+@njit(cache=True)
+def _difference_applied(omega, step, x, beams, maps, columns, high, low, terms, combos, out):
+    """``out`` = (D(ω (1 − step)) − D(ω (1 + step))) x, about −2 step ω D′(ω) x: the bodies'
+    mass terms at the slots (``high``, ``low``) of ``terms`` (the springs' cancel) and the
+    difference of the beams' exact local stiffness on their ends' displacements
+    (:func:`_beam_applied`; not finite at a beam's clamped–clamped frequency)."""
+    weight = 4 * step * omega * omega  # ω²(1 + step)² − ω²(1 − step)²
+    out[:] = 0.0
+    for s in range(high.size):
+        i, j = high[s], low[s]
+        out[i] += weight * terms[1, s] * x[j]
+        if i != j:
+            out[j] += weight * terms[3, s] * x[i]
+    n = x.size
+    ends, below, above = np.empty(12), np.empty(12), np.empty(12)
+    for b in range(beams.shape[0]):
+        for p in range(12):
+            total = 0.0
+            for j in range(columns.shape[1]):
+                if columns[b, j] < n:
+                    total += maps[b, p, j] * x[columns[b, j]]
+            ends[p] = total
+        _beam_applied(beams[b], omega * (1 - step), ends, below, combos)
+        _beam_applied(beams[b], omega * (1 + step), ends, above, combos)
+        for j in range(columns.shape[1]):
+            if columns[b, j] < n:
+                total = 0.0
+                for p in range(12):
+                    total += maps[b, p, j] * (below[p] - above[p])
+                out[columns[b, j]] += total
+
+
+@njit(cache=True)
+def _inverse_step(omega, x, derivative_step, beams, maps, columns, most_growth, plan, terms, buffers, z, rhs):
+    """One step of nonlinear inverse iteration on D(ω): x ← D(ω)⁻¹ D′(ω) x, D′(ω) x by
+    central differences ω (1 ± ``derivative_step``), then scaled to a largest entry of 1
+    (an exact mode stays what it is). D(ω) is equilibrated by the diagonal of |D|(ω),
+    as the count equilibrates it, and factorised by :func:`_ordered_solve`. False, x
+    left as it was, where D(ω) cannot be formed (a beam's clamped–clamped frequency) or
+    its factorisation refuses.
+
+    The arguments as for :func:`ordered_count`; z, rhs : (n,) scratch."""
+    order, starts, rows, high, low, updates, targets, beam_slots = plan
+    values, magnitudes, _, growth = buffers
+    n = order.size
+    _difference_applied(omega, derivative_step, x, beams, maps, columns, high, low, terms, np.empty(7), rhs)
+    if _assembled_slots(omega, beams, maps, beam_slots, terms, values, magnitudes) < 0:
+        return False
+    weights = np.empty(n)
+    for k in range(n):
+        if not magnitudes[starts[k]] > 0:
+            return False
+        weights[order[k]] = 1.0 / math.sqrt(magnitudes[starts[k]])
+    slots, largest = values.size, 0.0
+    for s in range(slots):
+        values[s] = values[s] * weights[high[s]] * weights[low[s]]
+        largest = max(largest, magnitudes[s] * weights[high[s]] * weights[low[s]])
+        largest = max(largest, magnitudes[slots + s] * weights[low[s]] * weights[high[s]])
+    if not math.isfinite(largest):
+        return False
+    for k in range(n):
+        z[k] = rhs[order[k]] * weights[order[k]]
+        if not math.isfinite(z[k]):
+            return False
+    if not _ordered_solve(values, starts, rows, updates, targets, most_growth * largest, growth, z):
+        return False
+    size = 0.0
+    for k in range(n):
+        z[k] *= weights[order[k]]
+        size = max(size, abs(z[k]))
+    if not (size > 0.0 and math.isfinite(size)):
+        return False
+    for k in range(n):
+        x[order[k]] = z[k] / size
+    return True
+
+
+@njit(cache=True, nogil=True)
+def rayleigh_roots(vectors, starts, beams, maps, columns, most_growth, plan, terms, buffers, first_step,
+                   form_steps, form_xtol, form_floor, settled, inverse_steps, derivative_step, out):
+    """Rayleigh values of the exact D(ω) from approximate nodal vectors, by Rayleigh
+    quotient iteration: for each row x of ``vectors`` (m, n) from ω₀ = ``starts[i]``
+    (rad/s), a step of inverse iteration at ω_k (:func:`_inverse_step`) and ω_(k+1) the
+    root of xᵀ D(ω) x nearest ω_k (:func:`_form_root`), until ω_(k+1) lies within
+    ``settled`` (relative) of ω_k: ω_(k+1) into ``out[i]``; NaN where that takes more
+    than ``inverse_steps`` steps or a step fails.
+
+    beams, maps, columns, plan, terms, buffers : as for :func:`ordered_count`;
+    most_growth : the largest entry of diag(|L| |D| |L|ᵀ) the solve takes, relative
+    to the largest equilibrated term. first_step, form_steps, form_xtol, form_floor :
+    the secant's of :func:`_form_root`. derivative_step : the inverse step's (relative).
+    ``vectors`` is overwritten by the last vectors.
+    """
+    n = vectors.shape[1]
+    ends = np.empty((maps.shape[0], 12))
+    combos = np.empty(7)
+    z, rhs = np.empty(n), np.empty(n)
+    high, low = plan[3], plan[4]
+    for i in range(starts.size):
+        out[i] = math.nan
+        x, omega = vectors[i], starts[i]
+        for _ in range(inverse_steps):
+            if not _inverse_step(omega, x, derivative_step, beams, maps, columns, most_growth, plan, terms, buffers,
+                                 z, rhs):
+                break
+            static, mass = _form_parts(x, maps, columns, high, low, terms, ends)
+            new = _form_root(omega, first_step, form_steps, form_xtol, form_floor, beams, ends, static, mass, combos)
+            if not math.isfinite(new):
+                break
+            if abs(new - omega) <= settled * new:
+                out[i] = new
+                break
+            omega = new

@@ -18,6 +18,7 @@ import scipy.linalg
 
 from linmstmm.block_lanczos import lowest_eigenvalues
 from linmstmm.elements.beam import bending_wavenumber
+from linmstmm.fe.sparse import scipy_csr
 from linmstmm.fe.node_constraints import kept_node_constraints
 from linmstmm.model import Model
 
@@ -68,14 +69,50 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
     Returns (m,) ascending, m <= count (fewer if the model has fewer); none for
     a model of more than MAX_UNKNOWNS unknowns.
     """
+    return coarse_modes(model, count, elements_per_beam, shift, nodal=False).values
+
+
+@dataclass(frozen=True, eq=False)
+class PredictedModes:
+    """The coarse FE model's lowest elastic modes (:func:`coarse_modes`).
+
+    Attributes
+    ----------
+    values : numpy.ndarray, shape (m,)
+        Natural frequencies, rad/s, ascending.
+    nodal : numpy.ndarray, shape (m, 6 · (points + bodies)), or None
+        Each mode's displacements (m) and rotations (rad) at the model's points and
+        rigid bodies' mass centres, six per node in the inertial frame, in the order
+        of the full DOFs of :mod:`linmstmm.fe.layout` (the nodes every mesh numbers
+        first): the eigenvector there, unnormalised. None where they were not asked
+        for, or the eigensolver gives no vectors (more than BISECTED wanted, the
+        sparse route, or massless unknowns).
+    """
+
+    values: np.ndarray
+    nodal: np.ndarray | None
+
+
+def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: float | None = None,
+                 nodal: bool = True) -> PredictedModes:
+    """:func:`coarse_predictions` with the modes at the nodes (``nodal``): the
+    :class:`PredictedModes` of the mesh of ``elements_per_beam``.
+
+    The vectors come from the same LAPACK call as the frequencies, syevx, which gives
+    the same frequencies with them, bit for bit (all eigenvalues of the pencil asked
+    for take another path there: to rounding); about 80 µs more on the launcher's
+    84 unknowns for its 12 lowest.
+    """
     if elements_per_beam > _finest_mesh(model):  # a dense solve would cost more than the search it saves
-        return np.zeros(0)
+        return PredictedModes(np.zeros(0), None)
     pencil = coarse_pencil(model, elements_per_beam)
     if pencil.size == 0:  # every point held: no unknown, no mode (LAPACK takes no empty matrix)
-        return np.zeros(0)
+        return PredictedModes(np.zeros(0), None)
     rigid = pencil.rigid_body_modes
-    lam = np.sort(_lowest_eigenvalues(pencil, min(count + rigid, pencil.size), shift))[rigid:]
-    return np.sqrt(np.maximum(lam[:count], 0.0))
+    lam, vectors = _lowest_eigenvalues(pencil, min(count + rigid, pencil.size), shift, nodal)
+    order = np.argsort(lam)[rigid:rigid + count]
+    values = np.sqrt(np.maximum(lam[order], 0.0))
+    return PredictedModes(values, None if vectors is None else pencil.at_nodes(vectors[:, order]))
 
 
 @dataclass(frozen=True, eq=False)
@@ -138,7 +175,7 @@ class CoarsePencil:
             matrix.setflags(write=False)
         return K, M
 
-    @functools.cached_property
+    @property
     def reduced(self) -> np.ndarray | None:
         """The pencil in standard form, C = L⁻¹ K L⁻ᵀ with M = L Lᵀ (lower triangle),
         shape (n, n); None where M is not positive definite (massless unknowns).
@@ -152,12 +189,35 @@ class CoarsePencil:
         second launcher's ten lowest saved a quarter of its prediction (one asking
         the same count now takes the kept predictions, :func:`predict_frequencies`).
         """
+        return self._standard[1]
+
+    @functools.cached_property
+    def _standard(self) -> tuple[np.ndarray, np.ndarray] | tuple[None, None]:
+        """(L, C): the Cholesky factor of M (lower) and :attr:`reduced`; (None, None)
+        where M is not positive definite."""
         factor, info = scipy.linalg.lapack.dpotrf(self.M, lower=1, clean=0)
         if info:
-            return None
+            return None, None
         reduced, info = scipy.linalg.lapack.dsygst(self.K, factor, itype=1, lower=1)
-        reduced.setflags(write=False)  # shared by every prediction of this model
-        return reduced
+        for matrix in (factor, reduced):
+            matrix.setflags(write=False)  # shared by every prediction of this model
+        return factor, reduced
+
+    def at_nodes(self, vectors: np.ndarray) -> np.ndarray:
+        """(m, 6 · (points + bodies)): the eigenvectors ``vectors`` (n, m) of
+        :attr:`reduced` as displacements and rotations at the model's points and mass
+        centres (:class:`PredictedModes`): x = L⁻ᵀ y on the scaled pencil, times
+        :attr:`scale` on the assembly's unknowns, and the rows of T at those nodes."""
+        factor = self._standard[0]
+        scaled, info = scipy.linalg.lapack.dtrtrs(factor, vectors, lower=1, trans=1)
+        return (self._node_rows @ (self.scale[:, None] * scaled)).T
+
+    @functools.cached_property
+    def _node_rows(self):
+        """The rows of the assembly's T (scipy CSR) at the full DOFs of the points and
+        mass centres, which every mesh numbers first (:mod:`linmstmm.fe.layout`)."""
+        model = self.assembly.model
+        return scipy_csr(self.assembly.parts.T)[:6 * (len(model.points) + len(model.rigids))]
 
 
 def coarse_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
@@ -218,7 +278,7 @@ def _unit_scale(stiffness: np.ndarray, mass: np.ndarray) -> np.ndarray:
 def _forget_pencils() -> None:
     """Drop every coarse pencil, node elimination and prediction kept (:func:`coarse_pencil`)."""
     _pencil.cache_clear()
-    _kept_predictions.cache_clear()
+    _forget_predictions()
     kept_node_constraints.cache_clear()
 
 
@@ -251,28 +311,31 @@ def _regular_pencil(K: np.ndarray, M: np.ndarray):
     return K[np.ix_(kept, kept)], M[np.ix_(kept, kept)]
 
 
-def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None) -> np.ndarray:
-    """At least the ``count`` lowest eigenvalues of ``pencil`` (K, M), (rad/s)², in
-    any order: by block shift-invert Lanczos about −shift
+def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None,
+                        vectors: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
+    """(at least the ``count`` lowest eigenvalues of ``pencil`` (K, M), (rad/s)², in
+    any order; their eigenvectors of :attr:`CoarsePencil.reduced`, (n, m), or None):
+    by block shift-invert Lanczos about −shift
     (:func:`~linmstmm.block_lanczos.lowest_eigenvalues`) where a shift is given,
     every unknown carries mass and there are more than DENSE_PREDICTION; else on the
-    kept standard form, the lowest by bisection (syevx), or all at once (QR, dsterf)
-    where more than BISECTED are wanted; by QZ where M is singular, the infinite
-    eigenvalues dropped."""
+    kept standard form, the lowest by bisection (syevx, with their ``vectors`` if
+    asked), or all at once (QR, dsterf) where more than BISECTED are wanted; by QZ
+    where M is singular, the infinite eigenvalues dropped. Vectors come only from syevx."""
     if shift is not None and pencil.size > DENSE_PREDICTION and np.all(pencil.assembly.M.diagonal() != 0):
         lam = _sparse_lowest(pencil, count, shift)
         if lam is not None:
-            return lam
+            return lam, None
     if pencil.reduced is None:  # massless unknowns: QZ, their eigenvalues infinite
         K, M = _regular_pencil(pencil.K, pencil.M)
         lam = scipy.linalg.eigvals(K, M)
-        return lam[np.isfinite(lam)].real
-    return _standard_lowest(pencil.reduced, count)
+        return lam[np.isfinite(lam)].real, None
+    return _standard_lowest(pencil.reduced, count, vectors)
 
 
-def _standard_lowest(reduced: np.ndarray, count: int) -> np.ndarray:
-    """The ``count`` lowest eigenvalues of the standard form ``reduced`` (n, n) (its lower
-    triangle), ascending: by bisection (syevx) up to BISECTED, else all of them (syev).
+def _standard_lowest(reduced: np.ndarray, count: int, vectors: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
+    """(the ``count`` lowest eigenvalues of the standard form ``reduced`` (n, n) (its lower
+    triangle), ascending; their eigenvectors (n, count) where ``vectors`` and syevx
+    finds them, else None): by bisection (syevx) up to BISECTED, else all of them (syev).
 
     LAPACK's routines called as ``scipy.linalg.eigh(driver="evx" or "ev", lower=True)``
     calls them, with its workspace (:func:`_workspace`), hence its eigenvalues to the bit,
@@ -281,16 +344,17 @@ def _standard_lowest(reduced: np.ndarray, count: int) -> np.ndarray:
     and a first solve's prediction of either launcher 2 to 8 % less, side by side.
     """
     n = reduced.shape[0]
+    found_vectors = None
     if count > BISECTED:
         eigenvalues, _, info = scipy.linalg.lapack.dsyev(reduced, compute_v=0, lower=1,
                                                          lwork=_workspace("dsyev", n))
     else:
-        eigenvalues, _, found, _, info = scipy.linalg.lapack.dsyevx(
-            reduced, compute_v=0, range="I", il=1, iu=count, lower=1, lwork=_workspace("dsyevx", n))
-        eigenvalues = eigenvalues[:found]
+        eigenvalues, found_vectors, found, _, info = scipy.linalg.lapack.dsyevx(
+            reduced, compute_v=int(vectors), range="I", il=1, iu=count, lower=1, lwork=_workspace("dsyevx", n))
+        eigenvalues, found_vectors = eigenvalues[:found], found_vectors[:, :found] if vectors else None
     if info:
         raise np.linalg.LinAlgError(f"LAPACK's symmetric eigensolver failed on the coarse pencil (info {info})")
-    return eigenvalues
+    return eigenvalues, found_vectors
 
 
 @functools.lru_cache(maxsize=None)
@@ -308,8 +372,6 @@ def _sparse_lowest(pencil: CoarsePencil, count: int, shift: float) -> np.ndarray
     that gives no answer."""
     from scipy.sparse import diags  # imported where used: the command line starts without it
 
-    from linmstmm.fe.sparse import scipy_csr
-
     scaling = diags(pencil.scale)
     K, M = (scaling @ scipy_csr(matrix) @ scaling for matrix in (pencil.assembly.K, pencil.assembly.M))
     return lowest_eigenvalues(K, M, count, shift)
@@ -326,7 +388,7 @@ def predict_frequencies(model: Model, count: int) -> np.ndarray:
     24,708 evaluations for the second launcher's 100 lowest on a mesh of 1,800
     unknowns, which a twice finer wave per element asked for).
 
-    The last answer is kept (:func:`_kept_predictions`): a parameter study's first
+    The last answer is kept (:func:`_kept_modes`): a parameter study's first
     step asks again, with the count its root search asked for, to measure the
     predictions' error at the roots found (:func:`linmstmm.warm_starts.prediction_error`),
     and a repeat solve of a model asks again; neither solves the eigenproblem anew.
@@ -345,20 +407,61 @@ def predict_frequencies(model: Model, count: int) -> np.ndarray:
     numpy.ndarray, shape (m,), rad/s
         Ascending, m <= count (:func:`coarse_predictions`); a copy, the caller's own.
     """
-    return _kept_predictions(model, count).copy()
+    return _kept_modes(model, count, nodal=False).values.copy()
 
 
-@functools.lru_cache(maxsize=1)
-def _kept_predictions(model: Model, count: int) -> np.ndarray:
-    """:func:`predict_frequencies` made anew."""
-    predictions = coarse_predictions(model, count, 2)
-    if not model.beams or not predictions.size:
-        return predictions
-    beta_L = max(bending_wavenumber(beam, predictions[-1]) * beam.length for beam in model.beams)
+def predicted_modes(model: Model, count: int) -> PredictedModes:
+    """:func:`predict_frequencies` with the modes at the model's points and mass
+    centres where the eigensolver gives them (:class:`PredictedModes`), kept as the
+    frequencies are (the frequencies are the same, to the bit, where the eigensolver
+    finds fewer than all of them: :func:`coarse_modes`).
+
+    Parameters
+    ----------
+    model : Model
+        The model.
+    count : int
+        Elastic frequencies wanted, >= 1.
+
+    Returns
+    -------
+    PredictedModes
+        Shared with later calls: not to be written into.
+    """
+    return _kept_modes(model, count, nodal=True)
+
+
+#: [((model, count, whether the modes at the nodes were asked for), PredictedModes)]: the last made.
+_kept = [(None, None)]
+
+
+def _kept_modes(model: Model, count: int, nodal: bool) -> PredictedModes:
+    """The last :class:`PredictedModes` made, where it was made for ``model`` and ``count``
+    with the modes at the nodes if ``nodal`` asks for them; else made anew and kept."""
+    key, kept = _kept[0]  # read once: another thread may replace it
+    if key is not None and key[0] is model and key[1] == count and (key[2] or not nodal):
+        return kept
+    made = _predicted_modes(model, count, nodal)
+    _kept[0] = (model, count, nodal), made
+    return made
+
+
+def _predicted_modes(model: Model, count: int, nodal: bool) -> PredictedModes:
+    """:func:`predicted_modes` made anew (the modes at the nodes only if ``nodal``): two
+    elements per beam, or as many as the highest frequency's bending waves need."""
+    predicted = coarse_modes(model, count, 2, nodal=nodal)
+    if not model.beams or not predicted.values.size:
+        return predicted
+    beta_L = max(bending_wavenumber(beam, predicted.values[-1]) * beam.length for beam in model.beams)
     needed = min(int(np.ceil(beta_L / WAVE_PER_ELEMENT)), MAX_ELEMENTS, max(_finest_mesh(model), 2))
     if needed <= 2 * 2:
-        return predictions
-    return coarse_predictions(model, count, needed, shift=0.5 * predictions[0] ** 2)
+        return predicted
+    return coarse_modes(model, count, needed, shift=0.5 * predicted.values[0] ** 2, nodal=nodal)
 
 
-predict_frequencies.cache_clear = _kept_predictions.cache_clear
+def _forget_predictions() -> None:
+    """Drop the kept predictions (:func:`predict_frequencies`)."""
+    _kept[0] = (None, None)
+
+
+predict_frequencies.cache_clear = _forget_predictions

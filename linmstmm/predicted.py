@@ -80,7 +80,7 @@ def _clusters(predictions: np.ndarray) -> list[list[int]]:
     return groups
 
 
-def _in_cluster(predictions: np.ndarray) -> list[bool]:
+def clustered(predictions: np.ndarray) -> list[bool]:
     """(m,): which of ``predictions`` (ascending) share a cluster (:func:`_clusters`) with another."""
     return [len(group) > 1 for group in _clusters(predictions) for _ in group]
 
@@ -161,7 +161,7 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
     stand where counts certify them to a loose rtol (if ``stand``), else by the secant, then the
     pencil, then the segment search around those both left troubled. None where a
     count of that search cannot be made (the full search decides)."""
-    in_cluster = _in_cluster(predictions)  # the same for the counts and the secant
+    in_cluster = clustered(predictions)  # the same for the counts and the secant
     standing, indices = (_counted_predictions(finder, predictions, in_cluster, start, stop) if stand
                          else ([], np.arange(start, stop)))
     leaders, followers = _coincident(predictions, indices)
@@ -208,7 +208,7 @@ def _counted_predictions(finder, predictions: np.ndarray, in_cluster: list[bool]
                          stop: int) -> tuple[list[float], np.ndarray]:
     """(predictions certified as they stand, rad/s; indices of the others, ascending):
     those of ``predictions[start:stop]`` alone (no other prediction within CLUSTER:
-    False in ``in_cluster``, :func:`_in_cluster` of ``predictions``)
+    False in ``in_cluster``, :func:`clustered` of ``predictions``)
     across which the Wittrick–Williams counts at ±rtol find one natural frequency (so
     a root lies within rtol of it), where the finder certifies to COUNTED_PREDICTION
     or looser; none otherwise. A prediction taken so has the finder's rtol as its
@@ -244,7 +244,7 @@ def _counted_predictions(finder, predictions: np.ndarray, in_cluster: list[bool]
 def _secant_polished(finder, predictions: np.ndarray, in_cluster: list[bool], indices: np.ndarray,
                      known: list[float], wanted: int) -> tuple[list[float], list[float]]:
     """(roots, unsettled predictions): ``predictions[indices]`` by the secant on det
-    (the others are their neighbours only; ``in_cluster``: :func:`_in_cluster` of
+    (the others are their neighbours only; ``in_cluster``: :func:`clustered` of
     ``predictions``); one that lands on a ``known`` root (rad/s) is unsettled.
 
     Cluster members too: the launcher's pairs 1e-4 apart at 5.7-21 krad/s are

@@ -129,12 +129,16 @@ class ModeCounter:
     ----------
     n_dof : int
         Order of the reduced D(ω) that each count factorises.
+    masters : numpy.ndarray, shape (n_dof,)
+        Its unknowns as the full DOFs of the one-element mesh (six per point and
+        mass centre, :mod:`linmstmm.fe.layout`).
     """
 
     def __init__(self, model: Model, engine: str = "auto"):
         self.engine = resolved_engine(engine)
         parts = counter_parts(model)  # its elimination kept by the model's structure where it can be
         self.n_dof = parts.T.shape[1]
+        self.masters = parts.masters
         self._static, self._mass = _reduced_terms(parts, self.engine)
         self._beams = BeamTable.of(model.beams)
         self._maps, self._columns = _beam_maps(parts, self.engine)
@@ -243,10 +247,15 @@ class ModeCounter:
         """Buffers the compiled kernel writes into: D(ω) and |D|(ω) ((n_dof + 1)², a row
         for padding) and dsytrf's workspace for the dense count, and the sparse
         count's own (:func:`linmstmm._stiffness_kernels.ordered_count`)."""
-        kernels = _stiffness_kernels()
-        size, slots = self.n_dof + 1, self._plan[1].shape[1]
-        return (np.empty((size, size)), np.empty((size, size)), np.empty(max(self.n_dof, 1) * kernels.WORK_PER_UNKNOWN),
-                (np.empty(slots), np.empty(2 * slots), np.empty(slots), np.empty(self.n_dof)))
+        size = self.n_dof + 1
+        return (np.empty((size, size)), np.empty((size, size)),
+                np.empty(max(self.n_dof, 1) * _stiffness_kernels().WORK_PER_UNKNOWN), self._sparse_scratch())
+
+    def _sparse_scratch(self) -> tuple:
+        """The sparse kernels' buffers (:func:`linmstmm._stiffness_kernels.ordered_count`):
+        values (slots,), magnitudes (2 · slots,), shifted values (slots,), growth (n_dof,)."""
+        slots = self._plan[1].shape[1]
+        return np.empty(slots), np.empty(2 * slots), np.empty(slots), np.empty(self.n_dof)
 
     def _beam_table(self) -> np.ndarray:
         """The beams as the compiled kernel takes them (:func:`linmstmm._stiffness_kernels.beam_columns`),
@@ -261,6 +270,63 @@ class ModeCounter:
         matrix, magnitude, work, buffers = scratch
         _stiffness_kernels().counts(omegas, self._beam_table(), self._maps, self._columns, self._static, self._mass,
                           SINGULAR_PIVOT, MOST_GROWTH, *self._plan, buffers, matrix, magnitude, work, found)
+
+    def forms(self, vectors, omegas) -> np.ndarray:
+        """xᵀ D(ω) x (N m for x in m and rad) for each row x of ``vectors`` (m, n_dof) at its
+        own ω of ``omegas`` (m,) rad/s, the beams' terms from their ends' displacements (not
+        finite at a clamped–clamped frequency): the numpy reference of
+        :func:`linmstmm._stiffness_kernels._form`."""
+        vectors = np.asarray(vectors, dtype=float).reshape(-1, self.n_dof)
+        omegas = np.asarray(omegas, dtype=float).ravel()
+        static = np.sum((vectors @ self._static.T) * vectors, axis=1)
+        mass = np.sum((vectors @ self._mass.T) * vectors, axis=1)
+        ends = self._ends(vectors)                                                   # (m, n_beams, 12, 1)
+        beams = (np.swapaxes(ends, 2, 3) @ dynamic_stiffnesses(self._beams, omegas) @ ends).sum(axis=(1, 2, 3))
+        return static - omegas ** 2 * mass + beams
+
+    def _ends(self, vectors: np.ndarray) -> np.ndarray:
+        """(m, n_beams, 12, 1): each beam's local end displacements for each row of ``vectors`` (m, n_dof)."""
+        padded = np.concatenate([vectors, np.zeros((vectors.shape[0], 1))], axis=1)  # the padding DOF n_dof
+        return self._maps @ padded[:, self._columns][..., None]
+
+    def differences(self, vectors, omegas, step: float) -> np.ndarray:
+        """(m, n_dof): (D(ω (1 − step)) − D(ω (1 + step))) x, about −2 step ω D′(ω) x, for each
+        row x of ``vectors`` (m, n_dof) at its own ω of ``omegas`` (m,) rad/s, the springs'
+        terms cancelled: the numpy reference of :func:`linmstmm._stiffness_kernels._difference_applied`."""
+        vectors = np.asarray(vectors, dtype=float).reshape(-1, self.n_dof)
+        omegas = np.asarray(omegas, dtype=float).ravel()
+        out = np.zeros((vectors.shape[0], self.n_dof + 1))                           # + the padding DOF
+        out[:, :-1] = (4 * step * omegas ** 2)[:, None] * (vectors @ self._mass.T)
+        below, above = (dynamic_stiffnesses(self._beams, omegas * (1 + sign * step)) for sign in (-1, 1))
+        forces = (np.swapaxes(self._maps, 1, 2) @ (below - above) @ self._ends(vectors))[..., 0]  # (m, n_beams, k)
+        rows = np.broadcast_to(np.arange(vectors.shape[0])[:, None, None], forces.shape)
+        np.add.at(out, (rows, np.broadcast_to(self._columns, forces.shape)), forces)
+        return out[:, :-1]
+
+    def rayleigh_values(self, vectors, starts) -> np.ndarray:
+        """(m,) rad/s, NaN where it does not settle: Rayleigh quotient iteration on D(ω)
+        (:mod:`linmstmm.rayleigh`) from each row of ``vectors`` (m, n_dof), a mode's
+        displacements (m) and rotations (rad) on D's unknowns, and its frequency ``starts``
+        (m,) rad/s; compiled (:func:`linmstmm._stiffness_kernels.rayleigh_roots`, from
+        COUNT_BATCH rows on the cores, each piece in buffers of its own), else by
+        :func:`linmstmm.rayleigh.rayleigh_values_in_numpy`."""
+        from linmstmm import rayleigh
+
+        starts = np.array(starts, dtype=float).ravel()
+        if self.engine != "compiled":
+            return rayleigh.rayleigh_values_in_numpy(self, vectors, starts)
+        vectors = np.array(vectors, dtype=float).reshape(starts.size, self.n_dof)  # the kernel's own copy
+        out = np.empty(starts.size)
+        kernel, table = _stiffness_kernels().rayleigh_roots, self._beam_table()
+
+        def piece(start: int, stop: int) -> None:
+            kernel(vectors[start:stop], starts[start:stop], table, self._maps, self._columns, rayleigh.SOLVE_GROWTH,
+                   *self._plan, self._sparse_scratch(), rayleigh.FIRST_STEP, rayleigh.FORM_STEPS, rayleigh.FORM_XTOL,
+                   rayleigh.FORM_FLOOR, rayleigh.SETTLED, rayleigh.INVERSE_STEPS, rayleigh.DERIVATIVE_STEP,
+                   out[start:stop])
+
+        spread(piece, starts.size, COUNT_BATCH)
+        return out
 
     def matrices(self, omegas) -> tuple[np.ndarray, np.ndarray]:
         """(D(ω), |D|(ω)) at each of the m ``omegas`` (rad/s): the reduced exact dynamic

@@ -135,23 +135,23 @@ def test_a_large_predicting_mesh_is_solved_sparse_and_agrees_with_the_fe_route(m
 def test_at_a_loose_rtol_a_prediction_stands_only_where_counts_hold_a_root_within_rtol(launcher):
     """Each of the FE route's roots moved up by half rtol stands as it is; moved by
     three rtol, it does not (the secant polishes it instead)."""
-    from linmstmm.predicted import _counted_predictions, _in_cluster
+    from linmstmm.predicted import _counted_predictions, clustered
 
     rtol = 1e-4
     _, finder, _ = frequency_finder(launcher, rtol=rtol, xtol=1e-6)
     exact = 2 * np.pi * fe_frequencies(launcher, 8).frequencies_hz
     moved = exact * np.where(np.arange(8) % 2 == 0, 1 + 0.5 * rtol, 1 + 3 * rtol)
-    standing, rest = _counted_predictions(finder, moved, _in_cluster(moved), 0, 8)
+    standing, rest = _counted_predictions(finder, moved, clustered(moved), 0, 8)
     assert standing == list(moved[::2]) and list(rest) == [1, 3, 5, 7]
     assert all(finder.last_step[omega] == rtol for omega in standing)
 
 
 def test_at_the_default_rtol_no_prediction_stands_unpolished(launcher):
-    from linmstmm.predicted import _counted_predictions, _in_cluster
+    from linmstmm.predicted import _counted_predictions, clustered
 
     _, finder, _ = frequency_finder(launcher)
     exact = 2 * np.pi * fe_frequencies(launcher, 4).frequencies_hz
-    standing, rest = _counted_predictions(finder, exact, _in_cluster(exact), 0, 4)
+    standing, rest = _counted_predictions(finder, exact, clustered(exact), 0, 4)
     assert standing == [] and list(rest) == [0, 1, 2, 3]
 
 

@@ -1,0 +1,195 @@
+"""Predictions refined by the Rayleigh functional of the exact dynamic stiffness.
+
+The coarse FE model of :mod:`linmstmm.coarse_prediction` predicts each natural
+frequency high, by 1e-8 to 1e-3 on the bundled launchers' twenty lowest. Its mode
+at the model's points and mass centres — the nodes of the Wittrick–Williams
+counter's exact dynamic stiffness D(ω) (:class:`~linmstmm.wittrick_williams.ModeCounter`)
+— is far closer to the exact one than the frequency suggests, and D(ω) is
+symmetric: the Rayleigh functional p(x), the root ω of xᵀ D(ω) x nearest the
+prediction, is stationary at a mode, so its error is quadratic in the vector's.
+One step of inverse iteration on D at the prediction first, x ← D(ω)⁻¹ W x
+(W the diagonal of the scale of D's terms, so the step does not depend on the
+units), shrinks the vector's error by about the prediction's error over the
+distance to the next natural frequency; where p then lies more than SETTLED from
+where the step was taken, the step is made again at p (Rayleigh quotient
+iteration), at most INVERSE_STEPS times. Each evaluation of the functional sums
+the beams' exact stiffness over their ends' displacements and the springs' and
+bodies' terms of x once formed; the steps factorise D(ω) on the counter's sparse
+plan (:mod:`linmstmm._stiffness_kernels`, :func:`~linmstmm._stiffness_kernels.rayleigh_roots`;
+this module's functions are the numpy reference, which the numpy engine runs).
+
+On the launchers' 20 lowest the coarse predictions are 1e-8 to 5e-4 off the roots
+found, the Rayleigh values of the coarse modes 1e-14 to 8e-6, and after the
+inverse steps 1e-16 to 2e-11 (median 4e-14). A refined value is still only a
+prediction: det Ū_all is evaluated at its ends of a bracket
+(:data:`linmstmm.predicted.BRACKET`), the root is the secant point inside it,
+and the roots are certified by counts as any others
+(:mod:`linmstmm.predicted`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from linmstmm.predicted import NEAR_COUNT, clustered
+
+#: Relative first step of the secant on the Rayleigh functional (its second point).
+FIRST_STEP = -1e-7
+#: Secant steps on the functional before it is given up.
+FORM_STEPS = 30
+#: A secant step on the functional below this (relative) ends it: superlinear, the
+#: root is then known far closer than a refined prediction needs (BRACKET).
+FORM_XTOL = 1e-13
+#: A secant on the functional that rises after a step below this (relative) has met
+#: its rounding, and ends there; after a longer step it straddles a pole of D(ω)
+#: (near a beam's clamped–clamped frequency the functional's terms grow without bound:
+#: a cantilever's root 7e-6 from one was known to 1e-13 only).
+FORM_FLOOR = 1e-10
+#: The factorisation of D(ω) in an inverse step is refused where an entry of
+#: diag(|L| |D| |L|ᵀ) exceeds this many times the largest equilibrated term: its
+#: backward error, about 1e-16 times that, stays far below the relative distance to
+#: a root at which the step is taken (the count's bound of 100 refused 11 of the
+#: launchers' 60 lowest; at 1e4 none).
+SOLVE_GROWTH = 1e6
+#: A Rayleigh value within this (relative) of where its inverse step was taken is
+#: final: the vector then was within about this much over the distance to the next
+#: root of the mode, and its Rayleigh value within the square of that.
+SETTLED = 1e-5
+#: Inverse steps made at most for one prediction.
+INVERSE_STEPS = 3
+#: Relative step of the central difference D′(ω) x of an inverse step: its truncation
+#: error (about its square) and rounding (about 1e-16 over it) both far below what the
+#: step needs.
+DERIVATIVE_STEP = 1e-6
+
+
+def refined_predictions(counter, modes, count: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(predictions (m,) rad/s, ascending; refined (m,) bool): the coarse predictions
+    ``modes`` (:class:`~linmstmm.coarse_prediction.PredictedModes`) with those alone
+    (none other within :data:`linmstmm.predicted.CLUSTER`) replaced by their Rayleigh
+    values where the refinement settles within half the distance to the nearest other
+    prediction (True in ``refined``): of a search for the lowest ``count``, those it
+    polishes (up to NEAR_COUNT above the count-th, :mod:`linmstmm.predicted`; the
+    others only place its last count), else all. As they are, all False, without a
+    ``counter`` (:class:`~linmstmm.wittrick_williams.ModeCounter`) or modes at the nodes."""
+    values = np.asarray(modes.values, dtype=float)
+    refined = np.zeros(values.size, dtype=bool)
+    if counter is None or modes.nodal is None or not values.size:
+        return values, refined
+    polished = values.size if count is None or count > values.size else \
+        int(np.searchsorted(values, values[count - 1] * (1 + NEAR_COUNT), side="right"))
+    tried = np.flatnonzero(~np.array(clustered(values), dtype=bool)[:polished])
+    if not tried.size:
+        return values, refined
+    found = counter.rayleigh_values(modes.nodal[tried][:, counter.masters], values[tried])
+    apart = np.abs(np.diff(values))
+    nearest = np.minimum(np.r_[np.inf, apart], np.r_[apart, np.inf])
+    reach = 0.5 * np.where(np.isfinite(nearest), nearest, values)[tried]
+    with np.errstate(invalid="ignore"):
+        kept = np.abs(found - values[tried]) <= reach  # False where NaN
+    values = values.copy()
+    values[tried[kept]] = found[kept]
+    refined[tried[kept]] = True
+    return values, refined
+
+
+def rayleigh_values_in_numpy(counter, vectors: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """The numpy reference of :func:`linmstmm._stiffness_kernels.rayleigh_roots`: for each
+    row x of ``vectors`` (m, n_dof), from ω₀ = ``starts`` (m,) rad/s, an inverse step at
+    ω_k (:func:`_inverse_steps`) and ω_(k+1) the root of xᵀ D(ω) x nearest ω_k
+    (:func:`_form_roots`), until ω_(k+1) lies within SETTLED of ω_k (then ω_(k+1)), at
+    most INVERSE_STEPS times (NaN where that is not reached or a step fails). All rows
+    step together; D(ω) dense, by :meth:`~linmstmm.wittrick_williams.ModeCounter.matrices`,
+    solved by LU with partial pivoting.
+
+    Parameters
+    ----------
+    counter : ModeCounter
+        The model's counter.
+    vectors : (m, n_dof) float
+        Displacements (m) and rotations (rad) on the counter's unknowns.
+    starts : (m,) float
+        rad/s.
+
+    Returns
+    -------
+    numpy.ndarray, shape (m,), rad/s
+    """
+    vectors = np.array(vectors, dtype=float)
+    omegas = np.array(starts, dtype=float)
+    out = np.full(omegas.size, np.nan)
+    active = np.arange(omegas.size)
+    for _ in range(INVERSE_STEPS):
+        if not active.size:
+            break
+        stepped = _inverse_steps(counter, vectors, omegas, active)
+        active = active[stepped]
+        new = _form_roots(counter, vectors[active], omegas[active])
+        with np.errstate(invalid="ignore"):
+            settled = np.abs(new - omegas[active]) <= SETTLED * new
+        out[active[settled]] = new[settled]
+        going = np.isfinite(new) & ~settled
+        omegas[active] = new
+        active = active[going]
+    return out
+
+
+def _inverse_steps(counter, vectors: np.ndarray, omegas: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """(len(active),) bool: rows ``active`` of ``vectors`` (m, n) each replaced by
+    D(ω)⁻¹ D′(ω) x at its ``omegas`` (D′(ω) x by the differences of
+    :meth:`~linmstmm.wittrick_williams.ModeCounter.differences`, DERIVATIVE_STEP), the
+    solve on D equilibrated by the diagonal of |D|(ω) (as the count equilibrates it),
+    scaled to a largest entry of 1; False, the row left, where D(ω) is not finite, a
+    DOF has no term, or the solve fails."""
+    ok = np.zeros(active.size, dtype=bool)
+    if not active.size:
+        return ok
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # a clamped pole: the step fails
+        matrices, magnitudes = counter.matrices(omegas[active])
+        sides = counter.differences(vectors[active], omegas[active], DERIVATIVE_STEP)
+    for k, i in enumerate(active):
+        matrix, scale = matrices[k], magnitudes[k].diagonal()
+        if not (np.all(scale > 0) and np.all(np.isfinite(matrix)) and np.all(np.isfinite(sides[k]))):
+            continue
+        weights = 1.0 / np.sqrt(scale)
+        try:
+            z = np.linalg.solve(matrix * weights[:, None] * weights[None, :], weights * sides[k])
+        except np.linalg.LinAlgError:
+            continue
+        y = weights * z
+        size = np.max(np.abs(y))
+        if size > 0 and np.isfinite(size):
+            vectors[i], ok[k] = y / size, True
+    return ok
+
+
+def _form_roots(counter, vectors: np.ndarray, starts: np.ndarray) -> np.ndarray:
+    """(m,) rad/s: for each row x of ``vectors`` (m, n) the root of xᵀ D(ω) x
+    (:meth:`~linmstmm.wittrick_williams.ModeCounter.forms`) nearest ``starts`` (m,) by the
+    secant method from ω₀ and ω₀ (1 + FIRST_STEP), to a step below FORM_XTOL (or a value
+    exactly 0, or one that no longer changes, or a rise after a step below FORM_FLOOR);
+    NaN where FORM_STEPS steps do not reach it, a value is not finite or the secant rises
+    after a longer step (it straddles a beam's clamped–clamped frequency):
+    :func:`linmstmm._stiffness_kernels._form_root`."""
+    roots = np.full(starts.size, np.nan)
+    old, omega = starts.copy(), starts * (1 + FIRST_STEP)
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+        f_old, f = counter.forms(vectors, old), counter.forms(vectors, omega)
+        active = np.arange(starts.size)
+        for _ in range(FORM_STEPS):
+            finite = np.isfinite(f_old) & np.isfinite(f)
+            rising = (f - f_old) * (omega - old) > 0
+            # a root, the functional's rounding floor; a rise after a longer step straddles a pole
+            ended = finite & ((f == 0.0) | (f == f_old) | (rising & (np.abs(omega - old) <= FORM_FLOOR * omega)))
+            finite &= ~rising
+            roots[active[ended]] = omega[ended]
+            new = omega - f * (omega - old) / (f - f_old)
+            moving = finite & ~ended & (new > 0) & np.isfinite(new)
+            done = moving & (np.abs(new - omega) <= FORM_XTOL * new)
+            roots[active[done]] = new[done]
+            going = moving & ~done
+            if not going.any():
+                break
+            active, vectors = active[going], vectors[going]
+            old, f_old, omega = omega[going], f[going], new[going]
+            f = counter.forms(vectors, omega)
+    return roots

@@ -1,0 +1,155 @@
+"""Predictions refined by the Rayleigh functional of the exact dynamic stiffness
+(:mod:`linmstmm.rayleigh`), and the secant's bracket about them.
+
+References, none of them the transfer matrices:
+
+* the closed-form bending frequencies of a cantilever (tests/test_closed_forms.py's
+  frequency equation in mpmath), for the refined values themselves;
+* the FE route (``fe_frequencies``) for the launchers' refined values;
+* the numpy reference of each kernel (:meth:`~linmstmm.wittrick_williams.ModeCounter.forms`,
+  :func:`~linmstmm.rayleigh.rayleigh_values_in_numpy` and its inverse step, LU with
+  partial pivoting on the dense D(ω)).
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from builders import fixed, single_beam_model
+from test_closed_forms import beam_lambdas, bending_frequencies_hz
+
+from linmstmm import _stiffness_kernels as kernels
+from linmstmm import rayleigh
+from linmstmm.coarse_prediction import predicted_modes
+from linmstmm.fe import fe_frequencies
+from linmstmm.model import load_model
+from linmstmm.rayleigh import refined_predictions
+from linmstmm.roots.settings import predictions_wanted
+from linmstmm.solve import natural_frequencies
+from linmstmm.wittrick_williams import ModeCounter
+
+LAUNCHERS = ("models/mlrs/mlrs.toml", "models/launcher2/launcher2.toml")
+
+
+def launcher_modes(path: str, count: int):
+    """(model, its PredictedModes for the ``count`` lowest as a search asks for them)."""
+    model = load_model(path)
+    return model, predicted_modes(model, predictions_wanted(count))
+
+
+@pytest.mark.parametrize("path", LAUNCHERS)
+def test_compiled_form_sums_the_terms_of_the_numpy_reference(path):
+    """xᵀ D(ω) x of random vectors, from below the beams' series range to above their
+    first clamped–clamped frequencies, to 1e-13 of the sum of the terms' magnitudes."""
+    model = load_model(path)
+    counter = ModeCounter(model, "compiled")
+    rng = np.random.default_rng(7)
+    vectors = rng.standard_normal((6, counter.n_dof))
+    omegas = np.geomspace(1e-2, 2e4, 6)
+    reference = counter.forms(vectors, omegas)
+    plan, terms = counter._plan
+    ends, combos = np.empty((counter._maps.shape[0], 12)), np.empty(7)
+    for x, omega, expected in zip(vectors, omegas, reference):
+        static, mass = kernels._form_parts(x, counter._maps, counter._columns, plan[3], plan[4], terms, ends)
+        value = kernels._form(omega, counter._beam_table(), ends, static, mass, combos)
+        magnitude = np.abs(x) @ counter.matrices([omega])[1][0] @ np.abs(x)
+        assert abs(value - expected) <= 1e-13 * magnitude
+
+
+@pytest.mark.parametrize("path", LAUNCHERS)
+def test_compiled_differences_mirror_the_numpy_reference(path):
+    """(D(ω(1 − h)) − D(ω(1 + h))) x of random vectors, to 1e-13 of the terms' sizes."""
+    model = load_model(path)
+    counter = ModeCounter(model, "compiled")
+    rng = np.random.default_rng(8)
+    vectors = rng.standard_normal((4, counter.n_dof))
+    omegas = np.geomspace(1.0, 2e4, 4)
+    reference = counter.differences(vectors, omegas, 1e-6)
+    plan, terms = counter._plan
+    for x, omega, expected in zip(vectors, omegas, reference):
+        out = np.empty(counter.n_dof)
+        kernels._difference_applied(omega, 1e-6, x, counter._beam_table(), counter._maps, counter._columns, plan[3],
+                                    plan[4], terms, np.empty(7), out)
+        sizes = counter.matrices([omega])[1][0] @ np.abs(x)
+        assert np.all(np.abs(out - expected) <= 1e-13 * sizes)
+
+
+@pytest.mark.parametrize("path", LAUNCHERS)
+def test_compiled_inverse_step_mirrors_a_dense_solve(path):
+    """One inverse step between two roots by the sparse LDLᵀ without pivoting: D(ω) y
+    along D′(ω) x to a backward error of 1e-11 of D's terms, and the vector of numpy's
+    LU of the dense D(ω) to 1e-8 (its largest entry 1; D(ω) is only as far from singular
+    as the roots beside it)."""
+    model, modes = launcher_modes(path, 10)
+    counter = ModeCounter(model, "compiled")
+    omega = float(np.sqrt(modes.values[3] * modes.values[4]))
+    x = np.ascontiguousarray(modes.nodal[3, counter.masters])
+    side = counter.differences(x[None], [omega], rayleigh.DERIVATIVE_STEP)[0]
+    expected = x[None].copy()
+    assert rayleigh._inverse_steps(counter, expected, np.array([omega]), np.array([0]))[0]
+    plan, terms = counter._plan
+    assert kernels._inverse_step(omega, x, rayleigh.DERIVATIVE_STEP, counter._beam_table(), counter._maps,
+                                 counter._columns, rayleigh.SOLVE_GROWTH, plan, terms, counter._sparse_scratch(),
+                                 np.empty(counter.n_dof), np.empty(counter.n_dof))
+    matrix, magnitude = (part[0] for part in counter.matrices([omega]))
+    applied = matrix @ x
+    residual = applied - (applied @ side) / (side @ side) * side
+    assert np.max(np.abs(residual)) <= 1e-11 * np.max(magnitude @ np.abs(x))
+    np.testing.assert_allclose(x, expected[0], rtol=0, atol=1e-8)
+
+
+@pytest.mark.parametrize("path", LAUNCHERS)
+def test_compiled_rayleigh_values_mirror_the_numpy_reference(path):
+    model, modes = launcher_modes(path, 20)
+    vectors = modes.nodal[:, ModeCounter(model, "numpy").masters]
+    compiled = ModeCounter(model, "compiled").rayleigh_values(vectors, modes.values)
+    reference = ModeCounter(model, "numpy").rayleigh_values(vectors, modes.values)
+    assert np.array_equal(np.isnan(compiled), np.isnan(reference))
+    assert np.sum(np.isfinite(compiled)) >= 0.9 * compiled.size
+    np.testing.assert_allclose(compiled, reference, rtol=1e-12)
+
+
+def cantilever_frequencies(case: str, length: float, Iz: float, Iy: float, beam) -> np.ndarray:
+    """rad/s: the bending frequencies of both planes from ``case``'s frequency equation, ascending."""
+    lambdas = beam_lambdas(case)
+    return 2 * np.pi * np.sort(np.r_[bending_frequencies_hz(lambdas, beam.E * Iz, beam.rho * beam.A, length),
+                                     bending_frequencies_hz(lambdas, beam.E * Iy, beam.rho * beam.A, length)])
+
+
+@pytest.mark.parametrize("engine", ["numpy", "compiled"])
+def test_refined_predictions_of_a_cantilever_meet_the_closed_form(engine):
+    """Bending in two planes (Iy = 3.5 Iz), eight lowest: the coarse model's are up to
+    1e-4 off, the six lowest refined within 1e-13 of the frequency equation's roots. The
+    seventh and eighth lie within 2e-5 of the beam's clamped–clamped frequencies, poles
+    of D(ω) whose terms swamp the functional there; whatever their refinement gives,
+    the solve polishes them on det Ū_all to the closed form."""
+    length, Iz, Iy = 2.0, 2e-7, 7e-7
+    model = single_beam_model(fixed(), None, length=length, Iz=Iz, Iy=Iy, axial=False, torsion=False)
+    exact = cantilever_frequencies("cantilever", length, Iz, Iy, model.beams[0])[:8]
+    modes = predicted_modes(model, 8)
+    values, refined = refined_predictions(ModeCounter(model, engine), modes)
+    assert np.max(np.abs(modes.values[:6] / exact[:6] - 1)) > 1e-5
+    assert refined[:6].all()
+    np.testing.assert_allclose(values[:6], exact[:6], rtol=1e-13)
+    result = natural_frequencies(model, 8, engine=engine)
+    np.testing.assert_allclose(2 * np.pi * result.frequencies_hz, exact, rtol=1e-12)
+
+
+@pytest.mark.parametrize("path", LAUNCHERS)
+def test_refined_launcher_predictions_agree_with_the_fe_route(path):
+    """The twenty lowest, refined where alone, against the FE route's refinement: within
+    three times its own error estimate (or 1e-10), where the coarse predictions are up
+    to 5e-4 off."""
+    model, modes = launcher_modes(path, 20)
+    values, refined = refined_predictions(ModeCounter(model, "compiled"), modes)
+    fe = fe_frequencies(model, count=20)
+    reference = 2 * np.pi * fe.frequencies_hz
+    assert refined[:20].sum() >= 18
+    error = np.abs(values[:20] / reference - 1)[refined[:20]]
+    assert np.all(error <= np.maximum(1e-10, 3 * fe.error_estimate[refined[:20]]))
+
+
+def test_no_refinement_without_modes_at_the_nodes_or_a_counter():
+    model, modes = launcher_modes(LAUNCHERS[0], 10)
+    for counter, given in ((None, modes), (ModeCounter(model, "compiled"), type(modes)(modes.values, None))):
+        values, refined = refined_predictions(counter, given)
+        assert not refined.any() and np.array_equal(values, modes.values)

@@ -14,6 +14,7 @@ from contextlib import contextmanager
 
 import linmstmm.determinant as determinant_module
 from linmstmm import compiled_model, predicted, roots, solve
+from linmstmm.roots import finder
 
 #: (module or class, attribute, stage name), in pipeline order.
 STAGES = (
@@ -24,7 +25,8 @@ STAGES = (
     (compiled_model, "rigid_body_mode_count", "rigid-body count"),
     (compiled_model, "count_in_disc", "rigid-body zeros (disc count)"),
     (compiled_model, "mode_counter", "Wittrick–Williams counter (build)"),
-    (solve, "predict_frequencies", "predict (coarse FE)"),
+    (solve, "predicted_modes", "predict (coarse FE)"),
+    (finder, "refined_predictions", "refine (Rayleigh functional)"),
     (predicted, "secant_roots", "polish (secant)"),
     (roots.RootFinder, "polish", "polish (pencil)"),
     (roots.RootFinder, "segment", "segment search"),

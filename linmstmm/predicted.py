@@ -7,17 +7,19 @@ roots are predicted first and each evaluation goes where a root is:
 1. **predict** — the natural frequencies of a coarse finite-element model of
    the same file (:mod:`linmstmm.coarse_prediction`): a dense eigenproblem of
    a few hundred unknowns, accurate to about 1e-3 for the lowest and 1e-2 by
-   the hundredth;
+   the hundredth (those the caller refined by the Rayleigh functional of the exact
+   dynamic stiffness to about 1e-13, :mod:`linmstmm.rayleigh`, with a bracket);
 2. **polish** — where the requested accuracy is loose (``rtol`` from
    COUNTED_PREDICTION up), a prediction with no other within CLUSTER that counts
    at ±rtol across it certify stands as it is (:func:`_counted_predictions`);
    every other prediction by the secant method on det Ū_all
    (:func:`secant_roots`: one evaluation per step, superlinear, all roots in
-   one batch per step); a result that strays, shares its root with another,
-   or (in a cluster) only creeps to the rounding floor goes to Newton on the
-   matrix pencil (:meth:`RootFinder.polish`), and where that too lands on a
-   known root, to the pencil's partner offset and then to the segment search
-   of :class:`RootFinder` between the neighbouring predictions;
+   one batch per step; from a bracket's ends where it has one: a sign change
+   there gives the root in two evaluations); a result that strays, shares its
+   root with another, or (in a cluster) only creeps to the rounding floor goes
+   to Newton on the matrix pencil (:meth:`RootFinder.polish`), and where that too
+   lands on a known root, to the pencil's partner offset and then to the segment
+   search of :class:`RootFinder` between the neighbouring predictions;
 3. **certify** — one argument-principle count of det Ū_all with the polished
    roots divided out, from the search's floor to a gap above the last root
    wanted, must come to zero (:meth:`RootFinder.confirm_no_other_zeros`).
@@ -62,9 +64,9 @@ COINCIDENT = 1e-10
 #: From this rtol up, each prediction with no other within CLUSTER is first tried as
 #: it stands: where the Wittrick–Williams counts at ±rtol across it find one natural
 #: frequency, it is certified to rtol without an evaluation of det
-#: (:func:`_counted_predictions`). The coarse model predicts the
-#: launchers' ten lowest to within 2e-6, so from about that rtol most stand; below
-#: it the counts would be spent in vain.
+#: (:func:`_counted_predictions`). The coarse model predicts the launchers' ten
+#: lowest to within 2e-6, so from about that rtol most stand; below it the counts
+#: would be spent in vain (refined ones stand from it too).
 COUNTED_PREDICTION = 1e-6
 
 
@@ -85,7 +87,7 @@ def clustered(predictions: np.ndarray) -> list[bool]:
     return [len(group) > 1 for group in _clusters(predictions) for _ in group]
 
 
-def predicted_roots(finder, predictions: np.ndarray, count: int):
+def predicted_roots(finder, predictions: np.ndarray, count: int, spans: np.ndarray | None = None):
     """The lowest ``count`` or more roots (rad/s, repeated per multiplicity) from
     ``predictions``, certified: every root up to the end of the certifying count
     (a gap above the count-th, so a multiple root there comes whole).
@@ -93,17 +95,22 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
     finder : the :class:`~linmstmm.roots.RootFinder` of the model (its
     determinant, pencil, counts and segment search). predictions : (m,) rad/s,
     a few more than ``count`` (those above place the count's upper end in a
-    gap). Returns the roots, or None where a count cannot be made or does not
-    come to zero (the caller then searches). Records each secant root's last
-    step in ``finder.last_step``. Where a prediction stood unpolished
-    (:func:`_counted_predictions`), the roots must pass the Wittrick–Williams
-    counts alone, else they are found again with every prediction polished.
+    gap). spans : (m,) relative half-widths of brackets that hold refined ones'
+    roots (:func:`linmstmm.rayleigh.refined_predictions`), 0 (None: all) where none.
+    Returns the roots, or None where a count cannot be made or does not come to zero
+    (the caller then searches). Records each secant root's last step in
+    ``finder.last_step``. Where a prediction stood unpolished (:func:`_counted_predictions`),
+    the roots must pass the Wittrick–Williams counts alone, else they are found
+    again with every prediction polished.
     """
-    predictions = np.sort(np.asarray(predictions, dtype=float))
-    predictions = predictions[predictions > 0]
+    predictions = np.asarray(predictions, dtype=float)
+    spans = np.zeros(predictions.size) if spans is None else np.asarray(spans, dtype=float)
+    order = np.argsort(predictions, kind="stable")
+    order = order[predictions[order] > 0]
+    predictions, spans = predictions[order], spans[order]
     if predictions.size < count:
         return None
-    roots, upper = _certified(finder, predictions, count, stand=True)
+    roots, upper = _certified(finder, predictions, count, stand=True, spans=spans)
     # A value that stood (:func:`_counted_predictions`, which records its last step
     # under the prediction's own value) is no zero of det: the argument principle's
     # count, with it divided out, takes it for any root missing. Where one stood, the
@@ -112,20 +119,21 @@ def predicted_roots(finder, predictions: np.ndarray, count: int):
     # to the caller's search, which takes no prediction as it stands.)
     stood = not finder.last_step.keys().isdisjoint(predictions.tolist())
     if stood and roots is not None and finder.stiffness_other_zeros(roots, None, upper) != 0:
-        roots, _ = _certified(finder, predictions, count, stand=False)
+        roots, _ = _certified(finder, predictions, count, stand=False, spans=spans)
     return roots
 
 
-def _certified(finder, predictions: np.ndarray, count: int, stand: bool) -> tuple[list[float] | None, float]:
+def _certified(finder, predictions: np.ndarray, count: int, stand: bool,
+               spans: np.ndarray) -> tuple[list[float] | None, float]:
     """(the roots :func:`predicted_roots` returns, rad/s, or None; the upper end of
-    their certifying count, rad/s): from ``predictions`` (ascending, positive),
-    with those that counts certify as they stand taken so if ``stand``."""
+    their certifying count, rad/s): from ``predictions`` (ascending, positive; with
+    their brackets' ``spans``), with those that counts certify as they stand taken so if ``stand``."""
     wanted = int(np.searchsorted(predictions, predictions[count - 1] * (1 + NEAR_COUNT), side="right"))
-    roots = _polished(finder, predictions, [], 0, wanted, stand, count)
+    roots = _polished(finder, predictions, [], 0, wanted, stand, count, spans)
     if roots is not None and len(roots) < count < predictions.size:  # some predicted twice: as many more
         more = min(wanted + count - len(roots), predictions.size)
         more = int(np.searchsorted(predictions, predictions[more - 1] * (1 + NEAR_COUNT), side="right"))
-        roots = _polished(finder, predictions, roots, wanted, more, stand, more)
+        roots = _polished(finder, predictions, roots, wanted, more, stand, more, spans)
         wanted = more
     if roots is None:
         return None, np.nan
@@ -156,18 +164,20 @@ def _certified(finder, predictions: np.ndarray, count: int, stand: bool) -> tupl
 
 
 def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, stop: int, stand: bool,
-              wanted: int):
+              wanted: int, spans: np.ndarray):
     """``roots`` (rad/s) and the roots of ``predictions[start:stop]``, ascending: as they
-    stand where counts certify them to a loose rtol (if ``stand``), else by the secant, then the
-    pencil, then the segment search around those both left troubled. None where a
-    count of that search cannot be made (the full search decides)."""
+    stand where counts certify them to a loose rtol (if ``stand``), else by the secant (from
+    their brackets' ends where ``spans`` has one), then the pencil, then the segment search
+    around those both left troubled. None where a count of that search cannot be made (the
+    full search decides)."""
     in_cluster = clustered(predictions)  # the same for the counts and the secant
     standing, indices = (_counted_predictions(finder, predictions, in_cluster, start, stop) if stand
                          else ([], np.arange(start, stop)))
     leaders, followers = _coincident(predictions, indices)
     coincident = {*leaders.tolist(), *followers.tolist()}
     alone = np.array([i for i in indices.tolist() if i not in coincident], dtype=np.int64)
-    found, unsettled = _secant_polished(finder, predictions, in_cluster, alone, list(roots) + standing, wanted)
+    found, unsettled = _secant_polished(finder, predictions, in_cluster, alone, list(roots) + standing, wanted,
+                                        spans)
     found, troubled = _pencil_polished(finder, list(roots) + standing + found,
                                        unsettled + [float(p) for p in predictions[leaders]])
     found, troubled = _deflated_polished(finder, found, troubled, predictions)
@@ -242,11 +252,11 @@ def _counted_predictions(finder, predictions: np.ndarray, in_cluster: list[bool]
 
 
 def _secant_polished(finder, predictions: np.ndarray, in_cluster: list[bool], indices: np.ndarray,
-                     known: list[float], wanted: int) -> tuple[list[float], list[float]]:
+                     known: list[float], wanted: int, spans: np.ndarray) -> tuple[list[float], list[float]]:
     """(roots, unsettled predictions): ``predictions[indices]`` by the secant on det
     (the others are their neighbours only; ``in_cluster``: :func:`clustered` of
-    ``predictions``); one that lands on a ``known`` root (rad/s) is unsettled.
-
+    ``predictions``); one that lands on a ``known`` root (rad/s) is unsettled, and
+    one alone with a bracket in ``spans`` starts from its ends, polished in full.
     Cluster members too: the launcher's pairs 1e-4 apart at 5.7-21 krad/s are
     predicted to 2e-5, where Newton on the pencil does not converge. A result
     stands where it stayed within half the gap to the neighbouring prediction,
@@ -265,9 +275,10 @@ def _secant_polished(finder, predictions: np.ndarray, in_cluster: list[bool], in
     """
     if not indices.size:  # every prediction stood, or went to the pencil
         return [], []
-    placing = np.array([i >= wanted and not in_cluster[i] for i in indices.tolist()])
+    spans = np.where(np.array(in_cluster, dtype=bool)[indices], 0.0, spans[indices])
+    placing = np.array([i >= wanted and not in_cluster[i] for i in indices.tolist()]) & (spans == 0)
     found, steps = secant_roots(finder.log_det, predictions[indices],
-                                np.where(placing, PLACING, finder.xtol), finder.UNCERTAIN)
+                                np.where(placing, PLACING, finder.xtol), finder.UNCERTAIN, spans)
     settled = _settled(finder, predictions, in_cluster, indices, found, steps, placing, known)
     if placing.any():
         full = ~placing

@@ -21,8 +21,8 @@ this module's functions are the numpy reference, which the numpy engine runs).
 On the launchers' 20 lowest the coarse predictions are 1e-8 to 5e-4 off the roots
 found, the Rayleigh values of the coarse modes 1e-14 to 8e-6, and after the
 inverse steps 1e-16 to 2e-11 (median 4e-14). A refined value is still only a
-prediction: det Ū_all is evaluated at its ends of a bracket
-(:data:`linmstmm.predicted.BRACKET`), the root is the secant point inside it,
+prediction: det Ū_all is evaluated at the ends of a bracket (BRACKET)
+about it, the root is the secant point inside it,
 and the roots are certified by counts as any others
 (:mod:`linmstmm.predicted`).
 """
@@ -32,6 +32,13 @@ import numpy as np
 
 from linmstmm.predicted import NEAR_COUNT, clustered
 
+#: Relative half-width of the bracket about a refined prediction (:func:`refined_predictions`):
+#: det Ū_all is evaluated at its ends, in the secant's first batch, and where det changes
+#: sign there the secant point between them is the root, two evaluations in all
+#: (:func:`~linmstmm.secant.secant_roots`). A tenth of the default rtol, a thousand times
+#: the launchers' roots' rounding floor; given where the rtol is at least ten times it
+#: (below, a refined prediction only starts the secant).
+BRACKET = 1e-10
 #: Relative first step of the secant on the Rayleigh functional (its second point).
 FIRST_STEP = -1e-7
 #: Secant steps on the functional before it is given up.
@@ -62,34 +69,37 @@ INVERSE_STEPS = 3
 DERIVATIVE_STEP = 1e-6
 
 
-def refined_predictions(counter, modes, count: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """(predictions (m,) rad/s, ascending; refined (m,) bool): the coarse predictions
-    ``modes`` (:class:`~linmstmm.coarse_prediction.PredictedModes`) with those alone
-    (none other within :data:`linmstmm.predicted.CLUSTER`) replaced by their Rayleigh
-    values where the refinement settles within half the distance to the nearest other
-    prediction (True in ``refined``): of a search for the lowest ``count``, those it
-    polishes (up to NEAR_COUNT above the count-th, :mod:`linmstmm.predicted`; the
-    others only place its last count), else all. As they are, all False, without a
-    ``counter`` (:class:`~linmstmm.wittrick_williams.ModeCounter`) or modes at the nodes."""
+def refined_predictions(counter, modes, count: int, rtol: float) -> tuple[np.ndarray, np.ndarray]:
+    """(predictions (m,) rad/s, ascending; spans (m,)): the coarse predictions ``modes``
+    (:class:`~linmstmm.coarse_prediction.PredictedModes`) of a search for the lowest
+    ``count`` to ``rtol``, with those it polishes (up to NEAR_COUNT above the count-th,
+    :mod:`linmstmm.predicted`; the others only place its last count) that are alone
+    (none other within CLUSTER) replaced by their Rayleigh values where the refinement
+    settles within half the distance to the nearest other prediction; BRACKET in
+    ``spans`` for each of those where ``rtol`` is at least ten times it, else 0. As they
+    are, spans 0, without a ``counter`` (:class:`~linmstmm.wittrick_williams.ModeCounter`)
+    or modes at the nodes."""
     values = np.asarray(modes.values, dtype=float)
-    refined = np.zeros(values.size, dtype=bool)
+    spans = np.zeros(values.size)
     if counter is None or modes.nodal is None or not values.size:
-        return values, refined
-    polished = values.size if count is None or count > values.size else \
-        int(np.searchsorted(values, values[count - 1] * (1 + NEAR_COUNT), side="right"))
+        return values, spans
+    polished = values.size
+    if count <= values.size:
+        polished = int(np.searchsorted(values, values[count - 1] * (1 + NEAR_COUNT), side="right"))
     tried = np.flatnonzero(~np.array(clustered(values), dtype=bool)[:polished])
     if not tried.size:
-        return values, refined
+        return values, spans
     found = counter.rayleigh_values(modes.nodal[tried][:, counter.masters], values[tried])
     apart = np.abs(np.diff(values))
     nearest = np.minimum(np.r_[np.inf, apart], np.r_[apart, np.inf])
     reach = 0.5 * np.where(np.isfinite(nearest), nearest, values)[tried]
     with np.errstate(invalid="ignore"):
-        kept = np.abs(found - values[tried]) <= reach  # False where NaN
+        settled = np.abs(found - values[tried]) <= reach  # False where NaN
     values = values.copy()
-    values[tried[kept]] = found[kept]
-    refined[tried[kept]] = True
-    return values, refined
+    values[tried[settled]] = found[settled]
+    if rtol >= 10 * BRACKET:
+        spans[tried[settled]] = BRACKET
+    return values, spans
 
 
 def rayleigh_values_in_numpy(counter, vectors: np.ndarray, starts: np.ndarray) -> np.ndarray:

@@ -20,23 +20,33 @@ FIRST_STEP = -1e-7
 SECANT_STEPS = 12
 
 
-def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: float):
+def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: float, spans: np.ndarray | None = None):
     """Simple real roots of det near ``starts`` (rad/s) by the secant method on det.
 
     log_det : callable ω (n,) -> (sign (n,), log|det| (n,)). xtol : relative
     step that ends the iteration, one for all or (n,) one per start. floor : a
     step below this (relative) that no longer shrinks has reached the rounding
     floor of det, and is accepted with that step as its uncertainty.
+    spans : (n,) relative half-widths, 0 where none (the default): where a start
+    is known to lie that close to its root (a prediction refined by
+    :mod:`linmstmm.rayleigh`), the first two points are start (1 ± span), and
+    where det changes sign between them the secant point between them is the
+    root, with no further evaluation and the bracket's width (relative) as its
+    last step (the secant's error there is of the order of the width squared
+    over the distance to the next root); elsewhere the secant goes on from them.
     Each step evaluates det once per root still moving, all in one call;
     det's ratio at two points is formed from the log magnitudes, so no value
     overflows. Returns (roots, last relative steps); a root that did not
     settle within SECANT_STEPS is NaN.
     """
-    x_old = np.asarray(starts, dtype=float)
-    if not x_old.size:
+    starts = np.asarray(starts, dtype=float)
+    if not starts.size:
         return np.zeros(0), np.zeros(0)
-    tolerance = np.broadcast_to(np.asarray(xtol, dtype=float), x_old.shape).copy()
-    x = x_old * (1 + FIRST_STEP)
+    tolerance = np.broadcast_to(np.asarray(xtol, dtype=float), starts.shape).copy()
+    spans = np.zeros(starts.size) if spans is None else np.asarray(spans, dtype=float)
+    bracketing = spans > 0
+    x_old = np.where(bracketing, starts * (1 + spans), starts)
+    x = np.where(bracketing, starts * (1 - spans), x_old * (1 + FIRST_STEP))
     # both starting points in one batch (each frequency is evaluated on its own: the same numbers)
     signs, logs = log_det(np.concatenate([x_old, x]))
     (sign_old, sign), (log_old, log_abs) = np.split(signs, 2), np.split(logs, 2)
@@ -45,6 +55,7 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: f
     active = np.arange(x.size)
     previous = before = np.full(x.size, np.inf)
     oldest = np.full(x.size, np.nan)  # the point evaluated before x_old (none yet)
+    bracketed = bracketing & ((sign * sign_old).real < 0)  # a bracket's ends: ended by the first step
     for _ in range(SECANT_STEPS):
         with np.errstate(divide="ignore", invalid="ignore"):  # sign 0: det exactly 0, x is a root
             ratio = (sign_old / sign).real * np.exp(np.clip(log_old - log_abs, -700, 700))  # det(x_old)/det(x)
@@ -72,13 +83,15 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: f
         measured = converging & np.isfinite(previous) & np.isfinite(reach) & (reach > 0)  # none before two steps
         ahead = np.where(measured, size * size / np.where(measured, reach, 1.0), np.inf)
         done = (((size <= tolerance) & converging) | (ahead <= tolerance / 10)
-                | ((size >= previous / 2) & (size <= floor)) | (sign == 0))
+                | ((size >= previous / 2) & (size <= floor)) | (sign == 0) | bracketed)
         roots[active[done]] = np.where(sign[done] == 0, x[done], new[done])
-        steps[active[done]] = np.minimum(size[done], ahead[done])
+        steps[active[done]] = np.where(bracketed[done], np.abs(x_old - x)[done] / np.abs(new[done]),
+                                       np.minimum(size[done], ahead[done]))
         keep = ~done
         if not keep.any():
             break
         active, previous, before, oldest = active[keep], size[keep], previous[keep], x_old[keep]
+        bracketed = np.zeros(active.size, dtype=bool)
         tolerance = tolerance[keep]
         x_old, sign_old, log_old = x[keep], sign[keep], log_abs[keep]
         x = new[keep]

@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from linmstmm.coarse_prediction import predict_frequencies
+from linmstmm.coarse_prediction import predicted_modes
 from linmstmm.compiled_model import compiled_system
 from linmstmm.deduction import Deduction
 from linmstmm.mode_bound import check_range_request
@@ -132,7 +132,7 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     evaluator = system.determinant
     finder = RootFinder(evaluator.log_det, lambda omega: evaluator.matrix(omega)[0],
                         rigid_body_modes=system.rigid_body_modes,
-                        predictor=lambda n: predict_frequencies(model, n), scale=system.scale, **options)
+                        predictor=lambda n: predicted_modes(model, n), scale=system.scale, **options)
     finder.determinant = evaluator
     finder._evaluations_reported = evaluator.evaluations  # this finder's search counts from here
     if system.counter is not None:
@@ -333,9 +333,9 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         :mod:`linmstmm.determinant`). The roots agree to rounding either way.
     rtol : float or None
         Relative accuracy every frequency is certified to, MIN_RTOL to MAX_RTOL
-        (1e-12 to 1e-4; None: 1e-9). From 1e-6 up, a lone coarse prediction that
-        the count across it certifies is listed unpolished, within rtol of its
-        root (:func:`~linmstmm.predicted.predicted_roots`).
+        (1e-12 to 1e-4; None: 1e-9). From 1e-6 up, a lone prediction (its Rayleigh
+        refinement where it has one) that the count across it certifies is listed
+        unpolished, within rtol of its root (:func:`~linmstmm.predicted.predicted_roots`).
 
     Returns
     -------

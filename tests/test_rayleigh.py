@@ -8,7 +8,8 @@ References, none of them the transfer matrices:
 * the FE route (``fe_frequencies``) for the launchers' refined values;
 * the numpy reference of each kernel (:meth:`~linmstmm.wittrick_williams.ModeCounter.forms`,
   :func:`~linmstmm.rayleigh.rayleigh_values_in_numpy` and its inverse step, LU with
-  partial pivoting on the dense D(ω)).
+  partial pivoting on the dense D(ω));
+* a polynomial with known roots for the secant's bracket.
 """
 from __future__ import annotations
 
@@ -24,6 +25,7 @@ from linmstmm.fe import fe_frequencies
 from linmstmm.model import load_model
 from linmstmm.rayleigh import refined_predictions
 from linmstmm.roots.settings import predictions_wanted
+from linmstmm.secant import secant_roots
 from linmstmm.solve import natural_frequencies
 from linmstmm.wittrick_williams import ModeCounter
 
@@ -126,7 +128,8 @@ def test_refined_predictions_of_a_cantilever_meet_the_closed_form(engine):
     model = single_beam_model(fixed(), None, length=length, Iz=Iz, Iy=Iy, axial=False, torsion=False)
     exact = cantilever_frequencies("cantilever", length, Iz, Iy, model.beams[0])[:8]
     modes = predicted_modes(model, 8)
-    values, refined = refined_predictions(ModeCounter(model, engine), modes)
+    values, spans = refined_predictions(ModeCounter(model, engine), modes, 8, 1e-9)
+    refined = spans > 0
     assert np.max(np.abs(modes.values[:6] / exact[:6] - 1)) > 1e-5
     assert refined[:6].all()
     np.testing.assert_allclose(values[:6], exact[:6], rtol=1e-13)
@@ -140,7 +143,8 @@ def test_refined_launcher_predictions_agree_with_the_fe_route(path):
     three times its own error estimate (or 1e-10), where the coarse predictions are up
     to 5e-4 off."""
     model, modes = launcher_modes(path, 20)
-    values, refined = refined_predictions(ModeCounter(model, "compiled"), modes)
+    values, spans = refined_predictions(ModeCounter(model, "compiled"), modes, 20, 1e-9)
+    refined = spans > 0
     fe = fe_frequencies(model, count=20)
     reference = 2 * np.pi * fe.frequencies_hz
     assert refined[:20].sum() >= 18
@@ -151,5 +155,59 @@ def test_refined_launcher_predictions_agree_with_the_fe_route(path):
 def test_no_refinement_without_modes_at_the_nodes_or_a_counter():
     model, modes = launcher_modes(LAUNCHERS[0], 10)
     for counter, given in ((None, modes), (ModeCounter(model, "compiled"), type(modes)(modes.values, None))):
-        values, refined = refined_predictions(counter, given)
-        assert not refined.any() and np.array_equal(values, modes.values)
+        values, spans = refined_predictions(counter, given, 10, 1e-9)
+        assert not spans.any() and np.array_equal(values, modes.values)
+
+
+def test_brackets_only_where_rtol_is_ten_times_theirs_and_only_about_those_polished():
+    """A refined prediction gets rayleigh.BRACKET at the default rtol, none at 1e-10 (a
+    refined value only starts the secant there); those more than NEAR_COUNT above the
+    count-th are not refined (they only place the certifying count)."""
+    model, modes = launcher_modes(LAUNCHERS[0], 10)
+    counter = ModeCounter(model, "compiled")
+    values, spans = refined_predictions(counter, modes, 10, 1e-9)
+    assert np.all((spans == rayleigh.BRACKET) | (spans == 0)) and spans[:10].all()
+    assert not spans[values > values[9] * (1 + 2e-2)].any()
+    tight_values, tight = refined_predictions(counter, modes, 10, 1e-10)
+    assert not tight.any() and np.array_equal(tight_values, values)
+
+
+def polynomial(roots, evaluations):
+    """log_det of Π (ω − r) over ``roots``, counting its evaluations into ``evaluations``."""
+    def log_det(omega):
+        omega = np.asarray(omega, dtype=float)
+        evaluations.append(omega.size)
+        value = np.prod(omega[:, None] - np.asarray(roots)[None, :], axis=1)
+        with np.errstate(divide="ignore"):  # a point on a root: log 0, sign 0
+            return np.sign(value), np.log(np.abs(value))
+    return log_det
+
+
+def test_a_bracket_whose_ends_change_sign_ends_the_secant_at_its_first_step():
+    """Starts 3e-11 and 3e-9 above simple roots, brackets of ±1e-10: the first is taken
+    from the bracket (two evaluations, its last step the bracket's width), to 1e-15;
+    the second has no sign change there and goes on to xtol."""
+    roots, evaluations = np.array([10.0, 17.0, 23.0]), []
+    starts = np.array([10.0 * (1 + 3e-11), 17.0 * (1 + 3e-9)])
+    found, steps = secant_roots(polynomial(roots, evaluations), starts, 1e-14, 1e-7, np.array([1e-10, 1e-10]))
+    np.testing.assert_allclose(found, roots[:2], rtol=1e-15)
+    assert steps[0] == pytest.approx(2e-10, rel=1e-6) and steps[1] <= 1e-14
+    assert evaluations[0] == 4 and sum(evaluations) > 4  # both brackets in one batch, then the second alone
+
+
+def test_without_spans_the_secant_starts_as_before():
+    """No spans: the start and a point FIRST_STEP beside it, the same roots and steps as spans of 0."""
+    roots, first, second = np.array([10.0, 17.0]), [], []
+    starts = np.array([10.001, 16.99])
+    found, steps = secant_roots(polynomial(roots, first), starts, 1e-14, 1e-7)
+    again, steps_again = secant_roots(polynomial(roots, second), starts, 1e-14, 1e-7, np.zeros(2))
+    assert np.array_equal(found, again) and np.array_equal(steps, steps_again) and first == second
+
+
+@pytest.mark.parametrize("path", LAUNCHERS)
+def test_launchers_ten_lowest_take_two_evaluations_a_root_and_agree_with_the_fe_route(path):
+    model = load_model(path)
+    result, fe = natural_frequencies(model, 10, engine="compiled"), fe_frequencies(model, count=10)
+    assert result.evaluations <= 2 * 10
+    np.testing.assert_allclose(result.frequencies_hz, fe.frequencies_hz,
+                               rtol=max(1e-9, 3 * float(np.nanmax(fe.error_estimate))))

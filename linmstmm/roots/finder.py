@@ -8,6 +8,7 @@ import numpy as np
 
 from linmstmm.counting import deflated
 from linmstmm.predicted import predicted_roots
+from linmstmm.rayleigh import refined_predictions
 from linmstmm.roots import brackets, certify, fast_path, floor, pencil, segments
 from linmstmm.roots import clusters as close_roots
 from linmstmm.roots.result import RootSearchResult, search_result
@@ -38,8 +39,11 @@ class RootFinder:
     kinematics (:func:`linmstmm.rigid_motion.rigid_body_mode_count`); their
     zeros of det Ū_all at ω = 0 are divided out once they are confirmed
     (:meth:`divide_out_rigid_body_zeros`).
-    predictor : callable n -> (m,) rad/s, the lowest n elastic roots predicted
-    (e.g. :func:`linmstmm.coarse_prediction.predict_frequencies` of the model), or None.
+    predictor : callable n -> :class:`~linmstmm.coarse_prediction.PredictedModes`, the
+    lowest n elastic roots predicted (rad/s) and their modes at the nodes where known
+    (:func:`linmstmm.coarse_prediction.predicted_modes` of the model), or None; the
+    modes refine the predictions by the Rayleigh functional of the counter's exact
+    dynamic stiffness (:func:`linmstmm.rayleigh.refined_predictions`).
     scale : rad/s, the model's own frequency scale; the floor, ceiling and scan
     chunks are multiples of it (see DEFAULT_SCALE).
     rtol : relative accuracy a root is certified to, in [MIN_RTOL, MAX_RTOL]: a root
@@ -136,7 +140,7 @@ class RootFinder:
         self.note = ""
         self._rigid = rigid_body_modes
         self._divided = False  # the rigid-body zeros divided out of log_det
-        #: callable n -> (m,) predicted lowest elastic roots, rad/s, or None
+        #: callable n -> PredictedModes of the lowest elastic roots, or None
         self.predictor = predictor
         #: the compiled determinant behind ``log_det`` and ``matrix``, where the
         #: caller gives one (:mod:`linmstmm.determinant`: it counts evaluations)
@@ -249,12 +253,14 @@ class RootFinder:
     def _found(self, count: int | None, omega_max: float | None) -> list[float]:
         """The roots :meth:`find` returns, as a list (rad/s)."""
         if count is not None and self.predictor is not None:
-            predictions = self.predictor(predictions_wanted(count))
-            wanted = count if predictions.size >= count else self._existing(count)
+            predicted = self.predictor(predictions_wanted(count))
+            wanted = count if predicted.values.size >= count else self._existing(count)
             if wanted == 0:
                 return []
-            found = (predicted_roots(self, predictions, wanted)
-                     if wanted is not None and self._usable(predictions) else None)
+            found = None
+            if wanted is not None and self._usable(predicted.values):
+                predictions, spans = refined_predictions(self.counter, predicted, wanted, self.rtol)
+                found = predicted_roots(self, predictions, wanted, spans)
             if found is not None:  # certified up to above the wanted-th: complete below omega_max too
                 found = self._separated_above_floor(found)
                 return self._cut_at(found[:count], omega_max)

@@ -382,19 +382,29 @@ def _assembled_slots(omega, beams, maps, beam_slots, terms, values, magnitudes):
 def ordered_inertia(values, starts, rows, updates, targets, singular, most_growth, growth):
     """Negative eigenvalues of a symmetric matrix by LDLᵀ without pivoting in the
     order of an :class:`~linmstmm.ordered_ldlt.EliminationPlan` (its ``starts``,
-    ``rows``, ``updates``, ``targets``); −1 where a pivot is below ``singular`` or
+    ``rows``, ``updates``, ``targets``); −1 where a pivot is below ``singular`` or not finite, or
     an entry of diag(|L| |D| |L|ᵀ), which bounds every entry of it, is above
     ``most_growth`` (the factorisation's rounding is not known to be small then).
 
     values : (slots,) the matrix's lower triangle, overwritten; growth : (n,) scratch.
     """
+    return _eliminated(values, starts, rows, updates, targets, singular, most_growth, growth)
+
+
+@njit(cache=True)
+def _eliminated(values, starts, rows, updates, targets, smallest, most_growth, growth):
+    """The elimination of :func:`ordered_inertia` and :func:`_ordered_solve`: ``values``
+    overwritten by the factors (each pivot at its column's start, L's column below it
+    times the pivot); the number of negative pivots, or −1 where a pivot's magnitude is
+    below ``smallest`` or not finite, or an entry of diag(|L| |D| |L|ᵀ) is above
+    ``most_growth``."""
     n = starts.size - 1
     growth[:] = 0.0
     negatives = 0
     for k in range(n):
         pivot = values[starts[k]]
         growth[k] += abs(pivot)
-        if abs(pivot) < singular or growth[k] > most_growth:
+        if abs(pivot) < smallest or not math.isfinite(pivot) or growth[k] > most_growth:
             return -1
         if pivot < 0:
             negatives += 1
@@ -595,6 +605,9 @@ def _form_root(start, first_step, steps, xtol, floor, beams, ends, static, mass,
     return math.nan
 
 
+#: The least pivot magnitude :func:`_ordered_solve` takes: any but an exact zero.
+SMALLEST_PIVOT = 5e-324
+
 @njit(cache=True)
 def _ordered_solve(values, starts, rows, updates, targets, most_growth, growth, z):
     """Solve A z' = z in place (``z`` (n,) in elimination order) by the LDLᵀ without
@@ -602,20 +615,9 @@ def _ordered_solve(values, starts, rows, updates, targets, most_growth, growth, 
     overwritten), False where a pivot is exactly zero or not finite, or an entry of
     diag(|L| |D| |L|ᵀ) is above ``most_growth`` (the factors are not known to be
     accurate then); a small last pivot is what inverse iteration asks for."""
+    if _eliminated(values, starts, rows, updates, targets, SMALLEST_PIVOT, most_growth, growth) < 0:
+        return False
     n = starts.size - 1
-    growth[:] = 0.0
-    for k in range(n):
-        pivot = values[starts[k]]
-        growth[k] += abs(pivot)
-        if pivot == 0.0 or not math.isfinite(pivot) or growth[k] > most_growth:
-            return False
-        t = updates[k]
-        for a in range(starts[k] + 1, starts[k + 1]):
-            multiplier = values[a] / pivot
-            growth[rows[a]] += abs(values[a] * multiplier)
-            for b in range(starts[k] + 1, a + 1):
-                values[targets[t]] -= multiplier * values[b]
-                t += 1
     for k in range(n):  # L y = z, L's column k below the diagonal: values / pivot
         pivot = values[starts[k]]
         for a in range(starts[k] + 1, starts[k + 1]):

@@ -379,6 +379,25 @@ def _assembled_slots(omega, beams, maps, beam_slots, terms, values, magnitudes):
 
 
 @njit(cache=True)
+def _equilibrated(values, magnitudes, order, starts, high, low, weights):
+    """Scale D(ω)'s lower-triangle slots ``values`` symmetrically by ``weights`` (n,),
+    written here: one over the square root of each DOF's diagonal magnitude (``magnitudes``:
+    (2 slots,) the terms' magnitudes, as :func:`_assembled_slots` gives them; ``order``,
+    ``starts``, ``high``, ``low``: the elimination plan's). Returns the largest scaled
+    magnitude, or −1.0 where a DOF has neither stiffness nor mass."""
+    for k in range(order.size):
+        if not magnitudes[starts[k]] > 0:
+            return -1.0
+        weights[order[k]] = 1.0 / math.sqrt(magnitudes[starts[k]])
+    slots, largest = values.size, 0.0
+    for s in range(slots):
+        values[s] = values[s] * weights[high[s]] * weights[low[s]]
+        largest = max(largest, magnitudes[s] * weights[high[s]] * weights[low[s]])
+        largest = max(largest, magnitudes[slots + s] * weights[low[s]] * weights[high[s]])
+    return largest
+
+
+@njit(cache=True)
 def ordered_inertia(values, starts, rows, updates, targets, singular, most_growth, growth):
     """Negative eigenvalues of a symmetric matrix by LDLᵀ without pivoting in the
     order of an :class:`~linmstmm.ordered_ldlt.EliminationPlan` (its ``starts``,
@@ -447,20 +466,13 @@ def ordered_count(omega, beams, maps, singular_pivot, most_growth, plan, terms, 
     n = order.size
     if n == 0:
         return clamped
-    weights = np.empty(n)
-    for k in range(n):
-        if not magnitudes[starts[k]] > 0:
-            return -1  # a DOF with neither stiffness nor mass
-        weights[order[k]] = 1.0 / math.sqrt(magnitudes[starts[k]])
-    slots, largest = values.size, 0.0
-    for s in range(slots):
-        values[s] = values[s] * weights[high[s]] * weights[low[s]]
-        largest = max(largest, magnitudes[s] * weights[high[s]] * weights[low[s]])
-        largest = max(largest, magnitudes[slots + s] * weights[low[s]] * weights[high[s]])
+    largest = _equilibrated(values, magnitudes, order, starts, high, low, np.empty(n))
+    if largest < 0:
+        return -1  # a DOF with neither stiffness nor mass
     singular = singular_pivot * largest
     negatives = -1
     for sign in (1.0, -1.0):
-        for s in range(slots):
+        for s in range(values.size):
             shifted[s] = values[s]
         for k in range(n):
             shifted[starts[k]] += sign * singular
@@ -469,7 +481,6 @@ def ordered_count(omega, beams, maps, singular_pivot, most_growth, plan, terms, 
             return REFUSED
         negatives = found
     return clamped + negatives
-
 
 
 @njit(cache=True)
@@ -529,20 +540,27 @@ def _form_parts(x, maps, columns, high, low, terms, ends):
     at the slots (``high``, ``low``), as :func:`_assembled_slots` takes them) for the
     vector ``x`` (n,) on the reduced DOFs, with each beam's local end displacements
     ``maps[b] @ x[columns[b]]`` written into ``ends`` (n_beams, 12) (padding: 0)."""
-    n = x.size
     static, mass = 0.0, 0.0
     for s in range(high.size):
         product = x[high[s]] * x[low[s]]
         static += (terms[0, s] + terms[2, s]) * product
         mass += (terms[1, s] + terms[3, s]) * product
     for b in range(maps.shape[0]):
-        for p in range(12):
-            total = 0.0
-            for j in range(columns.shape[1]):
-                if columns[b, j] < n:
-                    total += maps[b, p, j] * x[columns[b, j]]
-            ends[b, p] = total
+        _ends_of(maps, columns, b, x, ends[b])
     return static, mass
+
+
+@njit(cache=True)
+def _ends_of(maps, columns, b, x, out):
+    """``out`` (12,) = beam ``b``'s local end displacements ``maps[b] @ x[columns[b]]`` from
+    the vector ``x`` (n,) on the reduced DOFs (a column index of n or more: padding)."""
+    n = x.size
+    for p in range(12):
+        total = 0.0
+        for j in range(columns.shape[1]):
+            if columns[b, j] < n:
+                total += maps[b, p, j] * x[columns[b, j]]
+        out[p] = total
 
 
 @njit(cache=True)
@@ -647,12 +665,7 @@ def _difference_applied(omega, step, x, beams, maps, columns, high, low, terms, 
     n = x.size
     ends, below, above = np.empty(12), np.empty(12), np.empty(12)
     for b in range(beams.shape[0]):
-        for p in range(12):
-            total = 0.0
-            for j in range(columns.shape[1]):
-                if columns[b, j] < n:
-                    total += maps[b, p, j] * x[columns[b, j]]
-            ends[p] = total
+        _ends_of(maps, columns, b, x, ends)
         _beam_applied(beams[b], omega * (1 - step), ends, below, combos)
         _beam_applied(beams[b], omega * (1 + step), ends, above, combos)
         for j in range(columns.shape[1]):
@@ -680,16 +693,8 @@ def _inverse_step(omega, x, derivative_step, beams, maps, columns, most_growth, 
     if _assembled_slots(omega, beams, maps, beam_slots, terms, values, magnitudes) < 0:
         return False
     weights = np.empty(n)
-    for k in range(n):
-        if not magnitudes[starts[k]] > 0:
-            return False
-        weights[order[k]] = 1.0 / math.sqrt(magnitudes[starts[k]])
-    slots, largest = values.size, 0.0
-    for s in range(slots):
-        values[s] = values[s] * weights[high[s]] * weights[low[s]]
-        largest = max(largest, magnitudes[s] * weights[high[s]] * weights[low[s]])
-        largest = max(largest, magnitudes[slots + s] * weights[low[s]] * weights[high[s]])
-    if not math.isfinite(largest):
+    largest = _equilibrated(values, magnitudes, order, starts, high, low, weights)
+    if largest < 0 or not math.isfinite(largest):
         return False
     for k in range(n):
         z[k] = rhs[order[k]] * weights[order[k]]

@@ -37,11 +37,9 @@ import math
 import numpy as np
 
 from linmstmm.counting import deflated
+from linmstmm.prediction_groups import CLUSTER, clustered, clusters, polished_up_to
 from linmstmm.secant import secant_roots
 
-#: Predictions closer than this (relative) are a cluster: a member's secant result
-#: stands only where it converged to xtol (see :func:`_secant_polished`).
-CLUSTER = 1e-3
 #: Halvings of the range by counts before a stretch that misses a root is searched whole.
 REPAIR_DEPTH = 8
 #: Rounds of the secant on det with the known roots divided out (:func:`_deflated_polished`).
@@ -51,10 +49,6 @@ DEFLATION_ROUNDS = 3
 #: (a tip-mass cantilever's double root at 42.4339020 rad/s came back with a second
 #: member at 42.4339063); the pencil and the segment search decide there.
 NEAR_KNOWN = 1e-5
-#: Predictions above the count-th are polished only within this (relative) of it;
-#: the others only place the certifying count's upper end in the gap above it
-#: (the coarse model is within about 1e-2 of every root it predicts).
-NEAR_COUNT = 2e-2
 #: Relative step to which the secant polishes a prediction above the roots wanted that
 #: only places the certifying count's upper end (:func:`_secant_polished`): a tenth of
 #: CLUSTER, the least distance above the roots wanted at which such a value stands.
@@ -68,23 +62,6 @@ COINCIDENT = 1e-10
 #: lowest to within 2e-6, so from about that rtol most stand; below it the counts
 #: would be spent in vain (refined ones stand from it too).
 COUNTED_PREDICTION = 1e-6
-
-
-def _clusters(predictions: np.ndarray) -> list[list[int]]:
-    """Indices of ``predictions`` (ascending) grouped where neighbours are within CLUSTER."""
-    groups: list[list[int]] = []
-    values = predictions.tolist()
-    for i, omega in enumerate(values):
-        if groups and omega - values[groups[-1][-1]] <= CLUSTER * omega:
-            groups[-1].append(i)
-        else:
-            groups.append([i])
-    return groups
-
-
-def clustered(predictions: np.ndarray) -> list[bool]:
-    """(m,): which of ``predictions`` (ascending) share a cluster (:func:`_clusters`) with another."""
-    return [len(group) > 1 for group in _clusters(predictions) for _ in group]
 
 
 def predicted_roots(finder, predictions: np.ndarray, count: int, spans: np.ndarray | None = None):
@@ -128,11 +105,11 @@ def _certified(finder, predictions: np.ndarray, count: int, stand: bool,
     """(the roots :func:`predicted_roots` returns, rad/s, or None; the upper end of
     their certifying count, rad/s): from ``predictions`` (ascending, positive; with
     their brackets' ``spans``), with those that counts certify as they stand taken so if ``stand``."""
-    wanted = int(np.searchsorted(predictions, predictions[count - 1] * (1 + NEAR_COUNT), side="right"))
+    wanted = polished_up_to(predictions, count)
     roots = _polished(finder, predictions, [], 0, wanted, stand, count, spans)
     if roots is not None and len(roots) < count < predictions.size:  # some predicted twice: as many more
         more = min(wanted + count - len(roots), predictions.size)
-        more = int(np.searchsorted(predictions, predictions[more - 1] * (1 + NEAR_COUNT), side="right"))
+        more = polished_up_to(predictions, more)
         roots = _polished(finder, predictions, roots, wanted, more, stand, more, spans)
         wanted = more
     if roots is None:
@@ -475,7 +452,7 @@ def _intervals_around(troubled: list[float], predictions: np.ndarray, roots: lis
 def _cluster_reach(predictions: np.ndarray, start: float) -> float:
     """Half the distance, rad/s, from the cluster of ``predictions`` (ascending) that
     holds ``start`` to the nearest prediction outside it (``start`` itself if none)."""
-    group = next(g for g in _clusters(predictions) if predictions[g[0]] <= start <= predictions[g[-1]])
+    group = next(g for g in clusters(predictions) if predictions[g[0]] <= start <= predictions[g[-1]])
     outside = np.r_[predictions[:group[0]], predictions[group[-1] + 1:]]
     if not outside.size:
         return float(start)

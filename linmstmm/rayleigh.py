@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.predicted import NEAR_COUNT, clustered
+from linmstmm.prediction_groups import clustered, polished_up_to
 
 #: Relative half-width of the bracket about a refined prediction (:func:`refined_predictions`):
 #: det Ū_all is evaluated at its ends, in the secant's first batch, and where det changes
@@ -72,8 +72,8 @@ DERIVATIVE_STEP = 1e-6
 def refined_predictions(counter, modes, count: int, rtol: float) -> tuple[np.ndarray, np.ndarray]:
     """(predictions (m,) rad/s, ascending; spans (m,)): the coarse predictions ``modes``
     (:class:`~linmstmm.coarse_prediction.PredictedModes`) of a search for the lowest
-    ``count`` to ``rtol``, with those it polishes (up to NEAR_COUNT above the count-th,
-    :mod:`linmstmm.predicted`; the others only place its last count) that are alone
+    ``count`` to ``rtol``, with those it polishes (:func:`~linmstmm.predicted.polished_up_to`;
+    the others only place its last count) that are alone
     (none other within CLUSTER) replaced by their Rayleigh values where the refinement
     settles within half the distance to the nearest other prediction; BRACKET in
     ``spans`` for each of those where ``rtol`` is at least ten times it, else 0. As they
@@ -83,9 +83,7 @@ def refined_predictions(counter, modes, count: int, rtol: float) -> tuple[np.nda
     spans = np.zeros(values.size)
     if counter is None or modes.nodal is None or not values.size:
         return values, spans
-    polished = values.size
-    if count <= values.size:
-        polished = int(np.searchsorted(values, values[count - 1] * (1 + NEAR_COUNT), side="right"))
+    polished = polished_up_to(values, count) if count <= values.size else values.size
     tried = np.flatnonzero(~np.array(clustered(values), dtype=bool)[:polished])
     if not tried.size:
         return values, spans

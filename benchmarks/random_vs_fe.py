@@ -106,9 +106,13 @@ def differences(ours, theirs) -> list[str]:
 
 
 def unit_differences(model, units: str, frequencies, count: int) -> list[str]:
-    """Differences from the same model converted back to SI."""
+    """Differences from the same model converted back to SI (a failure of the SI copy's
+    solve among them)."""
     _, length, mass = next(u for u in UNITS if u[0] == units)
-    si = natural_frequencies(in_units(model, 1 / length, 1 / mass), count).frequencies_hz
+    try:
+        si = natural_frequencies(in_units(model, 1 / length, 1 / mass), count).frequencies_hz
+    except Exception as error:  # a sweep reports every failure and goes on
+        return [f"the SI copy raised: MSTMM {type(error).__name__}: {error}"]
     if len(si) != len(frequencies):
         return [f"{len(frequencies)} frequencies in {units}, {len(si)} in SI"]
     off = float(np.max(np.abs(frequencies / si - 1), initial=0.0))

@@ -183,10 +183,12 @@ KNOWN_LIMITS = ("Beams are cut into pieces by their bending waves (βL) alone, s
                 "1e-13 there, but made the numpy carry's solve of that model take minutes (its contours "
                 "reach |Im ω| = 14: 3000 pieces), and was not kept. At 10 modes the counts still come out "
                 "right on every model here; far out on a contour, where cos kL overflows, both engines "
-                "answer NaN and the counts step round the point. At 40 modes some models with Ip/J of 7e8 "
-                "or more raise instead (not diagnosed further): a count the phase of det Ū_all turns too "
-                "fast for, or a contour where det is not finite (reported as an undeflated indeterminate "
-                "constraint).")
+                "answer NaN and the counts step round the point. At 40 modes some models with a beam of "
+                "Ip/J from 2e7 up raise instead (not diagnosed further): a count the phase of det Ū_all "
+                "turns too fast for, or a contour where det is not finite (reported as an undeflated "
+                "indeterminate constraint; seed 4 at 0.262 + 0.152i rad/s: det exactly 0 within the "
+                "40-mode solve, log|det| 38.4 compiled and 40.0 by numpy in a fresh process). Which "
+                "models raise depends on the engine (seed 13, Ip/J 2.2e7: numpy raises, compiled solves).")
 
 
 def report(rows: list[dict], command: str, seconds: float) -> str:

@@ -721,7 +721,8 @@ def rayleigh_roots(vectors, starts, beams, maps, columns, most_growth, plan, ter
     (rad/s), a step of inverse iteration at ω_k (:func:`_inverse_step`) and ω_(k+1) the
     root of xᵀ D(ω) x nearest ω_k (:func:`_form_root`), until ω_(k+1) lies within
     ``settled`` (relative) of ω_k: ω_(k+1) into ``out[i]``; NaN where that takes more
-    than ``inverse_steps`` steps or a step fails.
+    than ``inverse_steps`` steps or a step fails. With ``inverse_steps`` 0, the root of
+    xᵀ D(ω) x nearest ω₀ for x as given (NaN where that fails).
 
     beams, maps, columns, plan, terms, buffers : as for :func:`ordered_count`;
     most_growth : the largest entry of diag(|L| |D| |L|ᵀ) the solve takes, relative
@@ -749,3 +750,6 @@ def rayleigh_roots(vectors, starts, beams, maps, columns, most_growth, plan, ter
                 out[i] = new
                 break
             omega = new
+        if inverse_steps == 0:  # the functional's root of the vector as given
+            static, mass = _form_parts(x, maps, columns, high, low, terms, ends)
+            out[i] = _form_root(omega, first_step, form_steps, form_xtol, form_floor, beams, ends, static, mass, combos)

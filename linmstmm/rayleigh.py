@@ -63,6 +63,13 @@ SOLVE_GROWTH = 1e6
 SETTLED = 1e-5
 #: Inverse steps made at most for one prediction.
 INVERSE_STEPS = 3
+#: From this rtol up, a coarse mode's Rayleigh value is taken without inverse steps
+#: (:func:`refined_predictions`): on the launchers' 20 lowest those are within 8e-6 of
+#: the roots, so each stands as it is where the Wittrick–Williams counts at ±rtol find
+#: one natural frequency across it (:mod:`linmstmm.predicted`), and the inverse steps'
+#: factorisations of D(ω), about a third of such a solve, are saved. Where one does not
+#: stand it is polished by the secant as any prediction.
+UNSTEPPED_FROM = 1e-4
 #: Relative step of the central difference D′(ω) x of an inverse step: its truncation
 #: error (about its square) and rounding (about 1e-16 over it) both far below what the
 #: step needs.
@@ -75,8 +82,9 @@ def refined_predictions(counter, modes, count: int, rtol: float) -> tuple[np.nda
     ``count`` to ``rtol``, with those it polishes (:func:`~linmstmm.predicted.polished_up_to`;
     the others only place its last count) that are alone
     (none other within CLUSTER) replaced by their Rayleigh values where the refinement
-    settles within half the distance to the nearest other prediction; BRACKET in
-    ``spans`` for each of those where ``rtol`` is at least ten times it, else 0. As they
+    settles within half the distance to the nearest other prediction (without inverse
+    steps from UNSTEPPED_FROM up); BRACKET in ``spans`` for each of those refined with
+    inverse steps where ``rtol`` is at least ten times it, else 0. As they
     are, spans 0, without a ``counter`` (:class:`~linmstmm.wittrick_williams.ModeCounter`)
     or modes at the nodes."""
     values = np.asarray(modes.values, dtype=float)
@@ -87,7 +95,9 @@ def refined_predictions(counter, modes, count: int, rtol: float) -> tuple[np.nda
     tried = np.flatnonzero(~np.array(clustered(values), dtype=bool)[:polished])
     if not tried.size:
         return values, spans
-    found = counter.rayleigh_values(modes.nodal[tried][:, counter.masters], values[tried])
+    stepped = rtol < UNSTEPPED_FROM
+    found = counter.rayleigh_values(modes.nodal[tried][:, counter.masters], values[tried],
+                                    INVERSE_STEPS if stepped else 0)
     apart = np.abs(np.diff(values))
     nearest = np.minimum(np.r_[np.inf, apart], np.r_[apart, np.inf])
     reach = 0.5 * np.where(np.isfinite(nearest), nearest, values)[tried]
@@ -95,17 +105,19 @@ def refined_predictions(counter, modes, count: int, rtol: float) -> tuple[np.nda
         settled = np.abs(found - values[tried]) <= reach  # False where NaN
     values = values.copy()
     values[tried[settled]] = found[settled]
-    if rtol >= 10 * BRACKET:
+    if stepped and rtol >= 10 * BRACKET:
         spans[tried[settled]] = BRACKET
     return values, spans
 
 
-def rayleigh_values_in_numpy(counter, vectors: np.ndarray, starts: np.ndarray) -> np.ndarray:
+def rayleigh_values_in_numpy(counter, vectors: np.ndarray, starts: np.ndarray,
+                             inverse_steps: int = INVERSE_STEPS) -> np.ndarray:
     """The numpy reference of :func:`linmstmm._stiffness_kernels.rayleigh_roots`: for each
     row x of ``vectors`` (m, n_dof), from ω₀ = ``starts`` (m,) rad/s, an inverse step at
     ω_k (:func:`_inverse_steps`) and ω_(k+1) the root of xᵀ D(ω) x nearest ω_k
     (:func:`_form_roots`), until ω_(k+1) lies within SETTLED of ω_k (then ω_(k+1)), at
-    most INVERSE_STEPS times (NaN where that is not reached or a step fails). All rows
+    most ``inverse_steps`` times (NaN where that is not reached or a step fails); with
+    ``inverse_steps`` 0, the root of xᵀ D(ω) x nearest ω₀ for x as given. All rows
     step together; D(ω) dense, by :meth:`~linmstmm.wittrick_williams.ModeCounter.matrices`,
     solved by LU with partial pivoting.
 
@@ -117,6 +129,8 @@ def rayleigh_values_in_numpy(counter, vectors: np.ndarray, starts: np.ndarray) -
         Displacements (m) and rotations (rad) on the counter's unknowns.
     starts : (m,) float
         rad/s.
+    inverse_steps : int
+        Inverse steps made at most for one row.
 
     Returns
     -------
@@ -124,9 +138,11 @@ def rayleigh_values_in_numpy(counter, vectors: np.ndarray, starts: np.ndarray) -
     """
     vectors = np.array(vectors, dtype=float)
     omegas = np.array(starts, dtype=float)
+    if inverse_steps == 0:
+        return _form_roots(counter, vectors, omegas)
     out = np.full(omegas.size, np.nan)
     active = np.arange(omegas.size)
-    for _ in range(INVERSE_STEPS):
+    for _ in range(inverse_steps):
         if not active.size:
             break
         stepped = _inverse_steps(counter, vectors, omegas, active)

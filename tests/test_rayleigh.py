@@ -100,11 +100,12 @@ def test_compiled_inverse_step_mirrors_a_dense_solve(path):
 
 
 @pytest.mark.parametrize("path", LAUNCHERS)
-def test_compiled_rayleigh_values_mirror_the_numpy_reference(path):
+@pytest.mark.parametrize("inverse_steps", [None, 0])
+def test_compiled_rayleigh_values_mirror_the_numpy_reference(path, inverse_steps):
     model, modes = launcher_modes(path, 20)
     vectors = modes.nodal[:, ModeCounter(model, "numpy").masters]
-    compiled = ModeCounter(model, "compiled").rayleigh_values(vectors, modes.values)
-    reference = ModeCounter(model, "numpy").rayleigh_values(vectors, modes.values)
+    compiled = ModeCounter(model, "compiled").rayleigh_values(vectors, modes.values, inverse_steps)
+    reference = ModeCounter(model, "numpy").rayleigh_values(vectors, modes.values, inverse_steps)
     assert np.array_equal(np.isnan(compiled), np.isnan(reference))
     assert np.sum(np.isfinite(compiled)) >= 0.9 * compiled.size
     np.testing.assert_allclose(compiled, reference, rtol=1e-12)
@@ -150,6 +151,28 @@ def test_refined_launcher_predictions_agree_with_the_fe_route(path):
     assert refined[:20].sum() >= 18
     error = np.abs(values[:20] / reference - 1)[refined[:20]]
     assert np.all(error <= np.maximum(1e-10, 3 * fe.error_estimate[refined[:20]]))
+
+
+@pytest.mark.parametrize("path", LAUNCHERS)
+def test_from_a_loose_rtol_the_rayleigh_values_are_taken_without_inverse_steps(path):
+    """From rayleigh.UNSTEPPED_FROM up the coarse modes' own Rayleigh values stand for
+    the predictions, with no bracket: closer to the FE route's refinement than the
+    coarse values (up to 5e-4 and 2e-6 off), within 1e-5 of it, and each a root of the
+    functional of its coarse mode (the numpy reference's, independently formed)."""
+    model, modes = launcher_modes(path, 20)
+    counter = ModeCounter(model, "compiled")
+    values, spans = refined_predictions(counter, modes, 20, rayleigh.UNSTEPPED_FROM)
+    assert not spans.any()
+    reference = 2 * np.pi * fe_frequencies(model, count=20).frequencies_hz
+    changed = values[:20] != modes.values[:20]
+    assert changed.sum() >= 18
+    coarse_error = np.abs(modes.values[:20] / reference - 1)
+    error = np.abs(values[:20] / reference - 1)
+    assert np.all(error[changed] <= 1e-5) and np.max(error[changed]) < 0.1 * np.max(coarse_error[changed])
+    vectors = modes.nodal[:20][changed][:, counter.masters]
+    forms = ModeCounter(model, "numpy").forms(vectors, values[:20][changed])
+    magnitude = np.abs(ModeCounter(model, "numpy").forms(vectors, modes.values[:20][changed] * (1 + 1e-3)))
+    assert np.all(np.abs(forms) <= 1e-9 * magnitude)
 
 
 def test_no_refinement_without_modes_at_the_nodes_or_a_counter():

@@ -188,22 +188,22 @@ def _half_windings(log_det, paths, wheres, max_points: int, initial_points: int 
         with np.errstate(invalid="ignore"):  # a point on a known root: not finite, flagged below
             change = (there.real - here.real) + 1j * np.angle(np.exp(1j * (there.imag - here.imag)))
             slope = change / steps
+        lost = ~np.isfinite(log_abs).reshape(2, -1).all(axis=0)
         return (np.split(here, edges), np.split(slope, edges),
-                [bool(ok.all()) for ok in np.split(np.isfinite(log_abs).reshape(2, -1).all(axis=0), edges)])
+                [None if not gone.any() else complex(where[gone][0])
+                 for gone, where in zip(np.split(lost, edges), np.split(points[:lost.size], edges))])
 
     thetas = [np.linspace(0.0, np.pi, initial_points) for _ in paths]
-    values, slopes, finite = logs(list(enumerate(thetas)))
-    results: list = [opposite_ends if opposite_ends is not None and finite[i]
+    values, slopes, lost = logs(list(enumerate(thetas)))
+    results: list = [opposite_ends if opposite_ends is not None and lost[i] is None
                      and np.cos(value[0].imag - value[-1].imag) < 0 else None for i, value in enumerate(values)]
     while True:
         pieces = []
         for i, theta in enumerate(thetas):
             if results[i] is not None:
                 continue
-            if not finite[i]:
-                results[i] = RuntimeError("det Ū_all vanishes on the counting contour: Ū_all is "
-                                          "singular at every frequency (undeflated indeterminate "
-                                          "constraint)")
+            if lost[i] is not None:
+                results[i] = RuntimeError(_lost_message(wheres[i], lost[i], values[i]))
                 continue
             steps = np.angle(np.exp(1j * np.diff(values[i].imag)))  # wrapped into (−π, π]
             h = np.diff(theta)
@@ -222,12 +222,12 @@ def _half_windings(log_det, paths, wheres, max_points: int, initial_points: int 
                 pieces.append((i, (theta[:-1][coarse] + theta[1:][coarse]) / 2))
         if not pieces:
             return results
-        new_values, new_slopes, new_finite = logs(pieces)
-        for (i, middles), more, more_slopes, ok in zip(pieces, new_values, new_slopes, new_finite):
+        new_values, new_slopes, new_lost = logs(pieces)
+        for (i, middles), more, more_slopes, gone in zip(pieces, new_values, new_slopes, new_lost):
             order = np.argsort(np.r_[thetas[i], middles])
             thetas[i] = np.r_[thetas[i], middles][order]
             values[i], slopes[i] = np.r_[values[i], more][order], np.r_[slopes[i], more_slopes][order]
-            finite[i] = finite[i] and ok
+            lost[i] = gone if lost[i] is None else lost[i]
 
 
 def count_inside(log_det, centre: complex, radius: float, height: float | None = None,
@@ -249,3 +249,17 @@ def count_inside(log_det, centre: complex, radius: float, height: float | None =
     if winding % 2:
         raise RuntimeError(f"the root count in the ellipse about {centre:.6g} rad/s is not an integer")
     return winding // 2
+
+
+def _lost_message(where: str, omega: complex, values: np.ndarray) -> str:
+    """Why a count in ``where`` cannot be made: det Ū_all came out exactly 0 or not finite
+    at ``omega`` (rad/s) on its contour, where ``values`` (log det at the contour's points)
+    are known. Where no point of the contour had a finite value, Ū_all is singular at
+    every frequency (an indeterminate constraint left in it); where others had, det lost
+    its digits at that point (its scales too far apart to be told from 0 there)."""
+    if not np.isfinite(values.real).any():
+        return (f"det Ū_all vanishes on the whole counting contour in {where}: Ū_all is singular at every "
+                "frequency (undeflated indeterminate constraint)")
+    return (f"cannot count the roots in {where}: det Ū_all came out exactly 0 or not finite at "
+            f"ω = {omega.real:.6g}{omega.imag:+.6g}j rad/s on the counting contour (the largest and smallest "
+            "scales of Ū_all there too far apart to be told from 0 in float64)")

@@ -81,3 +81,23 @@ def test_a_chain_whose_first_chunk_holds_an_odd_number_of_roots():
     assert zero_free(counted, lo, hi, initial_points=DEFLATED_POINTS) is False
     assert calls == [2 * DEFLATED_POINTS]
     assert count_zeros(log_det, lo, hi, initial_points=DEFLATED_POINTS) == inside
+
+
+def test_a_count_names_a_point_where_det_lost_its_digits_and_a_det_zero_everywhere():
+    """det exactly 0 at one contour point (a value lost to rounding) is not Ū_all
+    singular at every frequency: the message gives the point; where every point is 0,
+    it says singular."""
+    def log_sin_lost_near(omega):
+        value = np.sin(np.asarray(omega, dtype=complex))
+        sign, log_abs = value / np.abs(value), np.log(np.abs(value))
+        lost = np.abs(omega - (2.0 + 0.5j)) < 0.3
+        return np.where(lost, 0, sign), np.where(lost, -np.inf, log_abs)
+
+    def zero_everywhere(omega):
+        return np.zeros(len(omega), dtype=complex), np.full(len(omega), -np.inf)
+
+    with pytest.raises(RuntimeError, match=r"exactly 0 or not finite at ω = [0-9.]+\+[0-9.]+j rad/s") as lost:
+        count_zeros(log_sin_lost_near, 0.5, 3.5)
+    assert "every frequency" not in str(lost.value)
+    with pytest.raises(RuntimeError, match="singular at every frequency"):
+        count_zeros(zero_everywhere, 0.5, 3.5)

@@ -86,10 +86,10 @@ def refined_predictions(counter, modes, count: int, rtol: float) -> tuple[np.nda
     steps from UNSTEPPED_FROM up); BRACKET in ``spans`` for each of those refined with
     inverse steps where ``rtol`` is at least ten times it, else 0. As they
     are, spans 0, without a ``counter`` (:class:`~linmstmm.wittrick_williams.ModeCounter`)
-    or modes at the nodes."""
+    or modes at the nodes, or where D(ω) has no unknowns (every node held: J₀ counts all)."""
     values = np.asarray(modes.values, dtype=float)
     spans = np.zeros(values.size)
-    if counter is None or modes.nodal is None or not values.size:
+    if counter is None or modes.nodal is None or not values.size or not counter.n_dof:
         return values, spans
     polished = polished_up_to(values, count) if count <= values.size else values.size
     tried = np.flatnonzero(~np.array(clustered(values), dtype=bool)[:polished])

@@ -182,6 +182,23 @@ def test_no_refinement_without_modes_at_the_nodes_or_a_counter():
         assert not spans.any() and np.array_equal(values, modes.values)
 
 
+@pytest.mark.parametrize("engine", ["numpy", "compiled"])
+def test_a_beam_held_at_both_ends_has_nothing_to_refine_and_meets_the_closed_form(engine):
+    """Clamped at both ends, the one beam leaves D(ω) no unknown (the counter's J₀ counts
+    every root): its predictions stay as they are, with no bracket (the numpy engine
+    failed on the empty vectors), and the solve meets the frequency equation."""
+    length, Iz, Iy = 2.0, 2e-7, 7e-7
+    model = single_beam_model(fixed(), fixed(), length=length, Iz=Iz, Iy=Iy, axial=False, torsion=False)
+    counter = ModeCounter(model, engine)
+    assert counter.n_dof == 0
+    modes = predicted_modes(model, 8)
+    values, spans = refined_predictions(counter, modes, 8, 1e-9)
+    assert not spans.any() and np.array_equal(values, modes.values)
+    exact = cantilever_frequencies("clamped-clamped", length, Iz, Iy, model.beams[0])[:8]
+    result = natural_frequencies(model, 8, engine=engine)
+    np.testing.assert_allclose(2 * np.pi * result.frequencies_hz, exact, rtol=1e-12)
+
+
 def test_brackets_only_where_rtol_is_ten_times_theirs_and_only_about_those_polished():
     """A refined prediction gets rayleigh.BRACKET at the default rtol, none at 1e-10 (a
     refined value only starts the secant there); those more than NEAR_COUNT above the

@@ -303,20 +303,19 @@ class ModeCounter:
         np.add.at(out, (rows, np.broadcast_to(self._columns, forces.shape)), forces)
         return out[:, :-1]
 
-    def rayleigh_values(self, vectors, starts, inverse_steps: int | None = None) -> np.ndarray:
+    def rayleigh_values(self, vectors, starts, inverse_steps: int) -> np.ndarray:
         """(m,) rad/s, NaN where it does not settle: Rayleigh quotient iteration on D(ω)
-        (:mod:`linmstmm.rayleigh`) from each row of ``vectors`` (m, n_dof), a mode's
-        displacements (m) and rotations (rad) on D's unknowns, and its frequency ``starts``
-        (m,) rad/s, at most ``inverse_steps`` (None: rayleigh.INVERSE_STEPS) inverse steps a
-        row (0: the functional's root for each row as given); compiled (:func:`linmstmm._stiffness_kernels.rayleigh_roots`, from
-        COUNT_BATCH rows on the cores, each piece in buffers of its own), else by
+        (:mod:`linmstmm.rayleigh`), at most ``inverse_steps`` steps a row (0: the functional's
+        root), from each row of ``vectors`` (m, n_dof), a mode's displacements (m) and
+        rotations (rad) on D's unknowns, and its frequency ``starts`` (m,) rad/s; compiled
+        (:func:`linmstmm._stiffness_kernels.rayleigh_roots`, from COUNT_BATCH rows on the
+        cores, each piece in buffers of its own), else by
         :func:`linmstmm.rayleigh.rayleigh_values_in_numpy`."""
         from linmstmm import rayleigh
 
         starts = np.array(starts, dtype=float).ravel()
-        steps = rayleigh.INVERSE_STEPS if inverse_steps is None else inverse_steps
         if self.engine != "compiled":
-            return rayleigh.rayleigh_values_in_numpy(self, vectors, starts, steps)
+            return rayleigh.rayleigh_values_in_numpy(self, vectors, starts, inverse_steps)
         vectors = np.array(vectors, dtype=float).reshape(starts.size, self.n_dof)  # the kernel's own copy
         out = np.empty(starts.size)
         kernel, table = _stiffness_kernels().rayleigh_roots, self._beam_table()
@@ -324,7 +323,7 @@ class ModeCounter:
         def piece(start: int, stop: int) -> None:
             kernel(vectors[start:stop], starts[start:stop], table, self._maps, self._columns, rayleigh.SOLVE_GROWTH,
                    *self._plan, self._sparse_scratch(), rayleigh.FIRST_STEP, rayleigh.FORM_STEPS, rayleigh.FORM_XTOL,
-                   rayleigh.FORM_FLOOR, rayleigh.SETTLED, steps, rayleigh.DERIVATIVE_STEP,
+                   rayleigh.FORM_FLOOR, rayleigh.SETTLED, inverse_steps, rayleigh.DERIVATIVE_STEP,
                    out[start:stop])
 
         spread(piece, starts.size, COUNT_BATCH)

@@ -100,7 +100,7 @@ def test_compiled_inverse_step_mirrors_a_dense_solve(path):
 
 
 @pytest.mark.parametrize("path", LAUNCHERS)
-@pytest.mark.parametrize("inverse_steps", [None, 0])
+@pytest.mark.parametrize("inverse_steps", [rayleigh.INVERSE_STEPS, 0])
 def test_compiled_rayleigh_values_mirror_the_numpy_reference(path, inverse_steps):
     model, modes = launcher_modes(path, 20)
     vectors = modes.nodal[:, ModeCounter(model, "numpy").masters]

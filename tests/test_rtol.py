@@ -204,6 +204,16 @@ def test_the_command_line_refuses_them_with_exit_status_2(arguments, message):
     assert done.returncode == 2 and message in done.stderr and "Traceback" not in done.stderr
 
 
+def test_the_table_says_what_rtol_its_frequencies_are_certified_to():
+    """With --rtol the text table says the digits it prints beyond it are not certified;
+    without, it says nothing of the kind (the default prints digits det polished)."""
+    def table(*arguments):
+        return subprocess.run([sys.executable, "-m", "linmstmm", "freqs", "models/spring_mass_chain.toml", *arguments],
+                              cwd=ROOT, capture_output=True, text=True, timeout=120).stdout
+    assert "certified to: rtol 1e-04 (each frequency within it of the root" in table("--rtol", "1e-4")
+    assert "certified to" not in table()
+
+
 def test_at_a_loose_rtol_roots_a_count_encloses_within_rtol_are_not_bisected_further():
     """Two bending roots 2e-6 apart (Iy = Iz (1 + 4e-6)): at rtol 1e-4 an interval
     narrower than rtol that the count says holds both gives both at its middle, each

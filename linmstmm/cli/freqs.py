@@ -65,7 +65,8 @@ def run_freqs(args) -> int:
         result = natural_frequencies(model, count=count, fmax=fmax, digits=args.digits, root=args.root,
                                      engine=args.engine, rtol=args.rtol)
     data = result.to_dict()
-    emit(args, model, data, lambda d: print_frequency_table(f"{model.name}: natural frequencies (MSTMM)", d),
+    emit(args, model, data, lambda d: print_frequency_table(f"{model.name}: natural frequencies (MSTMM)", d,
+                                                            args.rtol),
          lambda: frequency_csv(data))
     return 0
 
@@ -85,14 +86,17 @@ def frequency_csv(data: dict) -> tuple[list[str], list[list]]:
                                                          enumerate(zip(hz, rad_s), start=1)]
 
 
-def print_frequency_table(title: str, data: dict) -> None:
-    """Print a frequency result (``to_dict`` of FrequencyResult or FEResult) as a table."""
+def print_frequency_table(title: str, data: dict, rtol: float | None = None) -> None:
+    """Print a frequency result (``to_dict`` of FrequencyResult or FEResult) as a table;
+    with the ``rtol`` it was asked for, where one was (the digits beyond it are not certified)."""
     print(f"{title}")
     print(f"  rigid-body modes: {data['rigid_body_modes']}")
     if "ubar_order" in data:
         print(f"  order of Ubar_all: {data['ubar_order']}")
     if data.get("precision", "float64") != "float64":
         print(f"  precision: {data['precision']}")
+    if rtol is not None:
+        print(f"  certified to: rtol {rtol:.0e} (each frequency within it of the root; digits beyond it are not)")
     hz, rad_s = frequency_texts(data)
     width = max([20] + [len(text) for text in hz + rad_s])
     print(f"  {'mode':>4}  {'f [Hz]':>{width}}  {'omega [rad/s]':>{width}}")

@@ -64,10 +64,11 @@ SETTLED = 1e-5
 #: Inverse steps made at most for one prediction.
 INVERSE_STEPS = 3
 #: From this rtol up, a coarse mode's Rayleigh value is taken without inverse steps
-#: (:func:`refined_predictions`): on the launchers' 20 lowest those are within 8e-6 of
+#: (:func:`refined_predictions`): on the launchers' 20 lowest those are within 8.5e-6 of
 #: the roots, so each stands as it is where the Wittrick–Williams counts at ±rtol find
 #: one natural frequency across it (:mod:`linmstmm.predicted`), and the inverse steps'
-#: factorisations of D(ω), about a third of such a solve, are saved. Where one does not
+#: factorisations of D(ω) are saved (the launcher's ten lowest, predictions kept:
+#: 0.67 -> 0.56 ms, a sixth of such a solve). Where one does not
 #: stand it is polished by the secant as any prediction.
 UNSTEPPED_FROM = 1e-4
 #: Relative step of the central difference D′(ω) x of an inverse step: its truncation

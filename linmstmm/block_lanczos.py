@@ -69,6 +69,32 @@ def lowest_eigenvalues(K, M, count: int, shift: float, seed: int = 0) -> np.ndar
     outgrow the pencil before converging, K + shift M is singular, or the basis
     becomes numerically dependent.
     """
+    converged = _converged(K, M, count, shift, seed)
+    return None if converged is None else np.sort(1.0 / converged[0] - shift)
+
+
+def lowest_modes(K, M, count: int, shift: float, seed: int = 0) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`lowest_eigenvalues` with their Ritz vectors: (eigenvalues (count,),
+    ascending; vectors (n, count), M-orthonormal, one per column), or None where
+    that gives no answer.
+
+    A Ritz vector whose value is within PRECISION of an eigenvalue lies about the
+    square root of that from the eigenvector (of a simple eigenvalue), which the
+    predictions' Rayleigh refinement takes from there (:mod:`linmstmm.rayleigh`).
+    The arguments are :func:`lowest_eigenvalues`'.
+    """
+    converged = _converged(K, M, count, shift, seed)
+    if converged is None:
+        return None
+    theta, coefficients, basis = converged  # θ descending: the eigenvalues ascending
+    return 1.0 / theta - shift, basis.T @ coefficients
+
+
+def _converged(K, M, count: int, shift: float, seed: int):
+    """(the ``count`` largest Ritz values θ (count,), descending; their coefficients on
+    the basis (m, count); the M-orthonormal basis (m, n), one vector per row) once each
+    is within PRECISION of an eigenvalue of (K + shift M)⁻¹ M; None where
+    :func:`lowest_eigenvalues` gives no answer (its arguments)."""
     from scipy.sparse.linalg import splu  # imported where used: the command line starts without it
 
     n = K.shape[0]
@@ -91,9 +117,9 @@ def lowest_eigenvalues(K, M, count: int, shift: float, seed: int = 0) -> np.ndar
         if lower is None:
             return None
         if size >= check:
-            theta, error = _ritz_values(rayleigh[:size, :size], lower, count)
+            theta, coefficients, error = _ritz_values(rayleigh[:size, :size], lower, count)
             if np.all(error <= PRECISION * theta):
-                return np.sort(1.0 / theta - shift)
+                return theta, coefficients, basis[:size]
             check = size + max(BLOCK, int(GROWTH * size))
         inverse = scipy.linalg.lapack.dtrtri(lower, lower=1)[0]
         rows = slice(size, size + BLOCK)
@@ -134,14 +160,15 @@ def _orthogonalised(images: np.ndarray, basis: np.ndarray, m_basis: np.ndarray,
 
 
 def _ritz_values(rayleigh: np.ndarray, lower: np.ndarray, count: int):
-    """The ``count`` largest Ritz values θ (count,), descending, of the basis whose
-    Rayleigh quotient's upper triangle is ``rayleigh`` (m, m), m > count, and each
-    one's error estimate (count,): the lesser of its residual's M-norm r (the next
-    block's factor ``lower`` (b, b) applied to its Ritz vector's coefficients on the
-    newest block) and r² over the distance to the nearest other Ritz value."""
+    """(the ``count`` largest Ritz values θ (count,), descending; their vectors'
+    coefficients on the basis (m, count); each one's error estimate (count,)) of the
+    basis whose Rayleigh quotient's upper triangle is ``rayleigh`` (m, m), m > count:
+    the error the lesser of its residual's M-norm r (the next block's factor
+    ``lower`` (b, b) applied to its Ritz vector's coefficients on the newest block)
+    and r² over the distance to the nearest other Ritz value."""
     theta, vectors = scipy.linalg.eigh(rayleigh, lower=False, driver="evd")
     theta, vectors = theta[::-1], vectors[:, ::-1][:, :count]
     residual = np.linalg.norm(lower.T @ vectors[-lower.shape[0]:], axis=0)
     apart = -np.diff(theta)
     gap = np.minimum(np.append(np.inf, apart[:count - 1]), apart[:count])
-    return theta[:count], np.minimum(residual, residual ** 2 / np.maximum(gap, np.finfo(float).tiny))
+    return theta[:count], vectors, np.minimum(residual, residual ** 2 / np.maximum(gap, np.finfo(float).tiny))

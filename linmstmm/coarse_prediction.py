@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg
 
-from linmstmm.block_lanczos import lowest_eigenvalues
+from linmstmm.block_lanczos import lowest_eigenvalues, lowest_modes
 from linmstmm.elements.beam import bending_wavenumber
 from linmstmm.fe.sparse import scipy_csr
 from linmstmm.fe.node_constraints import kept_node_constraints
@@ -84,9 +84,9 @@ class PredictedModes:
         Each mode's displacements (m) and rotations (rad) at the model's points and
         rigid bodies' mass centres, six per node in the inertial frame, in the order
         of the full DOFs of :mod:`linmstmm.fe.layout` (the nodes every mesh numbers
-        first): the eigenvector there, unnormalised. None where they were not asked
-        for, or the eigensolver gives no vectors (more than BISECTED wanted, the
-        sparse route, or massless unknowns).
+        first): the eigenvector there, unnormalised (a Ritz vector on the sparse
+        route). None where they were not asked for, or the pencil has massless
+        unknowns (QZ gives no vectors).
     """
 
     values: np.ndarray
@@ -109,10 +109,10 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     if pencil.size == 0:  # every point held: no unknown, no mode (LAPACK takes no empty matrix)
         return PredictedModes(np.zeros(0), None)
     rigid = pencil.rigid_body_modes
-    lam, vectors = _lowest_eigenvalues(pencil, min(count + rigid, pencil.size), shift, nodal)
+    lam, vectors, reduced = _lowest_eigenvalues(pencil, min(count + rigid, pencil.size), shift, nodal)
     order = np.argsort(lam)[rigid:rigid + count]
     values = np.sqrt(np.maximum(lam[order], 0.0))
-    return PredictedModes(values, None if vectors is None else pencil.at_nodes(vectors[:, order]))
+    return PredictedModes(values, None if vectors is None else pencil.at_nodes(vectors[:, order], reduced))
 
 
 @dataclass(frozen=True, eq=False)
@@ -203,14 +203,15 @@ class CoarsePencil:
             matrix.setflags(write=False)  # shared by every prediction of this model
         return factor, reduced
 
-    def at_nodes(self, vectors: np.ndarray) -> np.ndarray:
+    def at_nodes(self, vectors: np.ndarray, reduced: bool = True) -> np.ndarray:
         """(m, 6 · (points + bodies)): the eigenvectors ``vectors`` (n, m) of
-        :attr:`reduced` as displacements and rotations at the model's points and mass
-        centres (:class:`PredictedModes`): x = L⁻ᵀ y on the scaled pencil, times
+        :attr:`reduced` (y; x = L⁻ᵀ y on the scaled pencil), or of the scaled pencil
+        itself (x) where ``reduced`` is False, as displacements and rotations at the
+        model's points and mass centres (:class:`PredictedModes`): x times
         :attr:`scale` on the assembly's unknowns, and the rows of T at those nodes."""
-        factor = self._standard[0]
-        scaled, info = scipy.linalg.lapack.dtrtrs(factor, vectors, lower=1, trans=1)
-        return (self._node_rows @ (self.scale[:, None] * scaled)).T
+        if reduced:
+            vectors, info = scipy.linalg.lapack.dtrtrs(self._standard[0], vectors, lower=1, trans=1)
+        return (self._node_rows @ (self.scale[:, None] * vectors)).T
 
     @functools.cached_property
     def _node_rows(self):
@@ -312,40 +313,46 @@ def _regular_pencil(K: np.ndarray, M: np.ndarray):
 
 
 def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None,
-                        vectors: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
+                        vectors: bool = False) -> tuple[np.ndarray, np.ndarray | None, bool]:
     """(at least the ``count`` lowest eigenvalues of ``pencil`` (K, M), (rad/s)², in
-    any order; their eigenvectors of :attr:`CoarsePencil.reduced`, (n, m), or None):
-    by block shift-invert Lanczos about −shift
-    (:func:`~linmstmm.block_lanczos.lowest_eigenvalues`) where a shift is given,
-    every unknown carries mass and there are more than DENSE_PREDICTION; else on the
-    kept standard form, the lowest by bisection (syevx, with their ``vectors`` if
-    asked), or all at once (QR, dsterf) where more than BISECTED are wanted; by QZ
-    where M is singular, the infinite eigenvalues dropped. Vectors come only from syevx."""
+    any order; their eigenvectors (n, m) if ``vectors`` asks and the route gives them,
+    else None; whether those are of :attr:`CoarsePencil.reduced` (y), not of the scaled
+    pencil itself (x)): by block shift-invert Lanczos about −shift
+    (:mod:`linmstmm.block_lanczos`, x) where a shift is given, every unknown carries
+    mass and there are more than DENSE_PREDICTION; else on the kept standard form
+    (:func:`_standard_lowest`, y); by QZ where M is singular, the infinite
+    eigenvalues dropped, without vectors."""
     if shift is not None and pencil.size > DENSE_PREDICTION and np.all(pencil.assembly.M.diagonal() != 0):
-        lam = _sparse_lowest(pencil, count, shift)
-        if lam is not None:
-            return lam, None
+        found = _sparse_lowest(pencil, count, shift, vectors)
+        if found is not None:
+            return *found, False
     if pencil.reduced is None:  # massless unknowns: QZ, their eigenvalues infinite
         K, M = _regular_pencil(pencil.K, pencil.M)
         lam = scipy.linalg.eigvals(K, M)
-        return lam[np.isfinite(lam)].real, None
-    return _standard_lowest(pencil.reduced, count, vectors)
+        return lam[np.isfinite(lam)].real, None, True
+    return *_standard_lowest(pencil.reduced, count, vectors), True
 
 
 def _standard_lowest(reduced: np.ndarray, count: int, vectors: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
     """(the ``count`` lowest eigenvalues of the standard form ``reduced`` (n, n) (its lower
-    triangle), ascending; their eigenvectors (n, count) where ``vectors`` and syevx
-    finds them, else None): by bisection (syevx) up to BISECTED, else all of them (syev).
+    triangle), ascending, or all of them; their eigenvectors (n, m) where ``vectors``,
+    else None): by bisection (syevx) up to BISECTED, else all of them at once, by
+    divide and conquer (syevd) with the vectors, by QR (syev, dsterf) without.
 
     LAPACK's routines called as ``scipy.linalg.eigh(driver="evx" or "ev", lower=True)``
     calls them, with its workspace (:func:`_workspace`), hence its eigenvalues to the bit,
     without its checks and lookups: on the second launcher's 132 unknowns eigh took
     0.59 ms where syevx itself took 0.41 (the ten lowest, best of 200 in one process),
     and a first solve's prediction of either launcher 2 to 8 % less, side by side.
+    Beyond BISECTED, syevd's every pair costs less than bisection's few dozen: the
+    launcher's 68 lowest of 120 unknowns with their vectors 0.74 ms, against 2.6 ms
+    by syevx (0.33 ms without vectors, by syev).
     """
     n = reduced.shape[0]
     found_vectors = None
-    if count > BISECTED:
+    if count > BISECTED and vectors:
+        eigenvalues, found_vectors, info = scipy.linalg.lapack.dsyevd(reduced, compute_v=1, lower=1)
+    elif count > BISECTED:
         eigenvalues, _, info = scipy.linalg.lapack.dsyev(reduced, compute_v=0, lower=1,
                                                          lwork=_workspace("dsyev", n))
     else:
@@ -366,15 +373,20 @@ def _workspace(routine: str, n: int) -> int:
     return int(work)
 
 
-def _sparse_lowest(pencil: CoarsePencil, count: int, shift: float) -> np.ndarray | None:
-    """The ``count`` lowest eigenvalues, (rad/s)², of ``pencil``'s sparse assembly scaled
-    as its dense K and M are, by block shift-invert Lanczos about −shift; None where
+def _sparse_lowest(pencil: CoarsePencil, count: int, shift: float,
+                   vectors: bool) -> tuple[np.ndarray, np.ndarray | None] | None:
+    """(the ``count`` lowest eigenvalues, (rad/s)², of ``pencil``'s sparse assembly scaled
+    as its dense K and M are; their Ritz vectors (n, count) of that scaled pencil if
+    ``vectors``, else None), by block shift-invert Lanczos about −shift; None where
     that gives no answer."""
     from scipy.sparse import diags  # imported where used: the command line starts without it
 
     scaling = diags(pencil.scale)
     K, M = (scaling @ scipy_csr(matrix) @ scaling for matrix in (pencil.assembly.K, pencil.assembly.M))
-    return lowest_eigenvalues(K, M, count, shift)
+    if vectors:
+        return lowest_modes(K, M, count, shift)
+    lam = lowest_eigenvalues(K, M, count, shift)
+    return None if lam is None else (lam, None)
 
 
 def predict_frequencies(model: Model, count: int) -> np.ndarray:
@@ -448,15 +460,20 @@ def _kept_modes(model: Model, count: int, nodal: bool) -> PredictedModes:
 
 def _predicted_modes(model: Model, count: int, nodal: bool) -> PredictedModes:
     """:func:`predicted_modes` made anew (the modes at the nodes only if ``nodal``): two
-    elements per beam, or as many as the highest frequency's bending waves need."""
-    predicted = coarse_modes(model, count, 2, nodal=nodal)
-    if not model.beams or not predicted.values.size:
-        return predicted
-    beta_L = max(bending_wavenumber(beam, predicted.values[-1]) * beam.length for beam in model.beams)
-    needed = min(int(np.ceil(beta_L / WAVE_PER_ELEMENT)), MAX_ELEMENTS, max(_finest_mesh(model), 2))
-    if needed <= 2 * 2:
-        return predicted
-    return coarse_modes(model, count, needed, shift=0.5 * predicted.values[0] ** 2, nodal=nodal)
+    elements per beam, or as many as the highest frequency's bending waves need. The
+    two-element mesh's frequencies decide; its modes come with them where bisection
+    finds them (up to BISECTED), else only where no finer mesh follows."""
+    with_first = nodal and count <= BISECTED
+    predicted = coarse_modes(model, count, 2, nodal=with_first)
+    needed = 2
+    if model.beams and predicted.values.size:
+        beta_L = max(bending_wavenumber(beam, predicted.values[-1]) * beam.length for beam in model.beams)
+        needed = min(int(np.ceil(beta_L / WAVE_PER_ELEMENT)), MAX_ELEMENTS, max(_finest_mesh(model), 2))
+    if needed > 2 * 2:
+        return coarse_modes(model, count, needed, shift=0.5 * predicted.values[0] ** 2, nodal=nodal)
+    if nodal and not with_first and predicted.values.size and coarse_pencil(model, 2).reduced is not None:
+        return coarse_modes(model, count, 2, nodal=True)
+    return predicted
 
 
 def _forget_predictions() -> None:

@@ -1,6 +1,6 @@
 """Block shift-invert Lanczos (linmstmm.block_lanczos) against closed forms: a fixed-fixed
-chain of equal masses and springs has the eigenvalues (4k/m) sin²(jπ / 2(n+1)), two such
-chains side by side each of them twice. The coarse prediction's sparse route gives
+chain of equal masses and springs has the eigenvalues (4k/m) sin²(jπ / 2(n+1)) and the
+modes sin(i j π / (n+1)), two such chains side by side each of them twice. The coarse prediction's sparse route gives
 ARPACK's frequencies, and where the Lanczos gives no answer the dense route answers."""
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 import scipy.sparse
 
 from linmstmm import block_lanczos
-from linmstmm.block_lanczos import PRECISION, lowest_eigenvalues
+from linmstmm.block_lanczos import PRECISION, lowest_eigenvalues, lowest_modes
 
 
 def chain(n: int, stiffness: float, mass: float):
@@ -28,6 +28,20 @@ def test_lowest_eigenvalues_of_a_chain_are_the_closed_form(stiffness, mass, coun
     lam = lowest_eigenvalues(K, M, count, 0.5 * exact[0])
     assert lam.shape == (count,)
     np.testing.assert_allclose(lam, exact[:count], rtol=PRECISION, atol=0)
+
+
+@pytest.mark.parametrize("stiffness, mass", [(1.0, 1.0), (3.7e9, 2.1e-4)])
+def test_ritz_vectors_of_a_chain_are_its_modes(stiffness, mass):
+    """lowest_modes: lowest_eigenvalues' values to the bit, and M-orthonormal vectors each
+    within PRECISION (1 − |cos|, in the M inner product) of the closed-form mode."""
+    K, M, exact = chain(600, stiffness, mass)
+    values, vectors = lowest_modes(K, M, 20, 0.5 * exact[0])
+    assert np.array_equal(values, lowest_eigenvalues(K, M, 20, 0.5 * exact[0]))
+    np.testing.assert_allclose(vectors.T @ (M @ vectors), np.eye(20), rtol=0, atol=1e-13)
+    index = np.arange(1, 601)
+    shapes = np.sin(np.outer(index, np.arange(1, 21)) * np.pi / 601)
+    shapes /= np.sqrt(np.sum(shapes * (M @ shapes), axis=0))
+    assert np.max(1 - np.abs(np.sum(vectors * (M @ shapes), axis=0))) <= PRECISION
 
 
 def test_double_eigenvalues_come_twice():

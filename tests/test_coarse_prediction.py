@@ -57,3 +57,17 @@ def test_the_standard_form_is_solved_as_scipy_eigh_solves_it(name, count):
         expected = scipy.linalg.eigh(reduced, eigvals_only=True, subset_by_index=[0, count - 1], driver="evx",
                                      lower=True)
     assert np.array_equal(_standard_lowest(reduced, count)[0], expected)
+
+
+@pytest.mark.parametrize("name", ["launcher", "launcher 2"])
+def test_beyond_bisection_the_vectors_come_by_divide_and_conquer(name):
+    """More than BISECTED wanted with their vectors: syevd, scipy.linalg.eigh's "evd"
+    driver, its eigenvalues to the bit, and orthonormal eigenvectors of the kept
+    standard form (residuals at rounding of its norm)."""
+    reduced = coarse_pencil(MODELS[name](), 2).reduced
+    values, vectors = _standard_lowest(reduced, BISECTED + 1, vectors=True)
+    expected, expected_vectors = scipy.linalg.eigh(reduced, driver="evd", lower=True)
+    assert np.array_equal(values, expected) and np.array_equal(vectors, expected_vectors)
+    full = np.tril(reduced) + np.tril(reduced, -1).T
+    np.testing.assert_allclose(vectors.T @ vectors, np.eye(vectors.shape[1]), rtol=0, atol=1e-13)
+    assert np.max(np.abs(full @ vectors - vectors * values)) <= 1e-13 * np.abs(values).max()

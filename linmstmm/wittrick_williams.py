@@ -316,7 +316,7 @@ class ModeCounter:
         starts = np.array(starts, dtype=float).ravel()
         if self.engine != "compiled":
             return rayleigh.rayleigh_values_in_numpy(self, vectors, starts, inverse_steps)
-        vectors = np.array(vectors, dtype=float).reshape(starts.size, self.n_dof)  # the kernel's own copy
+        vectors = np.array(vectors, dtype=float, order="C").reshape(starts.size, self.n_dof)  # each piece contiguous: one compiled signature
         out = np.empty(starts.size)
         kernel, table = _stiffness_kernels().rayleigh_roots, self._beam_table()
 

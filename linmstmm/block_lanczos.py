@@ -1,4 +1,5 @@
-"""The lowest eigenvalues of a large sparse symmetric pencil by block shift-invert Lanczos.
+"""The lowest eigenvalues of a large sparse symmetric pencil, and their Ritz vectors, by
+block shift-invert Lanczos.
 
 For K x = λ M x (K symmetric positive semi-definite, M positive definite, both
 sparse) and a shift s > 0 below every wanted λ + s, the operator
@@ -10,7 +11,8 @@ last two (the Lanczos recurrence) and once more against every earlier one
 (full reorthogonalisation: no spurious copies), and normalises it in the M
 inner product (Cholesky). The Rayleigh quotient T of the basis gives the Ritz
 values; the subspace grows until each wanted one is within PRECISION of an
-eigenvalue.
+eigenvalue. Their Ritz vectors, the basis times T's eigenvectors, come where asked
+for (:func:`lowest_modes`).
 
 The accuracy asked for is that of a prediction, not of machine precision: a
 residual r of a Ritz value θ puts an eigenvalue within r of θ, and within r²/g

@@ -36,7 +36,7 @@ SINGULAR_PENCIL = 1e-12
 #: (see :func:`coarse_predictions`).
 DENSE_PREDICTION = 400
 #: Eigenvalues wanted of a dense standard form up to which only they are found, by
-#: bisection (syevx); beyond, all of them at once (dsyev: QR, dsterf) costs less: the
+#: bisection (syevx); beyond, all of them at once (syev, or syevd with vectors) costs less: the
 #: launcher's 68 lowest of 84 unknowns 1.2 against 0.2 ms, of 180 2.4 against 0.8 ms
 #: (at 12 of 84, 0.29 against 0.17 ms, but the few a solve of ten modes predicts stay
 #: to the bit those of the generalized solver sygvx).
@@ -98,10 +98,11 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     """:func:`coarse_predictions` with the modes at the nodes (``nodal``): the
     :class:`PredictedModes` of the mesh of ``elements_per_beam``.
 
-    The vectors come from the same LAPACK call as the frequencies, syevx, which gives
-    the same frequencies with them, bit for bit (all eigenvalues of the pencil asked
-    for take another path there: to rounding); about 80 µs more on the launcher's
-    84 unknowns for its 12 lowest.
+    The vectors come from the same call as the frequencies (:func:`_lowest_eigenvalues`).
+    Up to BISECTED that is syevx, which gives the same frequencies with them, bit for
+    bit, about 80 µs more on the launcher's 84 unknowns for its 12 lowest; beyond, syevd
+    with them and syev without, whose frequencies agree to rounding only; on the sparse
+    route the Lanczos's Ritz vectors, with the same frequencies.
     """
     if elements_per_beam > _finest_mesh(model):  # a dense solve would cost more than the search it saves
         return PredictedModes(np.zeros(0), None)

@@ -9,9 +9,9 @@ roots are predicted first and each evaluation goes where a root is:
    a few hundred unknowns, accurate to about 1e-3 for the lowest and 1e-2 by
    the hundredth (those the caller refined by the Rayleigh functional of the exact
    dynamic stiffness to about 1e-13, :mod:`linmstmm.rayleigh`, with a bracket);
-2. **polish** — where the requested accuracy is loose (``rtol`` from
-   COUNTED_PREDICTION up), a prediction with no other within CLUSTER that counts
-   at ±rtol across it certify stands as it is (:func:`_counted_predictions`);
+2. **polish** — where the caller asked for an ``rtol`` (from COUNTED_PREDICTION
+   up), a prediction with no other within CLUSTER that counts at ±rtol across it
+   certify stands as it is (:func:`_counted_predictions`);
    every other prediction by the secant method on det Ū_all
    (:func:`secant_roots`: one evaluation per step, superlinear, all roots in
    one batch per step; from a bracket's ends where it has one: a sign change
@@ -55,13 +55,16 @@ NEAR_KNOWN = 1e-5
 PLACING = 1e-4
 #: Predictions this close (relative) are one multiple root's (:func:`_coincident`).
 COINCIDENT = 1e-10
-#: From this rtol up, each prediction with no other within CLUSTER is first tried as
-#: it stands: where the Wittrick–Williams counts at ±rtol across it find one natural
-#: frequency, it is certified to rtol without an evaluation of det
-#: (:func:`_counted_predictions`). The coarse model predicts the launchers' ten
-#: lowest to within 2e-6, so from about that rtol most stand; below it the counts
-#: would be spent in vain (refined ones stand from it too).
-COUNTED_PREDICTION = 1e-6
+#: From this rtol up, where the caller asked for one (``RootFinder.unpolished``), each
+#: prediction with no other within CLUSTER is first tried as it stands: where the
+#: Wittrick–Williams counts at ±rtol across it find one natural frequency, it is
+#: certified to rtol without an evaluation of det (:func:`_counted_predictions`).
+#: The Rayleigh refinement brings the launchers' lone predictions within 5e-10
+#: (most within 1e-13), so from 1e-9 they stand: rtol 1e-9 took the launcher's ten
+#: lowest in no evaluation where the polish took 20. Counts narrower than 1e-9
+#: are too close to the root to decide (the dense count is tried, then the polish):
+#: at ±1e-10 the ten lowest took longer than polishing them.
+COUNTED_PREDICTION = 1e-9
 
 
 def predicted_roots(finder, predictions: np.ndarray, count: int, spans: np.ndarray | None = None):
@@ -204,8 +207,8 @@ def _counted_predictions(finder, predictions: np.ndarray, in_cluster: list[bool]
     those of ``predictions[start:stop]`` alone (no other prediction within CLUSTER:
     False in ``in_cluster``, :func:`clustered` of ``predictions``)
     across which the Wittrick–Williams counts at ±rtol find one natural frequency (so
-    a root lies within rtol of it), where the finder certifies to COUNTED_PREDICTION
-    or looser; none otherwise. A prediction taken so has the finder's rtol as its
+    a root lies within rtol of it), where the finder may list roots unpolished
+    (:attr:`RootFinder.unpolished`) to COUNTED_PREDICTION or looser; none otherwise. A prediction taken so has the finder's rtol as its
     last step (:attr:`RootFinder.last_step`). The counts are the certifying count's
     first ones across these values: it makes them once.
 
@@ -218,7 +221,7 @@ def _counted_predictions(finder, predictions: np.ndarray, in_cluster: list[bool]
     the default rtol took a few hundred).
     """
     counter = finder.counter
-    if counter is None or finder.rtol < COUNTED_PREDICTION or start >= stop:
+    if counter is None or not finder.unpolished or finder.rtol < COUNTED_PREDICTION or start >= stop:
         return [], np.arange(start, stop)
     values, width = predictions.tolist(), finder.rtol
     tried = [i for i in range(start, stop) if not in_cluster[i]]

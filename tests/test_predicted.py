@@ -138,7 +138,7 @@ def test_at_a_loose_rtol_a_prediction_stands_only_where_counts_hold_a_root_withi
     from linmstmm.predicted import _counted_predictions, clustered
 
     rtol = 1e-4
-    _, finder, _ = frequency_finder(launcher, rtol=rtol, xtol=1e-6)
+    _, finder, _ = frequency_finder(launcher, rtol=rtol, xtol=1e-6, unpolished=True)
     exact = 2 * np.pi * fe_frequencies(launcher, 8).frequencies_hz
     moved = exact * np.where(np.arange(8) % 2 == 0, 1 + 0.5 * rtol, 1 + 3 * rtol)
     standing, rest = _counted_predictions(finder, moved, clustered(moved), 0, 8)
@@ -147,12 +147,31 @@ def test_at_a_loose_rtol_a_prediction_stands_only_where_counts_hold_a_root_withi
 
 
 def test_at_the_default_rtol_no_prediction_stands_unpolished(launcher):
+    """The default polishes every root to rounding: not even the FE route's roots stand,
+    where the same finder told it may list them unpolished takes them."""
     from linmstmm.predicted import _counted_predictions, clustered
 
-    _, finder, _ = frequency_finder(launcher)
-    exact = 2 * np.pi * fe_frequencies(launcher, 4).frequencies_hz
-    standing, rest = _counted_predictions(finder, exact, clustered(exact), 0, 4)
-    assert standing == [] and list(rest) == [0, 1, 2, 3]
+    exact = 2 * np.pi * fe_frequencies(launcher, 4, rtol=1e-11).frequencies_hz
+    for unpolished, standing_expected in ((False, []), (True, list(exact))):
+        _, finder, _ = frequency_finder(launcher, unpolished=unpolished)
+        standing, rest = _counted_predictions(finder, exact, clustered(exact), 0, 4)
+        assert standing == standing_expected and list(rest) == ([] if unpolished else [0, 1, 2, 3])
+
+
+def test_rtol_1e9_asked_for_certifies_the_launchers_lowest_without_evaluating_det(launcher):
+    """Asked for rtol 1e-9, the Rayleigh-refined predictions of the ten lowest stand:
+    within 1e-9 of the FE route's roots, and of the default's, which polishes them
+    with 20 evaluations of det."""
+    from linmstmm.solve import natural_frequencies
+
+    asked = natural_frequencies(launcher, 10, rtol=1e-9, engine="compiled")
+    polished = natural_frequencies(launcher, 10, engine="compiled")
+    fe = fe_frequencies(launcher, 10, rtol=1e-11)
+    assert asked.evaluations == 0 < polished.evaluations
+    for found in (asked, polished):
+        np.testing.assert_allclose(found.frequencies_hz, fe.frequencies_hz,
+                                   rtol=max(1e-9, 3 * float(fe.error_estimate.max())), atol=0)
+    np.testing.assert_allclose(asked.frequencies_hz, polished.frequencies_hz, rtol=1e-9, atol=0)
 
 
 def test_the_launcher_at_rtol_1e4_is_certified_from_its_predictions_without_evaluating_det(launcher):

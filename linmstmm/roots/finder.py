@@ -50,6 +50,10 @@ class RootFinder:
     whose last step exceeds it is uncertified (the caller refines it in mpmath),
     and the Wittrick–Williams count across each root is made no narrower than it
     (:func:`~linmstmm.roots.certify.near_widths`).
+    unpolished : whether a prediction that Wittrick–Williams counts at ±rtol certify
+    may be listed as it stands, unpolished (an rtol the caller asked for; from
+    :data:`linmstmm.predicted.COUNTED_PREDICTION` up); False, the default, polishes
+    every root to xtol.
 
     Candidates come from the scan; each is polished by local linearisation
     (Newton for the nonlinear eigenproblem Ū(ω) v = 0): with A = Ū(ω) and
@@ -108,7 +112,7 @@ class RootFinder:
     def __init__(self, log_det, matrix, xtol: float = 1e-14,
                  points_per_octave: int = POINTS_PER_OCTAVE, points_per_root: int = 6,
                  rigid_body_modes: int = 0, predictor=None, scale: float = DEFAULT_SCALE,
-                 rtol: float = CERTIFIED_STEP):
+                 rtol: float = CERTIFIED_STEP, unpolished: bool = False):
         if not 0 < xtol <= MAX_XTOL:
             raise ValueError(f"xtol must be in (0, {MAX_XTOL:g}], got {xtol:g}: looser Newton "
                              "tolerances blur distinct roots into one")
@@ -129,6 +133,8 @@ class RootFinder:
         self.xtol = xtol
         #: relative accuracy each root is certified to (see the class docstring)
         self.rtol = rtol
+        #: whether a prediction counts certify within rtol may stand unpolished
+        self.unpolished = unpolished
         self.points_per_octave = points_per_octave
         self.points_per_root = points_per_root
         #: root -> relative size of the last Newton step that reached it

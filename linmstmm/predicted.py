@@ -37,7 +37,8 @@ import math
 import numpy as np
 
 from linmstmm.counting import deflated
-from linmstmm.prediction_groups import CLUSTER, clustered, clusters, polished_up_to
+from linmstmm.prediction_groups import (CLUSTER, cluster_reach, clustered, gap, gap_above, intervals_around,
+                                        polished_up_to)
 from linmstmm.secant import secant_roots
 
 #: Halvings of the range by counts before a stretch that misses a root is searched whole.
@@ -80,8 +81,9 @@ def predicted_roots(finder, predictions: np.ndarray, count: int, spans: np.ndarr
     Returns the roots, or None where a count cannot be made or does not come to zero
     (the caller then searches). Records each secant root's last step in
     ``finder.last_step``. Where a prediction stood unpolished (:func:`_counted_predictions`),
-    the roots must pass the Wittrick–Williams counts alone, else they are found
-    again with every prediction polished.
+    the roots must pass the Wittrick–Williams counts alone, else those that stood are
+    polished and the roots certified again (:func:`_stood_polished`), else they are
+    found again with every prediction polished.
     """
     predictions = np.asarray(predictions, dtype=float)
     spans = np.zeros(predictions.size) if spans is None else np.asarray(spans, dtype=float)
@@ -95,15 +97,42 @@ def predicted_roots(finder, predictions: np.ndarray, count: int, spans: np.ndarr
     # A value that stood (:func:`_counted_predictions`) is no zero of det: the argument
     # principle's count, with it divided out, takes it for any root missing. Where one
     # stood, the roots are kept only if the Wittrick–Williams counts alone certify them
-    # (those counts are made already); otherwise every prediction is polished. (None
-    # goes to the caller's search, which takes no prediction as it stands.) The values
+    # (those counts are made already); otherwise those that stood are polished, and
+    # failing that every prediction. (None goes to the caller's search, which takes
+    # no prediction as it stands.) The values
     # that stood are those recorded, not those a root equals: a secant root from a
     # bracket about a refined prediction can be that prediction to the bit, and taking
     # it for one that stood made the rod with planes 1e-7 apart polish its 60 lowest
     # twice (9,088 evaluations for 4,544).
     if stood and roots is not None and finder.stiffness_other_zeros(roots, None, upper) != 0:
-        roots, _ = _certified(finder, predictions, count, None, spans)
+        roots = _stood_polished(finder, predictions, spans, roots, stood, count, upper)
+        if roots is None:
+            roots, _ = _certified(finder, predictions, count, None, spans)
     return roots
+
+
+def _stood_polished(finder, predictions: np.ndarray, spans: np.ndarray, roots: list[float], stood: set[float],
+                    count: int, upper: float) -> list[float] | None:
+    """``roots`` (rad/s, ascending) with the values among them that ``stood`` unpolished
+    polished by the secant on det (from their brackets' ``spans``), certified again by
+    the argument principle (:func:`_closed`, above the ``count``-th, the predictions above
+    the first certifying count's end ``upper`` beyond them); None where one of them
+    does not settle or the roots cannot be certified.
+
+    Where the Wittrick–Williams counts alone cannot certify roots among which some
+    stood (the rod with planes 1e-7 apart, 30 lowest at rtol 1e-9: a count that
+    cannot decide), only those need det's zeros: polishing every prediction again,
+    the pairs' on the pencil too, took 6,310 evaluations where the first pass took 3,149."""
+    values, others = predictions.tolist(), list(roots)
+    among = [value for value in stood if value in others]  # (one above upper is no root of these)
+    for value in among:
+        others.remove(value)
+    indices = np.array([i for i, value in enumerate(values) if value in among], dtype=np.int64)
+    found, unsettled = _secant_polished(finder, predictions, clustered(predictions), indices, others,
+                                        len(values), spans)
+    if unsettled:
+        return None
+    return _closed(finder, sorted(others + found), count, [p for p in values if p > upper])[0]
 
 
 def _certified(finder, predictions: np.ndarray, count: int, stood: set[float] | None,
@@ -127,11 +156,20 @@ def _certified(finder, predictions: np.ndarray, count: int, stood: set[float] | 
         # three of its 30 lowest, and the full search took 29,453 evaluations): the
         # predictions not polished stand in for them to place the count's upper end,
         # and counts find them below it.
-        roots = _repaired(finder, roots, None, _gap_above(sorted(roots + beyond), count, _same_root(finder), []),
+        roots = _repaired(finder, roots, None, gap_above(sorted(roots + beyond), count, _same_root(finder), []),
                           REPAIR_DEPTH)
     if roots is None or len(roots) < count:
         return None, np.nan
-    upper = _gap_above(roots, count, _same_root(finder), beyond)
+    return _closed(finder, roots, count, beyond)
+
+
+def _closed(finder, roots: list[float], count: int, beyond: list[float]) -> tuple[list[float] | None, float]:
+    """(``roots`` (rad/s) up to the certifying count's upper end, or None; that end, rad/s,
+    placed in a gap above the ``count``-th by :func:`~linmstmm.prediction_groups.gap_above` with the predictions
+    ``beyond`` them, not polished): the argument principle's count with them divided
+    out, and where it does not come to zero, the stretch that holds the difference
+    searched (:func:`_repaired`) and the count made again."""
+    upper = gap_above(roots, count, _same_root(finder), beyond)
     # The predictions not polished above the count's contour, divided out too, change
     # no count but smooth its phase near the contour's upper end.
     beyond = [p for p in beyond if p > upper]
@@ -141,7 +179,7 @@ def _certified(finder, predictions: np.ndarray, count: int, stood: set[float] | 
         roots = _repaired(finder, roots, None, upper, REPAIR_DEPTH)
         if roots is None or len(roots) < count:
             return None, np.nan
-        upper = _gap_above(roots, count, _same_root(finder), beyond)
+        upper = gap_above(roots, count, _same_root(finder), beyond)
         if not finder.confirm_no_other_zeros(roots + beyond, upper):
             return None, np.nan
     return [r for r in roots if r <= upper], upper
@@ -168,7 +206,7 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
     found, troubled = _pencil_polished(finder, list(roots) + standing + found,
                                        unsettled + [float(p) for p in predictions[leaders]])
     found, troubled = _deflated_polished(finder, found, troubled, predictions)
-    for lo, hi in _intervals_around(troubled + [float(p) for p in predictions[followers]], predictions, found):
+    for lo, hi in intervals_around(troubled + [float(p) for p in predictions[followers]], predictions, found):
         counted = _completed_by_counts(finder, found, lo, hi)
         if counted is not None:
             found = counted
@@ -254,7 +292,7 @@ def _secant_polished(finder, predictions: np.ndarray, in_cluster: list[bool], in
 
     A prediction from the ``wanted``-th up (index ``wanted`` or more) alone in no
     cluster only places the certifying count's upper end in the gap above the roots
-    wanted (:func:`_gap_above`): it is polished to PLACING only, and stands so where
+    wanted (:func:`~linmstmm.prediction_groups.gap_above`): it is polished to PLACING only, and stands so where
     it lies more than CLUSTER above every root polished in full (and ``known``),
     which all settled; otherwise it is polished again in full, from where it came (the
     secant's steps are the same to either tolerance: one that does not settle to
@@ -291,7 +329,7 @@ def _settled(finder, predictions: np.ndarray, in_cluster: list[bool], indices: n
     roots = found.tolist()
     bounds = [PLACING if loose else finder.xtol if in_cluster[i] else finder.rtol
               for i, loose in zip(indices.tolist(), placing.tolist())]
-    settled = [not math.isnan(root) and abs(root - values[i]) <= 0.5 * _gap(values, i)
+    settled = [not math.isnan(root) and abs(root - values[i]) <= 0.5 * gap(values, i)
                and step <= bound and not _known(root, known, same)
                for i, root, step, bound in zip(indices.tolist(), roots, steps.tolist(), bounds)]
     for i in [k for k, stands in enumerate(settled) if stands]:  # two that settled on one root: neither stands
@@ -365,7 +403,7 @@ def _deflated_polished(finder, roots: list[float], starts: list[float],
         found, steps = secant_roots(deflated(finder.log_det, roots), np.array(starts), finder.xtol, 0.0)
         left, this_round = [], []
         for start, root, step in zip(starts, found, steps):
-            if (np.isnan(root) or step > finder.xtol or abs(root - start) > _cluster_reach(predictions, start)
+            if (np.isnan(root) or step > finder.xtol or abs(root - start) > cluster_reach(predictions, start)
                     or _known(root, roots, NEAR_KNOWN) or _known(root, this_round, _same_root(finder))):
                 left.append(start)
             else:
@@ -429,59 +467,3 @@ def _partner(root: float, offsets: np.ndarray, same: float, reach: float) -> flo
     real = offsets[(np.abs(offsets.imag) <= 1e-6 * np.abs(offsets)) & (np.abs(offsets) > same * root)
                    & (np.abs(offsets) <= reach * root)].real
     return float(root - real[np.argmin(np.abs(real))]) if real.size else None
-
-
-def _intervals_around(troubled: list[float], predictions: np.ndarray, roots: list[float]) -> list[tuple]:
-    """Disjoint intervals (lo, hi], rad/s, each holding troubled predictions and
-    reaching halfway (geometrically) to the nearest prediction on either side that
-    is neither among them nor within CLUSTER of one (the other prediction of a
-    double root is inside: an edge between the two lay on the root, and rounding
-    alone, the model's units, decided which side its one counted copy fell), and
-    below down to the nearest known root (``roots``, rad/s) under the prediction:
-    the segment search runs there. (The coarse model's predictions lie above the
-    roots they predict: the second of a close pair can lie below the halfway point
-    between their predictions.)"""
-    intervals: list[list[float]] = []
-    troubled_set = set(troubled)
-    for start in sorted(troubled):
-        outside = [p for p in predictions if p not in troubled_set and abs(p - start) > CLUSTER * start]
-        below = [p for p in outside if p < start]
-        above = [p for p in outside if p > start]
-        lo = np.sqrt(start * below[-1]) if below else start / 2
-        under = [r for r in roots if r < start]
-        if under:
-            lo = min(lo, max(under) * (1 + CLUSTER * 1e-3))
-        hi = np.sqrt(start * above[0]) if above else start * 1.5
-        if intervals and lo <= intervals[-1][1]:
-            intervals[-1][1] = max(intervals[-1][1], hi)
-        else:
-            intervals.append([lo, hi])
-    return [(float(lo), float(hi)) for lo, hi in intervals]
-
-
-def _cluster_reach(predictions: np.ndarray, start: float) -> float:
-    """Half the distance, rad/s, from the cluster of ``predictions`` (ascending) that
-    holds ``start`` to the nearest prediction outside it (``start`` itself if none)."""
-    group = next(g for g in clusters(predictions) if predictions[g[0]] <= start <= predictions[g[-1]])
-    outside = np.r_[predictions[:group[0]], predictions[group[-1] + 1:]]
-    if not outside.size:
-        return float(start)
-    return 0.5 * float(np.min(np.minimum(np.abs(outside - predictions[group[0]]),
-                                         np.abs(outside - predictions[group[-1]]))))
-
-
-def _gap(predictions: list[float], i: int) -> float:
-    """Distance from prediction i of ``predictions`` (ascending) to its nearest
-    neighbour, one of the two beside it (its own size if alone)."""
-    beside = [abs(predictions[j] - predictions[i]) for j in (i - 1, i + 1) if 0 <= j < len(predictions)]
-    return min(beside) if beside else predictions[i]
-
-
-def _gap_above(roots: list[float], count: int, same: float, beyond: list[float]) -> float:
-    """Upper end of the certifying count: between the count-th root and the next
-    distinct one (farther than ``same``, relative: a multiple root the count cuts
-    is counted whole), a root or one of the unpolished predictions ``beyond`` (rad/s),
-    or a little above the last if there is none."""
-    last = roots[count - 1]
-    above = [r for r in [*roots[count:], *beyond] if r > last * (1 + same)]
-    return float(np.sqrt(last * min(above))) if above else float(last * (1 + CLUSTER))

@@ -1,8 +1,10 @@
-"""Which predictions a predicted search polishes, and which stand alone.
+"""Which predictions a predicted search polishes, which stand alone, and the gaps between them.
 
 Shared by the search itself (:mod:`linmstmm.predicted`) and the refinement of its
 predictions (:mod:`linmstmm.rayleigh`), which refines those the search polishes that
-no other prediction stands close to.
+no other prediction stands close to. The search also places its certifying count's
+upper end (:func:`gap_above`), its segment searches (:func:`intervals_around`) and
+its pencil's reach in a cluster (:func:`cluster_reach`) by the predictions' positions.
 """
 from __future__ import annotations
 
@@ -39,3 +41,59 @@ def polished_up_to(predictions: np.ndarray, count: int) -> int:
     lowest ``count`` polishes: those up to NEAR_COUNT above the count-th (the others only
     place its certifying count's upper end)."""
     return int(np.searchsorted(predictions, predictions[count - 1] * (1 + NEAR_COUNT), side="right"))
+
+
+def gap(predictions: list[float], i: int) -> float:
+    """Distance from prediction i of ``predictions`` (ascending) to its nearest
+    neighbour, one of the two beside it (its own size if alone)."""
+    beside = [abs(predictions[j] - predictions[i]) for j in (i - 1, i + 1) if 0 <= j < len(predictions)]
+    return min(beside) if beside else predictions[i]
+
+
+def gap_above(roots: list[float], count: int, same: float, beyond: list[float]) -> float:
+    """Upper end of the certifying count: between the count-th root and the next
+    distinct one (farther than ``same``, relative: a multiple root the count cuts
+    is counted whole), a root or one of the unpolished predictions ``beyond`` (rad/s),
+    or a little above the last if there is none."""
+    last = roots[count - 1]
+    above = [r for r in [*roots[count:], *beyond] if r > last * (1 + same)]
+    return float(np.sqrt(last * min(above))) if above else float(last * (1 + CLUSTER))
+
+
+def cluster_reach(predictions: np.ndarray, start: float) -> float:
+    """Half the distance, rad/s, from the cluster of ``predictions`` (ascending) that
+    holds ``start`` to the nearest prediction outside it (``start`` itself if none)."""
+    group = next(g for g in clusters(predictions) if predictions[g[0]] <= start <= predictions[g[-1]])
+    outside = np.r_[predictions[:group[0]], predictions[group[-1] + 1:]]
+    if not outside.size:
+        return float(start)
+    return 0.5 * float(np.min(np.minimum(np.abs(outside - predictions[group[0]]),
+                                         np.abs(outside - predictions[group[-1]]))))
+
+
+def intervals_around(troubled: list[float], predictions: np.ndarray, roots: list[float]) -> list[tuple]:
+    """Disjoint intervals (lo, hi], rad/s, each holding troubled predictions and
+    reaching halfway (geometrically) to the nearest prediction on either side that
+    is neither among them nor within CLUSTER of one (the other prediction of a
+    double root is inside: an edge between the two lay on the root, and rounding
+    alone, the model's units, decided which side its one counted copy fell), and
+    below down to the nearest known root (``roots``, rad/s) under the prediction:
+    the segment search runs there. (The coarse model's predictions lie above the
+    roots they predict: the second of a close pair can lie below the halfway point
+    between their predictions.)"""
+    intervals: list[list[float]] = []
+    troubled_set = set(troubled)
+    for start in sorted(troubled):
+        outside = [p for p in predictions if p not in troubled_set and abs(p - start) > CLUSTER * start]
+        below = [p for p in outside if p < start]
+        above = [p for p in outside if p > start]
+        lo = np.sqrt(start * below[-1]) if below else start / 2
+        under = [r for r in roots if r < start]
+        if under:
+            lo = min(lo, max(under) * (1 + CLUSTER * 1e-3))
+        hi = np.sqrt(start * above[0]) if above else start * 1.5
+        if intervals and lo <= intervals[-1][1]:
+            intervals[-1][1] = max(intervals[-1][1], hi)
+        else:
+            intervals.append([lo, hi])
+    return [(float(lo), float(hi)) for lo, hi in intervals]

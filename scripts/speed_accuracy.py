@@ -726,7 +726,7 @@ def rtol_target_row(points) -> str:
     met = speedup >= 3 and loose["error"] <= 1e-4
     return (f"| MLRS first {COUNT}: `rtol=1e-4` at least 3× faster than the default, within 1e-4 | default "
             f"{fmt_time(default['seconds'])}; {by_rtol} | **{'met' if met else 'not met'}** ({speedup:.2f}× on "
-            "first solves by the numpy engine, what a new process runs: from rtol 1e-6 up a prediction the "
+            "first solves by the numpy engine, what a new process runs: from rtol 1e-9 up a prediction the "
             "counts at ±rtol hold stands unpolished, but compiling the model costs the same at every rtol; "
             "by engine, first solve and compiled model, see the rtol table of speed.md) |")
 

@@ -26,9 +26,11 @@ roots are predicted first and each evaluation goes where a root is:
    Where it does not (a root the coarse model ranked out of range, one found
    twice), counts halve the range to the stretch that holds the difference and
    the segment search fills only that (:func:`_repaired`); the count is made
-   again. Where a count cannot be made, :func:`predicted_roots` returns None
-   and the caller runs the full search. Completeness is never taken from the
-   predictions.
+   again. Where predictions stood unpolished, which are no zeros of det, the
+   Wittrick–Williams counts alone must certify the roots; where they cannot
+   decide, the values that stood are polished before the count. Where a count
+   cannot be made, :func:`predicted_roots` returns None and the caller runs the
+   full search. Completeness is never taken from the predictions.
 """
 from __future__ import annotations
 
@@ -92,55 +94,14 @@ def predicted_roots(finder, predictions: np.ndarray, count: int, spans: np.ndarr
     predictions, spans = predictions[order], spans[order]
     if predictions.size < count:
         return None
-    stood: set[float] = set()
-    roots, upper = _certified(finder, predictions, count, stood, spans)
-    # A value that stood (:func:`_counted_predictions`) is no zero of det: the argument
-    # principle's count, with it divided out, takes it for any root missing. Where one
-    # stood, the roots are kept only if the Wittrick–Williams counts alone certify them
-    # (those counts are made already); otherwise those that stood are polished, and
-    # failing that every prediction. (None goes to the caller's search, which takes
-    # no prediction as it stands.) The values
-    # that stood are those recorded, not those a root equals: a secant root from a
-    # bracket about a refined prediction can be that prediction to the bit, and taking
-    # it for one that stood made the rod with planes 1e-7 apart polish its 60 lowest
-    # twice (9,088 evaluations for 4,544).
-    if stood and roots is not None and finder.stiffness_other_zeros(roots, None, upper) != 0:
-        roots = _stood_polished(finder, predictions, spans, roots, stood, count, upper)
-        if roots is None:
-            roots, _ = _certified(finder, predictions, count, None, spans)
-    return roots
-
-
-def _stood_polished(finder, predictions: np.ndarray, spans: np.ndarray, roots: list[float], stood: set[float],
-                    count: int, upper: float) -> list[float] | None:
-    """``roots`` (rad/s, ascending) with the values among them that ``stood`` unpolished
-    polished by the secant on det (from their brackets' ``spans``), certified again by
-    the argument principle (:func:`_closed`, above the ``count``-th, the predictions above
-    the first certifying count's end ``upper`` beyond them); None where one of them
-    does not settle or the roots cannot be certified.
-
-    Where the Wittrick–Williams counts alone cannot certify roots among which some
-    stood (the rod with planes 1e-7 apart, 30 lowest at rtol 1e-9: a count that
-    cannot decide), only those need det's zeros: polishing every prediction again,
-    the pairs' on the pencil too, took 6,310 evaluations where the first pass took 3,149."""
-    values, others = predictions.tolist(), list(roots)
-    among = [value for value in stood if value in others]  # (one above upper is no root of these)
-    for value in among:
-        others.remove(value)
-    indices = np.array([i for i, value in enumerate(values) if value in among], dtype=np.int64)
-    found, unsettled = _secant_polished(finder, predictions, clustered(predictions), indices, others,
-                                        len(values), spans)
-    if unsettled:
-        return None
-    return _closed(finder, sorted(others + found), count, [p for p in values if p > upper])[0]
+    return _certified(finder, predictions, count, set(), spans)
 
 
 def _certified(finder, predictions: np.ndarray, count: int, stood: set[float] | None,
-               spans: np.ndarray) -> tuple[list[float] | None, float]:
-    """(the roots :func:`predicted_roots` returns, rad/s, or None; the upper end of
-    their certifying count, rad/s): from ``predictions`` (ascending, positive; with
-    their brackets' ``spans``), with those that counts certify as they stand taken so,
-    and added to ``stood``, unless it is None."""
+               spans: np.ndarray) -> list[float] | None:
+    """The roots :func:`predicted_roots` returns (rad/s), or None: from ``predictions``
+    (ascending, positive; with their brackets' ``spans``), with those that counts
+    certify as they stand taken so, and added to ``stood``, unless it is None."""
     wanted = polished_up_to(predictions, count)
     roots = _polished(finder, predictions, [], 0, wanted, stood, count, spans)
     if roots is not None and len(roots) < count < predictions.size:  # some predicted twice: as many more
@@ -149,7 +110,7 @@ def _certified(finder, predictions: np.ndarray, count: int, stood: set[float] | 
         roots = _polished(finder, predictions, roots, wanted, more, stood, more, spans)
         wanted = more
     if roots is None:
-        return None, np.nan
+        return None
     beyond = list(predictions[wanted:])
     if len(roots) < count <= len(roots) + len(beyond):
         # The polish lost some (onto a neighbour's root: a rod's pairs 1e-5 apart lost
@@ -159,16 +120,52 @@ def _certified(finder, predictions: np.ndarray, count: int, stood: set[float] | 
         roots = _repaired(finder, roots, None, gap_above(sorted(roots + beyond), count, _same_root(finder), []),
                           REPAIR_DEPTH)
     if roots is None or len(roots) < count:
-        return None, np.nan
+        return None
+    if stood:
+        # A value that stood (:func:`_counted_predictions`) is no zero of det: the argument
+        # principle's count, with it divided out, takes it for any root missing. The
+        # Wittrick–Williams counts alone must certify the roots as they are (those counts
+        # are made already); where they do not, the values that stood are polished first
+        # (:func:`_stood_polished`), and where one does not settle, every prediction.
+        upper = gap_above(roots, count, _same_root(finder), beyond)
+        if finder.stiffness_other_zeros(roots, None, upper) == 0:
+            return [r for r in roots if r <= upper]
+        roots = _stood_polished(finder, predictions, spans, roots, stood)
+        if roots is None:
+            return _certified(finder, predictions, count, None, spans)
     return _closed(finder, roots, count, beyond)
 
 
-def _closed(finder, roots: list[float], count: int, beyond: list[float]) -> tuple[list[float] | None, float]:
-    """(``roots`` (rad/s) up to the certifying count's upper end, or None; that end, rad/s,
-    placed in a gap above the ``count``-th by :func:`~linmstmm.prediction_groups.gap_above` with the predictions
-    ``beyond`` them, not polished): the argument principle's count with them divided
-    out, and where it does not come to zero, the stretch that holds the difference
-    searched (:func:`_repaired`) and the count made again."""
+def _stood_polished(finder, predictions: np.ndarray, spans: np.ndarray, roots: list[float],
+                    stood: set[float]) -> list[float] | None:
+    """``roots`` (rad/s) with the values among them that ``stood`` unpolished polished by
+    the secant on det (from their brackets' ``spans``), ascending; None where one of
+    them does not settle.
+
+    Where the Wittrick–Williams counts alone cannot certify roots among which some
+    stood (the rod with planes 1e-7 apart, 30 lowest at rtol 1e-9: a count by a pair
+    cannot decide), only those need to be det's zeros for the argument principle:
+    polishing every prediction again, the pairs' on the pencil too, took 6,310
+    evaluations; polishing the six that stood, 3,159 in all (the default, 3,164). The values that stood are those recorded,
+    not those a root equals: a secant root from a bracket about a refined prediction
+    can be that prediction to the bit (taking it for one that stood made the same rod's
+    60 lowest polish twice, 9,088 evaluations for 4,544)."""
+    values, others = predictions.tolist(), list(roots)
+    among = [value for value in stood if value in others]  # (one above the count's end is no root)
+    for value in among:
+        others.remove(value)
+    indices = np.array([i for i, value in enumerate(values) if value in among], dtype=np.int64)
+    found, unsettled = _secant_polished(finder, predictions, clustered(predictions), indices, others,
+                                        len(values), spans)
+    return None if unsettled else sorted(others + found)
+
+
+def _closed(finder, roots: list[float], count: int, beyond: list[float]) -> list[float] | None:
+    """``roots`` (rad/s) up to the certifying count's upper end, or None: that end placed
+    in a gap above the ``count``-th by :func:`~linmstmm.prediction_groups.gap_above`,
+    with the predictions ``beyond`` them, not polished; the argument principle's count
+    with them divided out, and where it does not come to zero, the stretch that holds
+    the difference searched (:func:`_repaired`) and the count made again."""
     upper = gap_above(roots, count, _same_root(finder), beyond)
     # The predictions not polished above the count's contour, divided out too, change
     # no count but smooth its phase near the contour's upper end.
@@ -178,11 +175,11 @@ def _closed(finder, roots: list[float], count: int, beyond: list[float]) -> tupl
         # halve by counts to the stretch that holds it and search only there.
         roots = _repaired(finder, roots, None, upper, REPAIR_DEPTH)
         if roots is None or len(roots) < count:
-            return None, np.nan
+            return None
         upper = gap_above(roots, count, _same_root(finder), beyond)
         if not finder.confirm_no_other_zeros(roots + beyond, upper):
-            return None, np.nan
-    return [r for r in roots if r <= upper], upper
+            return None
+    return [r for r in roots if r <= upper]
 
 
 def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, stop: int,

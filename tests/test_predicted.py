@@ -236,9 +236,9 @@ def test_a_root_equal_to_its_prediction_is_not_taken_for_one_that_stood(monkeypa
 def test_where_counts_alone_cannot_certify_only_the_predictions_that_stood_are_polished(monkeypatch):
     """The same cantilever's 30 lowest at rtol 1e-9 asked for: six lone predictions stand,
     and a Wittrick–Williams count by a pair cannot decide, so det's zeros are needed.
-    Only the six are polished and the roots certified again; polishing every prediction
-    again, the pairs' on the pencil too, took 6,310 evaluations where one pass takes
-    3,187. The bending roots of both planes hold to rtol against their closed form."""
+    Only the six are polished before the argument principle's count; polishing every
+    prediction again, the pairs' on the pencil too, took 6,310 evaluations where this
+    takes 3,159. The bending roots of both planes hold to rtol against their closed form."""
     from linmstmm import predicted
     from linmstmm.solve import natural_frequencies
 

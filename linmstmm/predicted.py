@@ -146,10 +146,11 @@ def _stood_polished(finder, predictions: np.ndarray, spans: np.ndarray, roots: l
     stood (the rod with planes 1e-7 apart, 30 lowest at rtol 1e-9: a count by a pair
     cannot decide), only those need to be det's zeros for the argument principle:
     polishing every prediction again, the pairs' on the pencil too, took 6,310
-    evaluations; polishing the six that stood, 3,159 in all (the default, 3,164). The values that stood are those recorded,
-    not those a root equals: a secant root from a bracket about a refined prediction
-    can be that prediction to the bit (taking it for one that stood made the same rod's
-    60 lowest polish twice, 9,088 evaluations for 4,544)."""
+    evaluations; polishing the six that stood, 3,159 in all (the default, 3,164).
+    The values that stood are those recorded, not those a root equals: a secant root
+    from a bracket about a refined prediction can be that prediction to the bit
+    (taking it for one that stood made the same rod's 60 lowest polish twice, 9,088
+    evaluations for 4,544)."""
     values, others = predictions.tolist(), list(roots)
     among = [value for value in stood if value in others]  # (one above the count's end is no root)
     for value in among:
@@ -243,9 +244,10 @@ def _counted_predictions(finder, predictions: np.ndarray, in_cluster: list[bool]
     False in ``in_cluster``, :func:`clustered` of ``predictions``)
     across which the Wittrick–Williams counts at ±rtol find one natural frequency (so
     a root lies within rtol of it), where the finder may list roots unpolished
-    (:attr:`RootFinder.unpolished`) to COUNTED_PREDICTION or looser; none otherwise. A prediction taken so has the finder's rtol as its
-    last step (:attr:`RootFinder.last_step`). The counts are the certifying count's
-    first ones across these values: it makes them once.
+    (:attr:`RootFinder.unpolished`) to COUNTED_PREDICTION or looser; none otherwise.
+    A prediction taken so has the finder's rtol as its last step
+    (:attr:`RootFinder.last_step`). The counts are the certifying count's first ones
+    across these values: it makes them once.
 
     A value that stands is known to rtol only, where the rest of the search tells
     roots apart far more finely, so a cluster's members are not tried: a double
@@ -289,9 +291,9 @@ def _secant_polished(finder, predictions: np.ndarray, in_cluster: list[bool], in
 
     A prediction from the ``wanted``-th up (index ``wanted`` or more) alone in no
     cluster only places the certifying count's upper end in the gap above the roots
-    wanted (:func:`~linmstmm.prediction_groups.gap_above`): it is polished to PLACING only, and stands so where
-    it lies more than CLUSTER above every root polished in full (and ``known``),
-    which all settled; otherwise it is polished again in full, from where it came (the
+    wanted (:func:`~linmstmm.prediction_groups.gap_above`): it is polished to PLACING
+    only, and stands so where it lies more than CLUSTER above every root polished in
+    full (and ``known``), which all settled; otherwise it is polished again in full, from where it came (the
     secant's steps are the same to either tolerance: one that does not settle to
     PLACING would not to xtol either).
     """

@@ -83,9 +83,7 @@ def predicted_roots(finder, predictions: np.ndarray, count: int, spans: np.ndarr
     Returns the roots, or None where a count cannot be made or does not come to zero
     (the caller then searches). Records each secant root's last step in
     ``finder.last_step``. Where a prediction stood unpolished (:func:`_counted_predictions`),
-    the roots must pass the Wittrick–Williams counts alone, else those that stood are
-    polished and the roots certified again (:func:`_stood_polished`), else they are
-    found again with every prediction polished.
+    the roots must pass the Wittrick–Williams counts alone (:func:`_stood_certified`).
     """
     predictions = np.asarray(predictions, dtype=float)
     spans = np.zeros(predictions.size) if spans is None else np.asarray(spans, dtype=float)
@@ -122,18 +120,37 @@ def _certified(finder, predictions: np.ndarray, count: int, stood: set[float] | 
     if roots is None or len(roots) < count:
         return None
     if stood:
-        # A value that stood (:func:`_counted_predictions`) is no zero of det: the argument
-        # principle's count, with it divided out, takes it for any root missing. The
-        # Wittrick–Williams counts alone must certify the roots as they are (those counts
-        # are made already); where they do not, the values that stood are polished first
-        # (:func:`_stood_polished`), and where one does not settle, every prediction.
-        upper = gap_above(roots, count, _same_root(finder), beyond)
-        if finder.stiffness_other_zeros(roots, None, upper) == 0:
-            return [r for r in roots if r <= upper]
-        roots = _stood_polished(finder, predictions, spans, roots, stood)
-        if roots is None:
-            return _certified(finder, predictions, count, None, spans)
-    return _closed(finder, roots, count, beyond)
+        return _stood_certified(finder, predictions, spans, roots, stood, count, beyond)
+    return _cut(*_closed(finder, roots, count, beyond))
+
+
+def _stood_certified(finder, predictions: np.ndarray, spans: np.ndarray, roots: list[float], stood: set[float],
+                     count: int, beyond: list[float]) -> list[float] | None:
+    """:func:`_certified`'s roots (rad/s) from ``roots``, among which some values ``stood``
+    unpolished; the predictions ``beyond`` them place the certifying count's end.
+
+    A value that stood (:func:`_counted_predictions`) is no zero of det: the argument
+    principle's count, with it divided out, takes it for any root missing. So the
+    Wittrick–Williams counts alone must certify the roots (those counts are made
+    already). Where they find roots missing or misplaced (the end placed above a root
+    the polish lost), the roots are repaired as they are (:func:`_closed`) and the
+    counts alone asked again. Where those cannot decide (a count by a close pair), or
+    still disagree, the values that stood are polished (:func:`_stood_polished`) before
+    the argument principle's count; where one does not settle, every prediction is."""
+    upper = gap_above(roots, count, _same_root(finder), beyond)
+    missing = finder.stiffness_other_zeros(roots, None, upper)
+    if missing == 0:
+        return _cut(roots, upper)
+    if missing is not None:
+        repaired, upper = _closed(finder, roots, count, beyond)
+        if repaired is not None:
+            if finder.stiffness_other_zeros(_cut(repaired, upper), None, upper) == 0:
+                return _cut(repaired, upper)
+            roots = repaired
+    roots = _stood_polished(finder, predictions, spans, roots, stood)
+    if roots is None:
+        return _certified(finder, predictions, count, None, spans)
+    return _cut(*_closed(finder, roots, count, beyond))
 
 
 def _stood_polished(finder, predictions: np.ndarray, spans: np.ndarray, roots: list[float],
@@ -161,12 +178,18 @@ def _stood_polished(finder, predictions: np.ndarray, spans: np.ndarray, roots: l
     return None if unsettled else sorted(others + found)
 
 
-def _closed(finder, roots: list[float], count: int, beyond: list[float]) -> list[float] | None:
-    """``roots`` (rad/s) up to the certifying count's upper end, or None: that end placed
-    in a gap above the ``count``-th by :func:`~linmstmm.prediction_groups.gap_above`,
-    with the predictions ``beyond`` them, not polished; the argument principle's count
-    with them divided out, and where it does not come to zero, the stretch that holds
-    the difference searched (:func:`_repaired`) and the count made again."""
+def _cut(roots: list[float] | None, upper: float) -> list[float] | None:
+    """``roots`` (rad/s) up to ``upper`` (rad/s), the certifying count's end; None stays None."""
+    return None if roots is None else [r for r in roots if r <= upper]
+
+
+def _closed(finder, roots: list[float], count: int, beyond: list[float]) -> tuple[list[float] | None, float]:
+    """(``roots`` (rad/s), repaired where needed, or None; the certifying count's upper
+    end, rad/s, up to which they are certified), the end placed in a gap above the ``count``-th by
+    :func:`~linmstmm.prediction_groups.gap_above`, with the predictions ``beyond`` them,
+    not polished: the argument principle's count with them divided out, and where it
+    does not come to zero, the stretch that holds the difference searched
+    (:func:`_repaired`) and the count made again."""
     upper = gap_above(roots, count, _same_root(finder), beyond)
     # The predictions not polished above the count's contour, divided out too, change
     # no count but smooth its phase near the contour's upper end.
@@ -176,11 +199,11 @@ def _closed(finder, roots: list[float], count: int, beyond: list[float]) -> list
         # halve by counts to the stretch that holds it and search only there.
         roots = _repaired(finder, roots, None, upper, REPAIR_DEPTH)
         if roots is None or len(roots) < count:
-            return None
+            return None, upper
         upper = gap_above(roots, count, _same_root(finder), beyond)
         if not finder.confirm_no_other_zeros(roots + beyond, upper):
-            return None
-    return [r for r in roots if r <= upper]
+            return None, upper
+    return roots, upper
 
 
 def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, stop: int,

@@ -28,7 +28,8 @@ roots are predicted first and each evaluation goes where a root is:
    the segment search fills only that (:func:`_repaired`); the count is made
    again. Where predictions stood unpolished, which are no zeros of det, the
    Wittrick–Williams counts alone must certify the roots; where they cannot
-   decide, the values that stood are polished before the count. Where a count
+   decide, the values that stood are polished before the argument principle's
+   count (:func:`_stood_certified`). Where a count
    cannot be made, :func:`predicted_roots` returns None and the caller runs the
    full search. Completeness is never taken from the predictions.
 """

@@ -254,13 +254,13 @@ def test_where_counts_alone_cannot_certify_only_the_predictions_that_stood_are_p
 
 
 def _rod_with_close_planes(gap: float):
-    """A 1.5 m steel cantilever whose bending planes are ``gap`` apart: Iz = Iy (1 + gap)²."""
-    from linmstmm.model import Beam, Model
+    """A 1.5 m steel cantilever whose bending planes are ``gap`` apart: Iz = Iy (1 + gap)²
+    (test_rtol's rods)."""
+    from builders import fixed, single_beam_model
 
-    E, rho, A, Iy, L = 2e11, 7800.0, 1e-3, 3e-7, 1.5
-    beam = Beam("rod", ("root", "tip"), E, 8e10, rho, A, Iy, Iy * (1 + gap) ** 2, 2e-7, 4.2e-7, np.eye(3), L)
-    return Model("rod", {"root": np.zeros(3), "tip": np.array([L, 0.0, 0.0])}, beams=(beam,),
-                 boundary={"root": np.ones(6, dtype=bool)})
+    iy = 3e-7
+    return single_beam_model(fixed(), None, length=1.5, A=1e-3, Iy=iy, Iz=iy * (1 + gap) ** 2, J=2e-7,
+                             Ip=4.2e-7, material=dict(E=2e11, G=8e10, rho=7800.0))
 
 
 def _worst_bending_error(model, result) -> float:

@@ -145,8 +145,9 @@ def _stood_certified(finder, predictions: np.ndarray, spans: np.ndarray, roots: 
     if missing is not None:
         repaired, upper = _closed(finder, roots, count, beyond)
         if repaired is not None:
-            if finder.stiffness_other_zeros(_cut(repaired, upper), None, upper) == 0:
-                return _cut(repaired, upper)
+            certified = _cut(repaired, upper)
+            if finder.stiffness_other_zeros(certified, None, upper) == 0:
+                return certified
             roots = repaired
     roots = _stood_polished(finder, predictions, spans, roots, stood)
     if roots is None:

@@ -1,7 +1,8 @@
 """Block shift-invert Lanczos (linmstmm.block_lanczos) against closed forms: a fixed-fixed
 chain of equal masses and springs has the eigenvalues (4k/m) sin²(jπ / 2(n+1)) and the
-modes sin(i j π / (n+1)), two such chains side by side each of them twice. The coarse prediction's sparse route gives
-ARPACK's frequencies, and where the Lanczos gives no answer the dense route answers."""
+modes sin(i j π / (n+1)), two such chains side by side each of them twice. The coarse
+prediction's sparse route gives ARPACK's frequencies, and where the Lanczos gives no
+answer the dense route answers."""
 from __future__ import annotations
 
 import numpy as np

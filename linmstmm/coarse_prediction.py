@@ -11,7 +11,8 @@ it by counts.
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
@@ -19,6 +20,7 @@ import scipy.linalg
 from linmstmm.block_lanczos import lowest_eigenvalues, lowest_modes
 from linmstmm.elements.beam import bending_wavenumber
 from linmstmm.fe.sparse import scipy_csr
+from linmstmm.standard_eigen import Bisection, lowest_eigenpairs
 from linmstmm.fe.node_constraints import kept_node_constraints
 from linmstmm.model import Model
 
@@ -35,12 +37,6 @@ SINGULAR_PENCIL = 1e-12
 #: Unknowns of the predicting FE model above which its eigenproblem is solved sparse
 #: (see :func:`coarse_predictions`).
 DENSE_PREDICTION = 400
-#: Eigenvalues wanted of a dense standard form up to which only they are found, by
-#: bisection (syevx); beyond, all of them at once (syev, or syevd with vectors) costs less: the
-#: launcher's 68 lowest of 84 unknowns 1.2 against 0.2 ms, of 180 2.4 against 0.8 ms
-#: (at 12 of 84, 0.29 against 0.17 ms, but the few a solve of ten modes predicts stay
-#: to the bit those of the generalized solver sygvx).
-BISECTED = 40
 #: Coarse pencils kept (:func:`coarse_pencil`; a model's meshes, least recently used dropped first).
 PENCILS_KEPT = 16
 #: Elements per beam the predicting mesh may take.
@@ -54,8 +50,9 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
     elements_per_beam : Hermite elements per beam; bending frequencies come
     out high by about (βh)⁴/720 relative, h the element length. The dense
     generalized eigenproblem (K, M) in its kept standard form: its lowest
-    eigenvalues only, or all at once where more than BISECTED are wanted; where M
-    is singular (massless unknowns) by QZ, whose infinite eigenvalues are dropped.
+    eigenvalues only, or all at once where more than
+    :data:`~linmstmm.standard_eigen.BISECTED` are wanted; where M is singular
+    (massless unknowns) by QZ, whose infinite eigenvalues are dropped.
     shift : (rad/s)², below the lowest elastic eigenvalue (half a coarser mesh's
     lowest), given for a refined mesh: where every unknown carries mass and there
     are more than DENSE_PREDICTION of them, sparse block shift-invert Lanczos about
@@ -87,10 +84,17 @@ class PredictedModes:
         first): the eigenvector there, unnormalised (a Ritz vector on the sparse
         route). None where they were not asked for, or the pencil has massless
         unknowns (QZ gives no vectors).
+    later : callable (rows=None) -> numpy.ndarray, or None
+        Where ``nodal`` is None and the eigensolve can give the modes afterwards
+        (bisection, :class:`~linmstmm.standard_eigen.Bisection`): what ``nodal`` would
+        have been, the same to the bit, without the eigenvalues found again; given
+        ``rows`` (k indices into ``values``), only those modes (k, ...), made alone
+        (the same to rounding where their frequencies are apart).
     """
 
     values: np.ndarray
     nodal: np.ndarray | None
+    later: Callable[[], np.ndarray] | None = field(default=None, repr=False)
 
 
 def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: float | None = None,
@@ -98,11 +102,12 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     """:func:`coarse_predictions` with the modes at the nodes (``nodal``): the
     :class:`PredictedModes` of the mesh of ``elements_per_beam``.
 
-    The vectors come from the same call as the frequencies (:func:`_lowest_eigenvalues`).
-    Up to BISECTED that is syevx, which gives the same frequencies with them, bit for
-    bit, about 80 µs more on the launcher's 84 unknowns for its 12 lowest; beyond, syevd
-    with them and syev without, whose frequencies agree to rounding only; on the sparse
-    route the Lanczos's Ritz vectors, with the same frequencies.
+    The vectors come from the same eigensolve as the frequencies (:func:`_lowest_eigenvalues`).
+    Up to :data:`~linmstmm.standard_eigen.BISECTED` that is syevx's steps, which give
+    the same frequencies with them, bit for bit, about 80 µs more on the launcher's 84
+    unknowns for its 12 lowest, now or later (:attr:`PredictedModes.later`); beyond,
+    syevd with them and syev without, whose frequencies agree to rounding only; on the
+    sparse route the Lanczos's Ritz vectors, with the same frequencies.
     """
     if elements_per_beam > _finest_mesh(model):  # a dense solve would cost more than the search it saves
         return PredictedModes(np.zeros(0), None)
@@ -110,10 +115,14 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     if pencil.size == 0:  # every point held: no unknown, no mode (LAPACK takes no empty matrix)
         return PredictedModes(np.zeros(0), None)
     rigid = pencil.rigid_body_modes
-    lam, vectors, reduced = _lowest_eigenvalues(pencil, min(count + rigid, pencil.size), shift, nodal)
+    lam, vectors, reduced, bisection = _lowest_eigenvalues(pencil, min(count + rigid, pencil.size), shift, nodal)
     order = np.argsort(lam)[rigid:rigid + count]
     values = np.sqrt(np.maximum(lam[order], 0.0))
-    return PredictedModes(values, None if vectors is None else pencil.at_nodes(vectors[:, order], reduced))
+    if vectors is not None:
+        return PredictedModes(values, pencil.at_nodes(vectors[:, order], reduced))
+    later = None if bisection is None else (
+        lambda rows=None: pencil.at_nodes(bisection.vectors(order if rows is None else order[rows]), reduced))
+    return PredictedModes(values, None, later)
 
 
 @dataclass(frozen=True, eq=False)
@@ -183,8 +192,9 @@ class CoarsePencil:
 
         LAPACK's potrf and sygst, the first two steps of the generalized eigensolver
         sygvx, made once per pencil: each prediction then runs only a standard
-        eigensolver on C (:func:`_lowest_eigenvalues`). Up to BISECTED eigenvalues
-        it is syevx, whose eigenvalues are sygvx's on (K, M) to the bit
+        eigensolver on C (:func:`_lowest_eigenvalues`). Up to
+        :data:`~linmstmm.standard_eigen.BISECTED` eigenvalues it is syevx (in its
+        steps), whose eigenvalues are sygvx's on (K, M) to the bit
         (tests/test_coarse_prediction.py); beyond, syev finds them all at once, not
         to the bit of sygvx's (1e-10 apart on the launcher). A repeat solve of the
         second launcher's ten lowest saved a quarter of its prediction (one asking
@@ -313,65 +323,28 @@ def _regular_pencil(K: np.ndarray, M: np.ndarray):
     return K[np.ix_(kept, kept)], M[np.ix_(kept, kept)]
 
 
-def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None,
-                        vectors: bool = False) -> tuple[np.ndarray, np.ndarray | None, bool]:
+def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None, vectors: bool = False
+                        ) -> tuple[np.ndarray, np.ndarray | None, bool, Bisection | None]:
     """(at least the ``count`` lowest eigenvalues of ``pencil`` (K, M), (rad/s)², in
     any order; their eigenvectors (n, m) if ``vectors`` asks and the route gives them,
     else None; whether those are of :attr:`CoarsePencil.reduced` (y), not of the scaled
-    pencil itself (x)): by block shift-invert Lanczos about −shift
+    pencil itself (x); the :class:`~linmstmm.standard_eigen.Bisection` that gives
+    those vectors later, in the eigenvalues' order, where the route has one, else None):
+    by block shift-invert Lanczos about −shift
     (:mod:`linmstmm.block_lanczos`, x) where a shift is given, every unknown carries
     mass and there are more than DENSE_PREDICTION; else on the kept standard form
-    (:func:`_standard_lowest`, y); by QZ where M is singular, the infinite
-    eigenvalues dropped, without vectors."""
+    (:func:`~linmstmm.standard_eigen.lowest_eigenpairs`, y); by QZ where M is singular,
+    the infinite eigenvalues dropped, without vectors."""
     if shift is not None and pencil.size > DENSE_PREDICTION and np.all(pencil.assembly.M.diagonal() != 0):
         found = _sparse_lowest(pencil, count, shift, vectors)
         if found is not None:
-            return *found, False
+            return *found, False, None
     if pencil.reduced is None:  # massless unknowns: QZ, their eigenvalues infinite
         K, M = _regular_pencil(pencil.K, pencil.M)
         lam = scipy.linalg.eigvals(K, M)
-        return lam[np.isfinite(lam)].real, None, True
-    return *_standard_lowest(pencil.reduced, count, vectors), True
-
-
-def _standard_lowest(reduced: np.ndarray, count: int, vectors: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
-    """(the ``count`` lowest eigenvalues of the standard form ``reduced`` (n, n) (its lower
-    triangle), ascending, or all of them; their eigenvectors (n, m) where ``vectors``,
-    else None): by bisection (syevx) up to BISECTED, else all of them at once, by
-    divide and conquer (syevd) with the vectors, by QR (syev, dsterf) without.
-
-    LAPACK's routines called as ``scipy.linalg.eigh(driver="evx" or "ev", lower=True)``
-    calls them, with its workspace (:func:`_workspace`), hence its eigenvalues to the bit,
-    without its checks and lookups: on the second launcher's 132 unknowns eigh took
-    0.59 ms where syevx itself took 0.41 (the ten lowest, best of 200 in one process),
-    and a first solve's prediction of either launcher 2 to 8 % less, side by side.
-    Beyond BISECTED, syevd's every pair costs less than bisection's few dozen: the
-    launcher's 68 lowest of 120 unknowns with their vectors 0.74 ms, against 2.6 ms
-    by syevx (0.33 ms without vectors, by syev).
-    """
-    n = reduced.shape[0]
-    found_vectors = None
-    if count > BISECTED and vectors:
-        eigenvalues, found_vectors, info = scipy.linalg.lapack.dsyevd(reduced, compute_v=1, lower=1)
-    elif count > BISECTED:
-        eigenvalues, _, info = scipy.linalg.lapack.dsyev(reduced, compute_v=0, lower=1,
-                                                         lwork=_workspace("dsyev", n))
-    else:
-        eigenvalues, found_vectors, found, _, info = scipy.linalg.lapack.dsyevx(
-            reduced, compute_v=int(vectors), range="I", il=1, iu=count, lower=1, lwork=_workspace("dsyevx", n))
-        eigenvalues, found_vectors = eigenvalues[:found], found_vectors[:, :found] if vectors else None
-    if info:
-        raise np.linalg.LinAlgError(f"LAPACK's symmetric eigensolver failed on the coarse pencil (info {info})")
-    return eigenvalues, found_vectors
-
-
-@functools.lru_cache(maxsize=None)
-def _workspace(routine: str, n: int) -> int:
-    """The workspace (doubles) LAPACK's ``routine`` ("dsyev" or "dsyevx") asks for at order
-    ``n``, lower triangle: the one scipy.linalg.eigh gives it (its blocking, hence its
-    rounding, depends on it)."""
-    work, info = getattr(scipy.linalg.lapack, routine + "_lwork")(n, lower=1)
-    return int(work)
+        return lam[np.isfinite(lam)].real, None, True, None
+    lam, found_vectors, bisection = lowest_eigenpairs(pencil.reduced, count, vectors)
+    return lam, found_vectors, True, bisection
 
 
 def _sparse_lowest(pencil: CoarsePencil, count: int, shift: float,
@@ -423,11 +396,12 @@ def predict_frequencies(model: Model, count: int) -> np.ndarray:
     return _kept_modes(model, count, nodal=False).values.copy()
 
 
-def predicted_modes(model: Model, count: int) -> PredictedModes:
+def predicted_modes(model: Model, count: int, nodal: bool = True) -> PredictedModes:
     """:func:`predict_frequencies` with the modes at the model's points and mass
-    centres where the eigensolver gives them (:class:`PredictedModes`), kept as the
-    frequencies are (the frequencies are the same, to the bit, where the eigensolver
-    finds fewer than all of them: :func:`coarse_modes`).
+    centres where the eigensolver gives them and ``nodal`` asks for them
+    (:class:`PredictedModes`), kept as the frequencies are (the frequencies are the
+    same, to the bit, where the eigensolver finds fewer than all of them:
+    :func:`coarse_modes`).
 
     Parameters
     ----------
@@ -435,13 +409,16 @@ def predicted_modes(model: Model, count: int) -> PredictedModes:
         The model.
     count : int
         Elastic frequencies wanted, >= 1.
+    nodal : bool
+        Whether the modes are wanted (False: ``nodal`` None, the eigenvectors not
+        computed: 0.26 against 0.34 ms on the launcher's 84 unknowns for its 12 lowest).
 
     Returns
     -------
     PredictedModes
         Shared with later calls: not to be written into.
     """
-    return _kept_modes(model, count, nodal=True)
+    return _kept_modes(model, count, nodal=nodal)
 
 
 #: [((model, count, whether the modes at the nodes were asked for), PredictedModes)]: the last made.
@@ -452,8 +429,13 @@ def _kept_modes(model: Model, count: int, nodal: bool) -> PredictedModes:
     """The last :class:`PredictedModes` made, where it was made for ``model`` and ``count``
     with the modes at the nodes if ``nodal`` asks for them; else made anew and kept."""
     key, kept = _kept[0]  # read once: another thread may replace it
-    if key is not None and key[0] is model and key[1] == count and (key[2] or not nodal):
-        return kept
+    if key is not None and key[0] is model and key[1] == count:
+        if key[2] or not nodal:
+            return kept
+        if kept.later is not None:  # the modes of the frequencies handed out already
+            made = PredictedModes(kept.values, kept.later())
+            _kept[0] = (model, count, True), made
+            return made
     made = _predicted_modes(model, count, nodal)
     _kept[0] = (model, count, nodal), made
     return made
@@ -462,17 +444,18 @@ def _kept_modes(model: Model, count: int, nodal: bool) -> PredictedModes:
 def _predicted_modes(model: Model, count: int, nodal: bool) -> PredictedModes:
     """:func:`predicted_modes` made anew (the modes at the nodes only if ``nodal``): two
     elements per beam, or as many as the highest frequency's bending waves need. The
-    two-element mesh's frequencies decide; its modes come with them where bisection
-    finds them (up to BISECTED), else only where no finer mesh follows."""
-    with_first = nodal and count <= BISECTED
-    predicted = coarse_modes(model, count, 2, nodal=with_first)
+    two-element mesh's frequencies decide; its modes are made only where no finer
+    mesh follows (from the same bisection, up to BISECTED)."""
+    predicted = coarse_modes(model, count, 2, nodal=False)
     needed = 2
     if model.beams and predicted.values.size:
         beta_L = max(bending_wavenumber(beam, predicted.values[-1]) * beam.length for beam in model.beams)
         needed = min(int(np.ceil(beta_L / WAVE_PER_ELEMENT)), MAX_ELEMENTS, max(_finest_mesh(model), 2))
     if needed > 2 * 2:
         return coarse_modes(model, count, needed, shift=0.5 * predicted.values[0] ** 2, nodal=nodal)
-    if nodal and not with_first and predicted.values.size and coarse_pencil(model, 2).reduced is not None:
+    if nodal and predicted.later is not None:
+        return PredictedModes(predicted.values, predicted.later())
+    if nodal and predicted.values.size and coarse_pencil(model, 2).reduced is not None:
         return coarse_modes(model, count, 2, nodal=True)
     return predicted
 

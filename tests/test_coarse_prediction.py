@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from linmstmm.coarse_prediction import BISECTED, _standard_lowest, coarse_pencil, coarse_predictions
+from linmstmm.coarse_prediction import coarse_modes, coarse_pencil, coarse_predictions
+from linmstmm.standard_eigen import BISECTED, Bisection, lowest_eigenpairs
 from linmstmm.model import load_model
 from random_models import KINDS, random_model
 
@@ -47,8 +48,8 @@ def test_both_kinds_of_mass_matrix_are_among_the_models():
 @pytest.mark.parametrize("name", ["launcher", "launcher 2", "cantilever"])
 @pytest.mark.parametrize("count", [1, 13, BISECTED, BISECTED + 1, 60])
 def test_the_standard_form_is_solved_as_scipy_eigh_solves_it(name, count):
-    """LAPACK's syevx (bisection) and syev (all at once), called directly, give
-    scipy.linalg.eigh's eigenvalues of the kept standard form to the bit."""
+    """LAPACK's syevx (bisection, in its steps) and syev (all at once), called directly,
+    give scipy.linalg.eigh's eigenvalues of the kept standard form to the bit."""
     reduced = coarse_pencil(MODELS[name](), 2).reduced
     count = min(count, reduced.shape[0])
     if count > BISECTED:
@@ -56,7 +57,7 @@ def test_the_standard_form_is_solved_as_scipy_eigh_solves_it(name, count):
     else:
         expected = scipy.linalg.eigh(reduced, eigvals_only=True, subset_by_index=[0, count - 1], driver="evx",
                                      lower=True)
-    assert np.array_equal(_standard_lowest(reduced, count)[0], expected)
+    assert np.array_equal(lowest_eigenpairs(reduced, count)[0], expected)
 
 
 @pytest.mark.parametrize("name", ["launcher", "launcher 2"])
@@ -65,9 +66,55 @@ def test_beyond_bisection_the_vectors_come_by_divide_and_conquer(name):
     driver, its eigenvalues to the bit, and orthonormal eigenvectors of the kept
     standard form (residuals at rounding of its norm)."""
     reduced = coarse_pencil(MODELS[name](), 2).reduced
-    values, vectors = _standard_lowest(reduced, BISECTED + 1, vectors=True)
+    values, vectors, _ = lowest_eigenpairs(reduced, BISECTED + 1, vectors=True)
     expected, expected_vectors = scipy.linalg.eigh(reduced, driver="evd", lower=True)
     assert np.array_equal(values, expected) and np.array_equal(vectors, expected_vectors)
     full = np.tril(reduced) + np.tril(reduced, -1).T
     np.testing.assert_allclose(vectors.T @ vectors, np.eye(vectors.shape[1]), rtol=0, atol=1e-13)
     assert np.max(np.abs(full @ vectors - vectors * values)) <= 1e-13 * np.abs(values).max()
+
+
+@pytest.mark.parametrize("name", ["launcher", "launcher 2", "cantilever"])
+@pytest.mark.parametrize("count", [1, 13, BISECTED])
+def test_syevx_in_its_steps_gives_eighs_vectors_now_or_later(name, count):
+    """Up to BISECTED, the eigenvectors from syevx's steps (stein, then ormtr's ormqr)
+    are scipy.linalg.eigh(driver="evx")'s to the bit, asked for with the eigenvalues or
+    after them; a few of them made alone are eigenvectors (residual at rounding of the
+    form's norm), the same to rounding where their eigenvalues are apart."""
+    reduced = coarse_pencil(MODELS[name](), 2).reduced
+    count = min(count, reduced.shape[0] - 1)  # all of them: syevx itself
+    expected, expected_vectors = scipy.linalg.eigh(reduced, subset_by_index=[0, count - 1], driver="evx", lower=True)
+    values, vectors, _ = lowest_eigenpairs(reduced, count, vectors=True)
+    assert np.array_equal(values, expected) and np.array_equal(vectors, expected_vectors)
+    later = Bisection(reduced, count)
+    assert np.array_equal(later.values, expected)
+    columns = np.arange(count)[::-3]                       # a few, out of order
+    alone = later.vectors(columns)
+    full = np.tril(reduced) + np.tril(reduced, -1).T
+    assert np.max(np.abs(full @ alone - alone * expected[columns])) <= 1e-13 * np.abs(full).max()
+    gaps = np.diff(np.r_[-np.inf, expected, np.inf])
+    apart = np.minimum(gaps[:-1], gaps[1:])[columns] > 1e-3 * np.abs(expected[columns])  # a double root's: any pair
+    assert apart.any()
+    overlap = np.abs(np.sum(alone * expected_vectors[:, columns], axis=0))[apart]
+    np.testing.assert_allclose(overlap, 1.0, rtol=0, atol=1e-12)
+    assert np.array_equal(later.vectors(), expected_vectors)
+    assert np.array_equal(later.vectors(columns), expected_vectors[:, columns])   # from those kept now
+
+
+@pytest.mark.parametrize("name", ["launcher", "cantilever"])
+def test_coarse_modes_made_later_are_those_made_at_once(name):
+    """The modes at the nodes of a prediction made without them come later from its own
+    bisection, the same to the bit as made with the frequencies; rows alone whose
+    frequencies are apart agree with those to rounding."""
+    model = MODELS[name]()
+    at_once = coarse_modes(model, 8, 2, nodal=True)
+    first = coarse_modes(model, 8, 2, nodal=False)
+    assert first.nodal is None and np.array_equal(first.values, at_once.values)
+    assert np.array_equal(first.later(), at_once.nodal)
+    gaps = np.diff(at_once.values)                          # the last one's partner may lie beyond: not tried
+    rows = np.flatnonzero(np.minimum(np.r_[np.inf, gaps[:-1]], gaps) > 1e-3 * at_once.values[:-1])[::-1][:3]
+    assert rows.size
+    alone = first.later(rows)
+    scale = np.abs(at_once.nodal[rows]).max(axis=1, keepdims=True)
+    signs = np.sign(np.sum(alone * at_once.nodal[rows], axis=1, keepdims=True))
+    np.testing.assert_allclose(signs * alone / scale, at_once.nodal[rows] / scale, rtol=0, atol=1e-10)

@@ -41,7 +41,7 @@ import numpy as np
 
 from linmstmm.counting import deflated
 from linmstmm.prediction_groups import (CLUSTER, cluster_reach, clustered, gap, gap_above, intervals_around,
-                                        polished_up_to)
+                                        polished_up_to, standing)
 from linmstmm.secant import secant_roots
 
 #: Halvings of the range by counts before a stretch that misses a root is searched whole.
@@ -287,15 +287,9 @@ def _counted_predictions(finder, predictions: np.ndarray, in_cluster: list[bool]
         return [], np.arange(start, stop)
     values, width = predictions.tolist(), finder.rtol
     tried = [i for i in range(start, stop) if not in_cluster[i]]
-    prefetch = getattr(counter, "prefetch", None)
-    if prefetch is not None:
-        prefetch([values[i] * (1 + sign * width) for i in tried for sign in (-1, 1)])
-    stands = set()
-    for i in tried:
-        below, above = counter(values[i] * (1 - width)), counter(values[i] * (1 + width))
-        if below is not None and above is not None and above - below == 1:
-            stands.add(i)
-            finder.last_step[values[i]] = width
+    stands = {i for i, stood in zip(tried, standing(counter, values, tried, width)) if stood}
+    for i in stands:
+        finder.last_step[values[i]] = width
     return ([values[i] for i in sorted(stands)],
             np.array([i for i in range(start, stop) if i not in stands], dtype=np.int64))
 

@@ -1,4 +1,4 @@
-"""Which predictions a predicted search polishes, which stand alone, and the gaps between them.
+"""Which predictions a predicted search polishes, which stand alone or as they are, and the gaps between them.
 
 Shared by the search itself (:mod:`linmstmm.predicted`) and the refinement of its
 predictions (:mod:`linmstmm.rayleigh`), which refines those the search polishes that
@@ -41,6 +41,24 @@ def polished_up_to(predictions: np.ndarray, count: int) -> int:
     lowest ``count`` polishes: those up to NEAR_COUNT above the count-th (the others only
     place its certifying count's upper end)."""
     return int(np.searchsorted(predictions, predictions[count - 1] * (1 + NEAR_COUNT), side="right"))
+
+
+def standing(counter, predictions: list[float], indices, width: float) -> list[bool]:
+    """For each of ``indices`` into ``predictions`` (rad/s), whether the Wittrick–Williams
+    counts at ``predictions[i]`` (1 ∓ ``width``) find one natural frequency across it, so
+    that a root lies within ``width`` (relative) of it, as it stands. ``counter``: the
+    model's :class:`~linmstmm.wittrick_williams.ModeCounter`; it remembers its answers, so a
+    second call at the same values and width counts nothing again (hence one place
+    forms these frequencies: the refinement asks first, the search again). All counted
+    in one batch where the counter can (``prefetch``)."""
+    prefetch = getattr(counter, "prefetch", None)
+    if prefetch is not None:
+        prefetch([predictions[i] * (1 + sign * width) for i in indices for sign in (-1, 1)])
+    stands = []
+    for i in indices:
+        below, above = counter(predictions[i] * (1 - width)), counter(predictions[i] * (1 + width))
+        stands.append(below is not None and above is not None and above - below == 1)
+    return stands
 
 
 def gap(predictions: list[float], i: int) -> float:

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.prediction_groups import clustered, polished_up_to
+from linmstmm.prediction_groups import clustered, polished_up_to, standing
 
 #: Relative half-width of the bracket about a refined prediction (:func:`refined_predictions`):
 #: det Ū_all is evaluated at its ends, in the secant's first batch, and where det changes
@@ -71,13 +71,23 @@ INVERSE_STEPS = 3
 #: 0.67 -> 0.56 ms, a sixth of such a solve). Where one does not
 #: stand it is polished by the secant as any prediction.
 UNSTEPPED_FROM = 1e-4
+#: From this rtol up, where the predictions may stand unpolished, each is first tried
+#: as the coarse model gives it, without its mode (:func:`refined_predictions`' ``with_modes``):
+#: the FE model is exact for rigid bodies and springs, and where the beams are stiff
+#: at the frequencies wanted its values are the roots to a few 1e-6 (the launchers'
+#: ten lowest: 2.0e-6 at most), so counts at ±rtol certify them as they are, and
+#: neither the eigenvectors (0.08 ms on the launcher's 84 unknowns), their values at
+#: the nodes nor the Rayleigh values are made. Where one does not stand, the modes
+#: are made then (the frequencies' eigensolve made again, with them) and it is refined.
+AS_PREDICTED_FROM = 1e-4
 #: Relative step of the central difference D′(ω) x of an inverse step: its truncation
 #: error (about its square) and rounding (about 1e-16 over it) both far below what the
 #: step needs.
 DERIVATIVE_STEP = 1e-6
 
 
-def refined_predictions(counter, modes, count: int, rtol: float) -> tuple[np.ndarray, np.ndarray]:
+def refined_predictions(counter, modes, count: int, rtol: float,
+                        with_modes=None) -> tuple[np.ndarray, np.ndarray]:
     """(predictions (m,) rad/s, ascending; spans (m,)): the coarse predictions ``modes``
     (:class:`~linmstmm.coarse_prediction.PredictedModes`) of a search for the lowest
     ``count`` to ``rtol``, with those it polishes (:func:`~linmstmm.predicted.polished_up_to`;
@@ -87,17 +97,29 @@ def refined_predictions(counter, modes, count: int, rtol: float) -> tuple[np.nda
     steps from UNSTEPPED_FROM up); BRACKET in ``spans`` for each of those refined with
     inverse steps where ``rtol`` is at least ten times it, else 0. As they
     are, spans 0, without a ``counter`` (:class:`~linmstmm.wittrick_williams.ModeCounter`)
-    or modes at the nodes, or where D(ω) has no unknowns (every node held: J₀ counts all)."""
+    or modes at the nodes, or where D(ω) has no unknowns (every node held: J₀ counts all).
+
+    ``with_modes``, where given, is called (no argument) for the same predictions with
+    their modes at the nodes, ``modes`` having come without them (AS_PREDICTED_FROM):
+    those alone that the counts at ±rtol certify as they are
+    (:func:`~linmstmm.prediction_groups.standing`) stay so, and the others' modes are
+    made only then: from the same bisection where ``modes`` can give them later
+    (``modes.later``), else by ``with_modes``."""
     values = np.asarray(modes.values, dtype=float)
     spans = np.zeros(values.size)
-    if counter is None or modes.nodal is None or not values.size or not counter.n_dof:
+    if counter is None or not values.size or not counter.n_dof:
         return values, spans
     polished = polished_up_to(values, count) if count <= values.size else values.size
     tried = np.flatnonzero(~np.array(clustered(values), dtype=bool)[:polished])
-    if not tried.size:
+    if with_modes is not None and tried.size:
+        tried = tried[~np.array(standing(counter, values.tolist(), tried.tolist(), rtol), dtype=bool)]
+        nodal = _made_now(modes, with_modes, tried) if tried.size else None
+    else:
+        nodal = _rows(modes, tried, values.size)
+    if not tried.size or nodal is None:
         return values, spans
     stepped = rtol < UNSTEPPED_FROM
-    found = counter.rayleigh_values(modes.nodal[tried][:, counter.masters], values[tried],
+    found = counter.rayleigh_values(nodal[:, counter.masters], values[tried],
                                     INVERSE_STEPS if stepped else 0)
     apart = np.abs(np.diff(values))
     nearest = np.minimum(np.r_[np.inf, apart], np.r_[apart, np.inf])
@@ -109,6 +131,20 @@ def refined_predictions(counter, modes, count: int, rtol: float) -> tuple[np.nda
     if stepped and rtol >= 10 * BRACKET:
         spans[tried[settled]] = BRACKET
     return values, spans
+
+
+def _made_now(modes, with_modes, rows: np.ndarray) -> np.ndarray | None:
+    """The modes at the nodes of the predictions ``rows`` of ``modes`` (which came without
+    them), made now: by ``modes.later`` where it can, else of ``with_modes()``."""
+    if modes.later is not None:
+        return modes.later(rows)
+    return _rows(with_modes(), rows, modes.values.size)
+
+
+def _rows(modes, rows: np.ndarray, size: int) -> np.ndarray | None:
+    """``modes.nodal``'s ``rows`` (a :class:`~linmstmm.coarse_prediction.PredictedModes`),
+    or None where it has no modes or not ``size`` of them."""
+    return None if modes.nodal is None or modes.nodal.shape[0] != size else modes.nodal[rows]
 
 
 def rayleigh_values_in_numpy(counter, vectors: np.ndarray, starts: np.ndarray,

@@ -1,0 +1,82 @@
+"""Predictions that stand as the coarse model gives them (rtol from
+:data:`linmstmm.rayleigh.AS_PREDICTED_FROM` up): certified by Wittrick–Williams counts
+alone, without their modes; where some do not stand, only theirs are made. Checked
+against the FE route on the same model, which shares nothing with the counts or the
+transfer matrices but the file."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import linmstmm.solve
+from linmstmm import load_model, natural_frequencies
+from linmstmm.coarse_prediction import predict_frequencies
+from linmstmm.fe import fe_frequencies
+from linmstmm.rayleigh import AS_PREDICTED_FROM
+from linmstmm.roots.settings import predictions_wanted
+from linmstmm.standard_eigen import Bisection
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture
+def vectors_made(monkeypatch):
+    """A list of the columns of every eigenvector set a bisection makes (None: all)."""
+    made, vectors = [], Bisection.vectors
+    monkeypatch.setattr(Bisection, "vectors", lambda self, columns=None: made.append(
+        None if columns is None else len(columns)) or vectors(self, columns))
+    predict_frequencies.cache_clear()
+    yield made
+    predict_frequencies.cache_clear()
+
+
+@pytest.fixture(scope="module")
+def launcher():
+    return load_model(ROOT / "models" / "mlrs" / "mlrs.toml")
+
+
+@pytest.fixture(scope="module")
+def launcher_fe(launcher):
+    """The FE route's 20 lowest (Hz) at rtol 1e-9, with its own error estimate."""
+    fe = fe_frequencies(launcher, 20, rtol=1e-9)
+    assert np.max(fe.error_estimate) <= 1e-9
+    return fe.frequencies_hz
+
+
+def test_the_launchers_ten_lowest_stand_as_predicted_without_modes(launcher, launcher_fe, vectors_made):
+    result = natural_frequencies(launcher, 10, engine="compiled", rtol=AS_PREDICTED_FROM)
+    predicted = predict_frequencies(launcher, predictions_wanted(10))[:10] / (2 * np.pi)
+    assert vectors_made == [] and result.evaluations == 0
+    assert np.array_equal(result.frequencies_hz, predicted)
+    assert np.max(np.abs(result.frequencies_hz / launcher_fe[:10] - 1)) <= AS_PREDICTED_FROM
+
+
+def test_where_some_do_not_stand_only_their_modes_are_made(launcher, launcher_fe, vectors_made):
+    """The launcher's twenty lowest: a few coarse values lie more than 1e-4 off (up to
+    5.3e-4); only those are refined, from their own modes."""
+    result = natural_frequencies(launcher, 20, engine="compiled", rtol=AS_PREDICTED_FROM)
+    assert len(vectors_made) == 1 and 0 < vectors_made[0] < 20
+    assert np.max(np.abs(result.frequencies_hz / launcher_fe - 1)) <= AS_PREDICTED_FROM
+
+
+@pytest.mark.parametrize("engine", ["compiled", "numpy"])
+def test_a_beam_models_predictions_that_do_not_stand_are_refined_within_rtol(engine):
+    """The tip-mass cantilever: bending waves that a coarse mesh resolves to about 1e-3
+    only, on a finer mesh than the first; every root within rtol of the FE route's."""
+    model = load_model(ROOT / "models" / "cantilever_tip_mass.toml")
+    fe = fe_frequencies(model, 12, rtol=1e-9)
+    result = natural_frequencies(model, 12, engine=engine, rtol=AS_PREDICTED_FROM)
+    allowed = AS_PREDICTED_FROM + 3 * fe.error_estimate
+    assert np.all(np.abs(result.frequencies_hz / fe.frequencies_hz - 1) <= allowed)
+
+
+@pytest.mark.parametrize("rtol", [None, AS_PREDICTED_FROM / 10])
+def test_a_tighter_request_predicts_with_the_modes(launcher, monkeypatch, rtol):
+    asked = []
+    predicted_modes = linmstmm.solve.predicted_modes
+    monkeypatch.setattr(linmstmm.solve, "predicted_modes",
+                        lambda model, count, nodal=True: asked.append(nodal) or predicted_modes(model, count, nodal))
+    natural_frequencies(launcher, 10, engine="compiled", rtol=rtol)
+    assert asked == [True]

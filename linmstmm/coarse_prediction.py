@@ -20,7 +20,7 @@ import scipy.linalg
 from linmstmm.block_lanczos import lowest_eigenvalues, lowest_modes
 from linmstmm.elements.beam import bending_wavenumber
 from linmstmm.fe.sparse import scipy_csr
-from linmstmm.standard_eigen import Bisection, lowest_eigenpairs
+from linmstmm.standard_eigen import Bisection, bisects, lowest_eigenpairs
 from linmstmm.fe.node_constraints import kept_node_constraints
 from linmstmm.model import Model
 
@@ -98,9 +98,11 @@ class PredictedModes:
 
 
 def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: float | None = None,
-                 nodal: bool = True) -> PredictedModes:
+                 nodal: bool = True, later: bool = False) -> PredictedModes:
     """:func:`coarse_predictions` with the modes at the nodes (``nodal``): the
-    :class:`PredictedModes` of the mesh of ``elements_per_beam``.
+    :class:`PredictedModes` of the mesh of ``elements_per_beam``; with ``later``, the
+    modes are left to :attr:`PredictedModes.later` where the eigensolve can make them
+    afterwards (bisection), else made now.
 
     The vectors come from the same eigensolve as the frequencies (:func:`_lowest_eigenvalues`).
     Up to :data:`~linmstmm.standard_eigen.BISECTED` that is syevx's steps, which give
@@ -115,7 +117,10 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     if pencil.size == 0:  # every point held: no unknown, no mode (LAPACK takes no empty matrix)
         return PredictedModes(np.zeros(0), None)
     rigid = pencil.rigid_body_modes
-    lam, vectors, reduced, bisection = _lowest_eigenvalues(pencil, min(count + rigid, pencil.size), shift, nodal)
+    wanted = min(count + rigid, pencil.size)
+    now = nodal and not (later and not _sparse_route(pencil, shift) and pencil.reduced is not None
+                         and bisects(pencil.size, wanted))
+    lam, vectors, reduced, bisection = _lowest_eigenvalues(pencil, wanted, shift, now)
     order = np.argsort(lam)[rigid:rigid + count]
     values = np.sqrt(np.maximum(lam[order], 0.0))
     if vectors is not None:
@@ -335,7 +340,7 @@ def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None, v
     mass and there are more than DENSE_PREDICTION; else on the kept standard form
     (:func:`~linmstmm.standard_eigen.lowest_eigenpairs`, y); by QZ where M is singular,
     the infinite eigenvalues dropped, without vectors."""
-    if shift is not None and pencil.size > DENSE_PREDICTION and np.all(pencil.assembly.M.diagonal() != 0):
+    if _sparse_route(pencil, shift):
         found = _sparse_lowest(pencil, count, shift, vectors)
         if found is not None:
             return *found, False, None
@@ -345,6 +350,12 @@ def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None, v
         return lam[np.isfinite(lam)].real, None, True, None
     lam, found_vectors, bisection = lowest_eigenpairs(pencil.reduced, count, vectors)
     return lam, found_vectors, True, bisection
+
+
+def _sparse_route(pencil: CoarsePencil, shift: float | None) -> bool:
+    """Whether :func:`_lowest_eigenvalues` tries the sparse route first: a shift given,
+    more than DENSE_PREDICTION unknowns, every one carrying mass."""
+    return shift is not None and pencil.size > DENSE_PREDICTION and bool(np.all(pencil.assembly.M.diagonal() != 0))
 
 
 def _sparse_lowest(pencil: CoarsePencil, count: int, shift: float,
@@ -396,12 +407,11 @@ def predict_frequencies(model: Model, count: int) -> np.ndarray:
     return _kept_modes(model, count, nodal=False).values.copy()
 
 
-def predicted_modes(model: Model, count: int, nodal: bool = True) -> PredictedModes:
+def predicted_modes(model: Model, count: int, later: bool = False) -> PredictedModes:
     """:func:`predict_frequencies` with the modes at the model's points and mass
-    centres where the eigensolver gives them and ``nodal`` asks for them
-    (:class:`PredictedModes`), kept as the frequencies are (the frequencies are the
-    same, to the bit, where the eigensolver finds fewer than all of them:
-    :func:`coarse_modes`).
+    centres where the eigensolver gives them (:class:`PredictedModes`), kept as the
+    frequencies are (the frequencies are the same, to the bit, where the eigensolver
+    finds fewer than all of them: :func:`coarse_modes`).
 
     Parameters
     ----------
@@ -409,52 +419,58 @@ def predicted_modes(model: Model, count: int, nodal: bool = True) -> PredictedMo
         The model.
     count : int
         Elastic frequencies wanted, >= 1.
-    nodal : bool
-        Whether the modes are wanted (False: ``nodal`` None, the eigenvectors not
-        computed: 0.26 against 0.34 ms on the launcher's 84 unknowns for its 12 lowest).
+    later : bool
+        Whether the modes may be left to :attr:`PredictedModes.later` where the
+        eigensolve can make them afterwards (bisection: the launcher's 12 lowest on
+        its 84 unknowns 0.27 ms, their modes 0.08 ms more, only where asked for);
+        else they are made now.
 
     Returns
     -------
     PredictedModes
         Shared with later calls: not to be written into.
     """
-    return _kept_modes(model, count, nodal=nodal)
+    return _kept_modes(model, count, nodal=True, later=later)
 
 
 #: [((model, count, whether the modes at the nodes were asked for), PredictedModes)]: the last made.
 _kept = [(None, None)]
 
 
-def _kept_modes(model: Model, count: int, nodal: bool) -> PredictedModes:
+def _kept_modes(model: Model, count: int, nodal: bool, later: bool = False) -> PredictedModes:
     """The last :class:`PredictedModes` made, where it was made for ``model`` and ``count``
-    with the modes at the nodes if ``nodal`` asks for them; else made anew and kept."""
+    with the modes at the nodes if ``nodal`` asks for them (now, or ``later`` where
+    they can come so); else made anew and kept."""
     key, kept = _kept[0]  # read once: another thread may replace it
     if key is not None and key[0] is model and key[1] == count:
-        if key[2] or not nodal:
-            return kept
+        if not nodal or kept.nodal is not None or (key[2] and kept.later is None):
+            return kept  # (asked for before and none given: the eigensolve gives none)
         if kept.later is not None:  # the modes of the frequencies handed out already
+            if later:
+                return kept
             made = PredictedModes(kept.values, kept.later())
             _kept[0] = (model, count, True), made
             return made
-    made = _predicted_modes(model, count, nodal)
+    made = _predicted_modes(model, count, nodal, later)
     _kept[0] = (model, count, nodal), made
     return made
 
 
-def _predicted_modes(model: Model, count: int, nodal: bool) -> PredictedModes:
-    """:func:`predicted_modes` made anew (the modes at the nodes only if ``nodal``): two
-    elements per beam, or as many as the highest frequency's bending waves need. The
-    two-element mesh's frequencies decide; its modes are made only where no finer
-    mesh follows (from the same bisection, up to BISECTED)."""
+def _predicted_modes(model: Model, count: int, nodal: bool, later: bool = False) -> PredictedModes:
+    """:func:`predicted_modes` made anew (the modes at the nodes only if ``nodal``, now or
+    ``later`` where they can come so): two elements per beam, or as many as the highest
+    frequency's bending waves need. The two-element mesh's frequencies decide; its
+    modes are made only where no finer mesh follows (from the same bisection, up to
+    BISECTED)."""
     predicted = coarse_modes(model, count, 2, nodal=False)
     needed = 2
     if model.beams and predicted.values.size:
         beta_L = max(bending_wavenumber(beam, predicted.values[-1]) * beam.length for beam in model.beams)
         needed = min(int(np.ceil(beta_L / WAVE_PER_ELEMENT)), MAX_ELEMENTS, max(_finest_mesh(model), 2))
     if needed > 2 * 2:
-        return coarse_modes(model, count, needed, shift=0.5 * predicted.values[0] ** 2, nodal=nodal)
+        return coarse_modes(model, count, needed, shift=0.5 * predicted.values[0] ** 2, nodal=nodal, later=later)
     if nodal and predicted.later is not None:
-        return PredictedModes(predicted.values, predicted.later())
+        return predicted if later else PredictedModes(predicted.values, predicted.later())
     if nodal and predicted.values.size and coarse_pencil(model, 2).reduced is not None:
         return coarse_modes(model, count, 2, nodal=True)
     return predicted

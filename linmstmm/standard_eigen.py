@@ -113,7 +113,7 @@ def lowest_eigenpairs(reduced: np.ndarray, count: int, vectors: bool = False
     by syevx (0.33 ms without vectors, by syev).
     """
     n = reduced.shape[0]
-    if count <= BISECTED and count < n:
+    if bisects(n, count):
         bisection = Bisection(reduced, count)
         return bisection.values, bisection.vectors() if vectors else None, bisection
     if count <= BISECTED:  # all of them: syevx itself, which takes QR's route (sterf, or steqr with vectors) then
@@ -128,6 +128,12 @@ def lowest_eigenpairs(reduced: np.ndarray, count: int, vectors: bool = False
     eigenvalues, _, info = scipy.linalg.lapack.dsyev(reduced, compute_v=0, lower=1, lwork=_workspace("dsyev", n))
     _check(info, "syev")
     return eigenvalues, None, None
+
+
+def bisects(n: int, count: int) -> bool:
+    """Whether :func:`lowest_eigenpairs` finds the ``count`` lowest of an order ``n`` form by
+    bisection (:class:`Bisection`, whose vectors can come later): up to BISECTED, not all."""
+    return count <= BISECTED and count < n
 
 
 def _check(info: int, routine: str) -> None:

@@ -39,13 +39,14 @@ class RootFinder:
     kinematics (:func:`linmstmm.rigid_motion.rigid_body_mode_count`); their
     zeros of det Ū_all at ω = 0 are divided out once they are confirmed
     (:meth:`divide_out_rigid_body_zeros`).
-    predictor : callable (n, nodal=True) -> :class:`~linmstmm.coarse_prediction.PredictedModes`,
-    the lowest n elastic roots predicted (rad/s) and, where ``nodal``, their modes at the
-    nodes where known (:func:`linmstmm.coarse_prediction.predicted_modes` of the model),
-    or None; the modes refine the predictions by the Rayleigh functional of the
-    counter's exact dynamic stiffness (:func:`linmstmm.rayleigh.refined_predictions`;
-    asked for first without the modes where the predictions may stand unpolished to an
-    rtol from :data:`linmstmm.rayleigh.AS_PREDICTED_FROM` up).
+    predictor : callable (n, later=False) -> :class:`~linmstmm.coarse_prediction.PredictedModes`,
+    the lowest n elastic roots predicted (rad/s) and their modes at the nodes where
+    known, made now or, with ``later``, where the eigensolve can make them afterwards
+    (:func:`linmstmm.coarse_prediction.predicted_modes` of the model), or None; the
+    modes refine the predictions by the Rayleigh functional of the counter's exact
+    dynamic stiffness (:func:`linmstmm.rayleigh.refined_predictions`; only of those
+    that do not stand as predicted where they may stand unpolished to an rtol from
+    :data:`linmstmm.rayleigh.AS_PREDICTED_FROM` up).
     scale : rad/s, the model's own frequency scale; the floor, ceiling and scan
     chunks are multiples of it (see DEFAULT_SCALE).
     rtol : relative accuracy a root is certified to, in [MIN_RTOL, MAX_RTOL]: a root
@@ -263,14 +264,13 @@ class RootFinder:
         if count is not None and self.predictor is not None:
             asked = predictions_wanted(count)
             as_predicted = self.unpolished and self.rtol >= AS_PREDICTED_FROM and self.counter is not None
-            predicted = self.predictor(asked, nodal=not as_predicted)
+            predicted = self.predictor(asked, later=as_predicted)
             wanted = count if predicted.values.size >= count else self._existing(count)
             if wanted == 0:
                 return []
             found = None
             if wanted is not None and self._usable(predicted.values):
-                predictions, spans = refined_predictions(self.counter, predicted, wanted, self.rtol,
-                                                         (lambda: self.predictor(asked)) if as_predicted else None)
+                predictions, spans = refined_predictions(self.counter, predicted, wanted, self.rtol, as_predicted)
                 found = predicted_roots(self, predictions, wanted, spans)
             if found is not None:  # certified up to above the wanted-th: complete below omega_max too
                 found = self._separated_above_floor(found)

@@ -20,9 +20,9 @@ import scipy.linalg
 from linmstmm.block_lanczos import lowest_eigenvalues, lowest_modes
 from linmstmm.elements.beam import bending_wavenumber
 from linmstmm.fe.sparse import scipy_csr
-from linmstmm.standard_eigen import Bisection, bisects, lowest_eigenpairs
 from linmstmm.fe.node_constraints import kept_node_constraints
 from linmstmm.model import Model
+from linmstmm.standard_eigen import Bisection, bisects, lowest_eigenpairs
 
 #: Radians of a bending wave per element of the predicting mesh: its frequencies are
 #: then high by about 1/720 relative, well inside the secant's reach.
@@ -94,7 +94,7 @@ class PredictedModes:
 
     values: np.ndarray
     nodal: np.ndarray | None
-    later: Callable[[], np.ndarray] | None = field(default=None, repr=False)
+    later: Callable[..., np.ndarray] | None = field(default=None, repr=False)
 
 
 def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: float | None = None,
@@ -118,8 +118,7 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
         return PredictedModes(np.zeros(0), None)
     rigid = pencil.rigid_body_modes
     wanted = min(count + rigid, pencil.size)
-    now = nodal and not (later and not _sparse_route(pencil, shift) and pencil.reduced is not None
-                         and bisects(pencil.size, wanted))
+    now = nodal and not (later and _bisected(pencil, wanted, shift))
     lam, vectors, reduced, bisection = _lowest_eigenvalues(pencil, wanted, shift, now)
     order = np.argsort(lam)[rigid:rigid + count]
     values = np.sqrt(np.maximum(lam[order], 0.0))
@@ -352,6 +351,12 @@ def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None, v
     return lam, found_vectors, True, bisection
 
 
+def _bisected(pencil: CoarsePencil, count: int, shift: float | None) -> bool:
+    """Whether :func:`_lowest_eigenvalues` finds ``count`` of ``pencil``'s eigenvalues by
+    bisection on its standard form, which can give their vectors afterwards."""
+    return not _sparse_route(pencil, shift) and pencil.reduced is not None and bisects(pencil.size, count)
+
+
 def _sparse_route(pencil: CoarsePencil, shift: float | None) -> bool:
     """Whether :func:`_lowest_eigenvalues` tries the sparse route first: a shift given,
     more than DENSE_PREDICTION unknowns, every one carrying mass."""
@@ -443,14 +448,16 @@ def _kept_modes(model: Model, count: int, nodal: bool, later: bool = False) -> P
     they can come so); else made anew and kept."""
     key, kept = _kept[0]  # read once: another thread may replace it
     if key is not None and key[0] is model and key[1] == count:
-        if not nodal or kept.nodal is not None or (key[2] and kept.later is None):
-            return kept  # (asked for before and none given: the eigensolve gives none)
-        if kept.later is not None:  # the modes of the frequencies handed out already
+        if not nodal or kept.nodal is not None:
+            return kept
+        if kept.later is not None:  # the modes of the frequencies handed out already can come
             if later:
                 return kept
             made = PredictedModes(kept.values, kept.later())
             _kept[0] = (model, count, True), made
             return made
+        if key[2]:  # asked for before, and the eigensolve gives none (QZ)
+            return kept
     made = _predicted_modes(model, count, nodal, later)
     _kept[0] = (model, count, nodal), made
     return made

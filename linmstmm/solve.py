@@ -132,7 +132,8 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     evaluator = system.determinant
     finder = RootFinder(evaluator.log_det, lambda omega: evaluator.matrix(omega)[0],
                         rigid_body_modes=system.rigid_body_modes,
-                        predictor=lambda n, later=False: predicted_modes(model, n, later), scale=system.scale, **options)
+                        predictor=lambda n, later=False: predicted_modes(model, n, later), scale=system.scale,
+                        **options)
     finder.determinant = evaluator
     finder._evaluations_reported = evaluator.evaluations  # this finder's search counts from here
     if system.counter is not None:

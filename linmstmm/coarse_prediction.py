@@ -88,8 +88,7 @@ class PredictedModes:
         Where ``nodal`` is None and the eigensolve can give the modes afterwards
         (bisection, :class:`~linmstmm.standard_eigen.Bisection`): what ``nodal`` would
         have been, the same to the bit, without the eigenvalues found again; given
-        ``rows`` (k indices into ``values``), only those modes (k, ...), made alone
-        (the same to rounding where their frequencies are apart).
+        ``rows`` (k indices into ``values``), those rows of it.
     """
 
     values: np.ndarray
@@ -125,7 +124,7 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     if vectors is not None:
         return PredictedModes(values, pencil.at_nodes(vectors[:, order], reduced))
     later = None if bisection is None else (
-        lambda rows=None: pencil.at_nodes(bisection.vectors(order if rows is None else order[rows]), reduced))
+        lambda rows=None: pencil.at_nodes(bisection.vectors()[:, order if rows is None else order[rows]], reduced))
     return PredictedModes(values, None, later)
 
 

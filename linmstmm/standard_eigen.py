@@ -61,37 +61,25 @@ class Bisection:
         self.values = self._blocked[self._order]
         self._vectors = None
 
-    def vectors(self, columns: np.ndarray | None = None) -> np.ndarray:
-        """(n, m), or (n, k) of ``columns`` (k indices into :attr:`values`): the eigenvectors of
-        :attr:`values`, in their order: inverse iteration on T (stein), back-transformed
-        by Q (ormtr: ormqr on T's reflectors below its diagonal, row 0 as it is). All of
-        them are syevx's to the bit, and kept; a few ``columns`` alone are made by the
-        same steps for their eigenvalues only (stein reorthogonalises a vector against
-        the others it makes of close eigenvalues, so these agree with the full set's to
-        rounding where their eigenvalues are apart), a sixth of all twenty-four's cost
-        for four of them on the launcher."""
-        if self._vectors is not None or columns is None:
-            if self._vectors is None:
-                self._vectors = self._made(np.arange(self._blocked.size))[:, self._order]
-            return self._vectors if columns is None else self._vectors[:, columns]
-        picked = np.sort(self._order[np.asarray(columns, dtype=int)])  # stein's order: by block, ascending
-        vectors = self._made(picked)
-        return vectors[:, np.searchsorted(picked, self._order[np.asarray(columns, dtype=int)])]
-
-    def _made(self, picked: np.ndarray) -> np.ndarray:
-        """(n, k): the eigenvectors of the eigenvalues ``picked`` (ascending indices into
-        stebz's block order), in that order."""
-        block = np.zeros(self._n, dtype=self._block.dtype)
-        block[:picked.size] = self._block[picked]
-        vectors, info = scipy.linalg.lapack.dstein(self._diagonal, self._off_diagonal, self._blocked[picked],
-                                                   block, self._split)
-        _check(info, "stein")
-        vectors = vectors[:, :picked.size]
-        if self._n > 1:
-            vectors[1:], _, info = scipy.linalg.lapack.dormqr("L", "N", self._reflectors[1:, :-1], self._tau,
-                                                              vectors[1:], lwork=self._work - self._n)
-            _check(info, "ormqr")
-        return vectors
+    def vectors(self) -> np.ndarray:
+        """(n, m): the eigenvectors of :attr:`values`, in their order, syevx's to the bit:
+        inverse iteration on T (stein), back-transformed by Q (ormtr: ormqr on T's
+        reflectors below its diagonal, row 0 as it is); made once, all of them
+        together. (A few alone are not the same: stein takes eigenvalues within 1e-3
+        of T's norm for one cluster and orthogonalises each vector against the others
+        it makes, which for a stiff pencil's lowest are all of them: without the
+        rigid-body modes' vectors, elastic ones came out as rigid-body motions.)"""
+        if self._vectors is None:
+            vectors, info = scipy.linalg.lapack.dstein(self._diagonal, self._off_diagonal, self._blocked,
+                                                       self._block, self._split)
+            _check(info, "stein")
+            vectors = vectors[:, :self._blocked.size]
+            if self._n > 1:
+                vectors[1:], _, info = scipy.linalg.lapack.dormqr("L", "N", self._reflectors[1:, :-1], self._tau,
+                                                                  vectors[1:], lwork=self._work - self._n)
+                _check(info, "ormqr")
+            self._vectors = vectors[:, self._order]
+        return self._vectors
 
 
 def lowest_eigenpairs(reduced: np.ndarray, count: int, vectors: bool = False

@@ -17,16 +17,27 @@ from linmstmm.fe import fe_frequencies
 from linmstmm.rayleigh import AS_PREDICTED_FROM
 from linmstmm.roots.settings import predictions_wanted
 from linmstmm.standard_eigen import Bisection
+from linmstmm.wittrick_williams import ModeCounter
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture
-def vectors_made(monkeypatch):
-    """A list of the columns of every eigenvector set a bisection makes (None: all)."""
-    made, vectors = [], Bisection.vectors
-    monkeypatch.setattr(Bisection, "vectors", lambda self, columns=None: made.append(
-        None if columns is None else len(columns)) or vectors(self, columns))
+def made(monkeypatch):
+    """{"vectors": eigenvector sets a bisection makes, "refined": the rows of each set of
+    Rayleigh values made}, growing as a solve runs."""
+    made, vectors, rayleigh = {"vectors": 0, "refined": []}, Bisection.vectors, ModeCounter.rayleigh_values
+
+    def counted_vectors(self):
+        made["vectors"] += self._vectors is None
+        return vectors(self)
+
+    def counted_rayleigh(self, modes, *args, **kwargs):
+        made["refined"].append(len(modes))
+        return rayleigh(self, modes, *args, **kwargs)
+
+    monkeypatch.setattr(Bisection, "vectors", counted_vectors)
+    monkeypatch.setattr(ModeCounter, "rayleigh_values", counted_rayleigh)
     predict_frequencies.cache_clear()
     yield made
     predict_frequencies.cache_clear()
@@ -46,21 +57,21 @@ def launcher_fe(launcher):
 
 
 @pytest.mark.parametrize("rtol", [1e-5, 1e-4])
-def test_the_launchers_ten_lowest_stand_as_predicted_without_modes(launcher, launcher_fe, vectors_made, rtol):
+def test_the_launchers_ten_lowest_stand_as_predicted_without_modes(launcher, launcher_fe, made, rtol):
     """Coarse values within 2.0e-6 of the roots: every one stands."""
     result = natural_frequencies(launcher, 10, engine="compiled", rtol=rtol)
     predicted = predict_frequencies(launcher, predictions_wanted(10))[:10] / (2 * np.pi)
-    assert vectors_made == [] and result.evaluations == 0
+    assert made == {"vectors": 0, "refined": []} and result.evaluations == 0
     assert np.array_equal(result.frequencies_hz, predicted)
     assert np.max(np.abs(result.frequencies_hz / launcher_fe[:10] - 1)) <= rtol
 
 
 @pytest.mark.parametrize("count, rtol", [(10, AS_PREDICTED_FROM), (20, 1e-4)])
-def test_where_some_do_not_stand_only_their_modes_are_made(launcher, launcher_fe, vectors_made, count, rtol):
+def test_where_some_do_not_stand_only_they_are_refined(launcher, launcher_fe, made, count, rtol):
     """A few coarse values lie more than rtol off (the ten lowest up to 2.0e-6, the
-    twenty lowest up to 5.3e-4): only those are refined, from their own modes."""
+    twenty lowest up to 5.3e-4): the modes are made once, and only those few refined."""
     result = natural_frequencies(launcher, count, engine="compiled", rtol=rtol)
-    assert len(vectors_made) == 1 and 0 < vectors_made[0] < count
+    assert made["vectors"] == 1 and len(made["refined"]) == 1 and 0 < made["refined"][0] < count // 2
     assert np.max(np.abs(result.frequencies_hz / launcher_fe[:count] - 1)) <= rtol
 
 
@@ -83,3 +94,4 @@ def test_a_tighter_request_predicts_with_the_modes(launcher, monkeypatch, rtol):
                         lambda model, count, later=False: asked.append(later) or predicted_modes(model, count, later))
     natural_frequencies(launcher, 10, engine="compiled", rtol=rtol)
     assert asked == [False]
+

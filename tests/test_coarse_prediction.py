@@ -79,42 +79,27 @@ def test_beyond_bisection_the_vectors_come_by_divide_and_conquer(name):
 def test_syevx_in_its_steps_gives_eighs_vectors_now_or_later(name, count):
     """Up to BISECTED, the eigenvectors from syevx's steps (stein, then ormtr's ormqr)
     are scipy.linalg.eigh(driver="evx")'s to the bit, asked for with the eigenvalues or
-    after them; a few of them made alone are eigenvectors (residual at rounding of the
-    form's norm), the same to rounding where their eigenvalues are apart."""
+    after them."""
     reduced = coarse_pencil(MODELS[name](), 2).reduced
     count = min(count, reduced.shape[0] - 1)  # all of them: syevx itself
     expected, expected_vectors = scipy.linalg.eigh(reduced, subset_by_index=[0, count - 1], driver="evx", lower=True)
     values, vectors, _ = lowest_eigenpairs(reduced, count, vectors=True)
     assert np.array_equal(values, expected) and np.array_equal(vectors, expected_vectors)
     later = Bisection(reduced, count)
-    assert np.array_equal(later.values, expected)
-    columns = np.arange(count)[::-3]                       # a few, out of order
-    alone = later.vectors(columns)
-    full = np.tril(reduced) + np.tril(reduced, -1).T
-    assert np.max(np.abs(full @ alone - alone * expected[columns])) <= 1e-13 * np.abs(full).max()
-    gaps = np.diff(np.r_[-np.inf, expected, np.inf])
-    apart = np.minimum(gaps[:-1], gaps[1:])[columns] > 1e-3 * np.abs(expected[columns])  # a double root's: any pair
-    assert apart.any()
-    overlap = np.abs(np.sum(alone * expected_vectors[:, columns], axis=0))[apart]
-    np.testing.assert_allclose(overlap, 1.0, rtol=0, atol=1e-12)
-    assert np.array_equal(later.vectors(), expected_vectors)
-    assert np.array_equal(later.vectors(columns), expected_vectors[:, columns])   # from those kept now
+    assert np.array_equal(later.values, expected) and np.array_equal(later.vectors(), expected_vectors)
 
 
-@pytest.mark.parametrize("name", ["launcher", "cantilever"])
+@pytest.mark.parametrize("name", ["launcher", "cantilever", "floating_tree 0", "loops 1", "ring 0"])
 def test_coarse_modes_made_later_are_those_made_at_once(name):
     """The modes at the nodes of a prediction made without them come later from its own
-    bisection, the same to the bit as made with the frequencies; rows alone whose
-    frequencies are apart agree with those to rounding."""
+    bisection, the same to the bit as made with the frequencies, some rows or all; so
+    too where the pencil has rigid-body modes, whose vectors the elastic ones are made
+    beside (without them, stein had made elastic modes that were rigid-body motions)."""
     model = MODELS[name]()
+    assert name in ("launcher", "cantilever") or coarse_pencil(model, 2).rigid_body_modes > 0
     at_once = coarse_modes(model, 8, 2, nodal=True)
     first = coarse_modes(model, 8, 2, nodal=False)
     assert first.nodal is None and np.array_equal(first.values, at_once.values)
     assert np.array_equal(first.later(), at_once.nodal)
-    gaps = np.diff(at_once.values)                          # the last one's partner may lie beyond: not tried
-    rows = np.flatnonzero(np.minimum(np.r_[np.inf, gaps[:-1]], gaps) > 1e-3 * at_once.values[:-1])[::-1][:3]
-    assert rows.size
-    alone = first.later(rows)
-    scale = np.abs(at_once.nodal[rows]).max(axis=1, keepdims=True)
-    signs = np.sign(np.sum(alone * at_once.nodal[rows], axis=1, keepdims=True))
-    np.testing.assert_allclose(signs * alone / scale, at_once.nodal[rows] / scale, rtol=0, atol=1e-10)
+    rows = np.array([5, 1, 6])
+    assert np.array_equal(first.later(rows), at_once.nodal[rows])

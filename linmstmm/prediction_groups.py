@@ -8,6 +8,8 @@ its pencil's reach in a cluster (:func:`cluster_reach`) by the predictions' posi
 """
 from __future__ import annotations
 
+import bisect
+
 import numpy as np
 
 #: Predictions closer than this (relative) are a cluster: a member's secant result
@@ -59,6 +61,13 @@ def standing(counter, predictions: list[float], indices, width: float) -> list[b
         below, above = counter(predictions[i] * (1 - width)), counter(predictions[i] * (1 + width))
         stands.append(below is not None and above is not None and above - below == 1)
     return stands
+
+
+def beside(values: list[float], around: list[float]) -> set[float]:
+    """Of ``values`` (rad/s), the nearest below and the nearest above each of ``around``."""
+    ordered = sorted(values)
+    return {ordered[k] for omega in around for k in (bisect.bisect_left(ordered, omega) - 1,
+                                                     bisect.bisect_right(ordered, omega)) if 0 <= k < len(ordered)}
 
 
 def gap(predictions: list[float], i: int) -> float:

@@ -40,9 +40,8 @@ import math
 import numpy as np
 
 from linmstmm.counting import deflated
-from linmstmm.prediction_groups import (CLUSTER, beside, cluster_reach, clustered, gap, gap_above,
+from linmstmm.prediction_groups import (CLUSTER, Stood, cluster_reach, clustered, gap, gap_above,
                                         intervals_around, polished_up_to, standing)
-from linmstmm.rayleigh import AS_PREDICTED_FROM
 from linmstmm.secant import secant_roots
 
 #: Halvings of the range by counts before a stretch that misses a root is searched whole.
@@ -216,11 +215,8 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
     to ``stood``), else by the secant (from
     their brackets' ends where ``spans`` has one), then the pencil, then the segment search
     around those both left troubled. None where a count of that search cannot be made (the
-    full search decides). Beside a prediction the secant leaves unsettled, values that
-    stood as the coarse model gave them (AS_PREDICTED_FROM) are polished first: one only
-    within rtol of its root, divided out, left a zero beside its pole, which the deflated
-    secant took for a known root (varied model 41's twenty lowest at rtol 1e-4: the
-    segment search ran, 48 evaluations; 31 with those polished, 26 from refined values)."""
+    full search decides). A root the pencil or the deflated secant finds within rtol of
+    a value that stood is that value's root (:class:`Stood`)."""
     in_cluster = clustered(predictions)  # the same for the counts and the secant
     standing, indices = (_counted_predictions(finder, predictions, in_cluster, start, stop) if stood is not None
                          else ([], np.arange(start, stop)))
@@ -231,15 +227,10 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
     alone = np.array([i for i in indices.tolist() if i not in coincident], dtype=np.int64)
     found, unsettled = _secant_polished(finder, predictions, in_cluster, alone, list(roots) + standing, wanted,
                                         spans)
-    found = list(roots) + standing + found
-    if unsettled and standing and finder.rtol >= AS_PREDICTED_FROM:  # the pencil and deflation take roots as exact
-        near = beside(standing, unsettled)
-        polished = _stood_polished(finder, predictions, spans, found, near)
-        if polished is not None:
-            found = polished
-            stood.difference_update(near)
-    found, troubled = _pencil_polished(finder, found, unsettled + [float(p) for p in predictions[leaders]])
-    found, troubled = _deflated_polished(finder, found, troubled, predictions)
+    stood_for = Stood(stood, finder.rtol)
+    found, troubled = _pencil_polished(finder, list(roots) + standing + found,
+                                       unsettled + [float(p) for p in predictions[leaders]], stood_for)
+    found, troubled = _deflated_polished(finder, found, troubled, predictions, stood_for)
     for lo, hi in intervals_around(troubled + [float(p) for p in predictions[followers]], predictions, found):
         counted = _completed_by_counts(finder, found, lo, hi)
         if counted is not None:
@@ -381,7 +372,8 @@ def _completed_by_counts(finder, found: list[float], lo: float, hi: float):
     return sorted(found)
 
 
-def _pencil_polished(finder, roots: list[float], starts: list[float]) -> tuple[list[float], list[float]]:
+def _pencil_polished(finder, roots: list[float], starts: list[float],
+                     stood_for: Stood) -> tuple[list[float], list[float]]:
     """(roots, troubled starts): ``starts`` by Newton on the pencil, which steps to the
     nearest root whatever its neighbours. One that lands on a root already found
     tries the partner the pencil's next offset there points at; the rest are
@@ -392,6 +384,8 @@ def _pencil_polished(finder, roots: list[float], starts: list[float]) -> tuple[l
     if not starts:
         return roots, troubled
     for start, (root, offsets) in zip(starts, finder.polish(starts)):
+        if root is not None:
+            stood_for.absorbed(root, roots)
         if root is not None and not _known(root, roots, _same_root(finder)):
             roots.append(root)
             continue
@@ -401,6 +395,8 @@ def _pencil_polished(finder, roots: list[float], starts: list[float]) -> tuple[l
         else:
             partners.append((start, partner))
     for (start, _), (root, _) in zip(partners, finder.polish([p for _, p in partners])):
+        if root is not None:
+            stood_for.absorbed(root, roots)
         if root is not None and not _known(root, roots, _same_root(finder)):
             roots.append(root)
         else:
@@ -408,8 +404,8 @@ def _pencil_polished(finder, roots: list[float], starts: list[float]) -> tuple[l
     return roots, troubled
 
 
-def _deflated_polished(finder, roots: list[float], starts: list[float],
-                       predictions: np.ndarray) -> tuple[list[float], list[float]]:
+def _deflated_polished(finder, roots: list[float], starts: list[float], predictions: np.ndarray,
+                       stood_for: Stood) -> tuple[list[float], list[float]]:
     """(roots, troubled starts): ``starts`` by the secant on det with every known root
     divided out (:func:`~linmstmm.counting.deflated`), in rounds of DEFLATION_ROUNDS at
     most, each adding the roots it finds to those divided out.
@@ -432,6 +428,8 @@ def _deflated_polished(finder, roots: list[float], starts: list[float],
         found, steps = secant_roots(deflated(finder.log_det, roots), np.array(starts), finder.xtol, 0.0)
         left, this_round = [], []
         for start, root, step in zip(starts, found, steps):
+            if not np.isnan(root):
+                stood_for.absorbed(float(root), roots)
             if (np.isnan(root) or step > finder.xtol or abs(root - start) > cluster_reach(predictions, start)
                     or _known(root, roots, NEAR_KNOWN) or _known(root, this_round, _same_root(finder))):
                 left.append(start)

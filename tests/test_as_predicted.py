@@ -96,12 +96,13 @@ def test_a_tighter_request_predicts_with_the_modes(launcher, monkeypatch, rtol):
     assert asked == [False]
 
 
-def test_values_that_stood_beside_an_unsettled_prediction_are_polished_before_deflation(monkeypatch):
+def test_a_root_found_within_rtol_of_a_value_that_stood_takes_its_place(monkeypatch):
     """Varied model 41's twenty lowest at rtol 1e-4: the root at 3457.9 rad/s is predicted
-    at 3503.9, and the secant from there lands on the next root, whose coarse value
-    (7e-6 off) stood. Divided out as it stood, that value left a zero beside its pole,
-    which the deflated secant took for a known root: the segment search ran (48
-    evaluations). Polished first, it leaves the deflated secant the missing root."""
+    at 3503.9, and the secant and the pencil from there land on the next root, whose
+    coarse value (7e-6 off) stood. Divided out as it stood, that value left a zero
+    beside its pole, which the deflated secant took for a known root: the segment
+    search ran (48 evaluations). The root found there takes the value's place, and
+    the deflated secant finds the missing one."""
     from varied_models import varied_model
 
     from linmstmm.roots import RootFinder

@@ -383,11 +383,19 @@ def _pencil_polished(finder, roots: list[float], starts: list[float],
     roots, troubled, partners = list(roots), [], []
     if not starts:
         return roots, troubled
+
+    def taken(root) -> bool:
+        """Whether ``root`` (rad/s, or None) is new, then added; first in place of a value that stood for it."""
+        if root is None:
+            return False
+        stood_for.absorbed(root, roots)
+        if _known(root, roots, _same_root(finder)):
+            return False
+        roots.append(root)
+        return True
+
     for start, (root, offsets) in zip(starts, finder.polish(starts)):
-        if root is not None:
-            stood_for.absorbed(root, roots)
-        if root is not None and not _known(root, roots, _same_root(finder)):
-            roots.append(root)
+        if taken(root):
             continue
         partner = None if root is None else _partner(root, offsets, _same_root(finder), finder.NEWTON_REACH)
         if partner is None:
@@ -395,11 +403,7 @@ def _pencil_polished(finder, roots: list[float], starts: list[float],
         else:
             partners.append((start, partner))
     for (start, _), (root, _) in zip(partners, finder.polish([p for _, p in partners])):
-        if root is not None:
-            stood_for.absorbed(root, roots)
-        if root is not None and not _known(root, roots, _same_root(finder)):
-            roots.append(root)
-        else:
+        if not taken(root):
             troubled.append(start)
     return roots, troubled
 

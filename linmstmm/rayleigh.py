@@ -136,7 +136,7 @@ def _modes_of(modes, rows: np.ndarray) -> np.ndarray | None:
     :class:`~linmstmm.coarse_prediction.PredictedModes`): those it holds, or made now
     where it left them for later; None where it has none."""
     if modes.nodal is not None:
-        return modes.nodal[rows] if modes.nodal.shape[0] == modes.values.size else None
+        return modes.nodal[rows]
     return None if modes.later is None else modes.later(rows)
 
 

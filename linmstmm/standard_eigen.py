@@ -37,7 +37,7 @@ class Bisection:
     reduced : numpy.ndarray, shape (n, n)
         C, its lower triangle read; not written.
     count : int
-        1 <= count <= n.
+        1 <= count < n (all n: syevx takes QR's route, :func:`lowest_eigenpairs`).
 
     Attributes
     ----------

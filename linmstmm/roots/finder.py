@@ -262,9 +262,8 @@ class RootFinder:
     def _found(self, count: int | None, omega_max: float | None) -> list[float]:
         """The roots :meth:`find` returns, as a list (rad/s)."""
         if count is not None and self.predictor is not None:
-            asked = predictions_wanted(count)
             as_predicted = self.unpolished and self.rtol >= AS_PREDICTED_FROM and self.counter is not None
-            predicted = self.predictor(asked, later=as_predicted)
+            predicted = self.predictor(predictions_wanted(count), later=as_predicted)
             wanted = count if predicted.values.size >= count else self._existing(count)
             if wanted == 0:
                 return []

@@ -250,7 +250,7 @@ def _symmetrise(A):
 @njit(cache=True)
 def unit_scaled(K, M):
     """The coarse pencil scaled to unit mass (or stiffness) per unknown, as
-    :func:`linmstmm.coarse_prediction._unit_scaled` scales it in numpy, the same
+    :func:`linmstmm.scaled_pencil._unit_scaled` scales it in numpy, the same
     numbers in one pass.
 
     Parameters

@@ -22,6 +22,7 @@ from linmstmm.elements.beam import bending_wavenumber
 from linmstmm.fe.sparse import scipy_csr
 from linmstmm.fe.node_constraints import kept_node_constraints
 from linmstmm.model import Model
+from linmstmm.scaled_pencil import CoarsePencil, assembled_pencil
 from linmstmm.standard_eigen import BISECTED, Bisection, bisects, lowest_eigenpairs
 
 #: Radians of a bending wave per element of the predicting mesh: its frequencies are
@@ -128,113 +129,6 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     return PredictedModes(values, None, later)
 
 
-@dataclass(frozen=True, eq=False)
-class CoarsePencil:
-    """The coarse FE model of :func:`coarse_predictions`, assembled and scaled.
-
-    Attributes
-    ----------
-    assembly : linmstmm.fe.assembly.Assembly
-        The assembled model (its K and M dense where small, else sparse).
-    rigid_body_modes : int
-        Its rigid-body modes, counted as the FE route counts them
-        (:func:`linmstmm.fe.rigid_motions.rigid_mode_count`), not formed.
-    scale : numpy.ndarray, shape (n,)
-        The scaling of each unknown: to unit mass (or stiffness, where it has
-        none), the same eigenvalues, and a pencil that no longer depends on
-        the units (in km the translations' and rotations' entries lie 1e6
-        further apart, and the predictions were 1e-4 to 3e-2 off where in m
-        they were 1e-7 to 1e-4 off).
-    compiled : bool
-        Whether the dense K and M are scaled by the compiled kernel (the same numbers).
-    K, M : numpy.ndarray, shape (n, n)
-        Dense and scaled, made on first use: the sparse route of a refined mesh
-        never asks for them (on the second launcher's 1,284 unknowns they cost
-        about 10 ms).
-    """
-
-    assembly: object
-    rigid_body_modes: int
-    scale: np.ndarray
-    compiled: bool
-
-    @property
-    def size(self) -> int:
-        """n, the unknowns of the pencil."""
-        return self.scale.size
-
-    @property
-    def K(self) -> np.ndarray:
-        """(n, n) the scaled stiffness, dense (made on first use)."""
-        return self._dense[0]
-
-    @property
-    def M(self) -> np.ndarray:
-        """(n, n) the scaled mass, dense (made on first use)."""
-        return self._dense[1]
-
-    @functools.cached_property
-    def _dense(self) -> tuple[np.ndarray, np.ndarray]:
-        """(K, M) dense, scaled (:attr:`scale`), read-only: shared by every prediction of this model."""
-        K, M = (matrix if isinstance(matrix, np.ndarray) else matrix.toarray()
-                for matrix in (self.assembly.K, self.assembly.M))
-        if self.compiled:  # the same numbers in one pass
-            from linmstmm._product_kernels import unit_scaled
-
-            _, K, M = unit_scaled(K, M)
-        else:
-            _, K, M = _unit_scaled(K, M)
-        for matrix in (K, M):
-            matrix.setflags(write=False)
-        return K, M
-
-    @property
-    def reduced(self) -> np.ndarray | None:
-        """The pencil in standard form, C = L⁻¹ K L⁻ᵀ with M = L Lᵀ (lower triangle),
-        shape (n, n); None where M is not positive definite (massless unknowns).
-
-        LAPACK's potrf and sygst, the first two steps of the generalized eigensolver
-        sygvx, made once per pencil: each prediction then runs only a standard
-        eigensolver on C (:func:`_lowest_eigenvalues`). Up to
-        :data:`~linmstmm.standard_eigen.BISECTED` eigenvalues it is syevx (in its
-        steps), whose eigenvalues are sygvx's on (K, M) to the bit
-        (tests/test_coarse_prediction.py); beyond, syev finds them all at once, not
-        to the bit of sygvx's (1e-10 apart on the launcher). A repeat solve of the
-        second launcher's ten lowest saved a quarter of its prediction (one asking
-        the same count now takes the kept predictions, :func:`predict_frequencies`).
-        """
-        return self._standard[1]
-
-    @functools.cached_property
-    def _standard(self) -> tuple[np.ndarray, np.ndarray] | tuple[None, None]:
-        """(L, C): the Cholesky factor of M (lower) and :attr:`reduced`; (None, None)
-        where M is not positive definite."""
-        factor, info = scipy.linalg.lapack.dpotrf(self.M, lower=1, clean=0)
-        if info:
-            return None, None
-        reduced, info = scipy.linalg.lapack.dsygst(self.K, factor, itype=1, lower=1)
-        for matrix in (factor, reduced):
-            matrix.setflags(write=False)  # shared by every prediction of this model
-        return factor, reduced
-
-    def at_nodes(self, vectors: np.ndarray, reduced: bool = True) -> np.ndarray:
-        """(m, 6 · (points + bodies)): the eigenvectors ``vectors`` (n, m) of
-        :attr:`reduced` (y; x = L⁻ᵀ y on the scaled pencil), or of the scaled pencil
-        itself (x) where ``reduced`` is False, as displacements and rotations at the
-        model's points and mass centres (:class:`PredictedModes`): x times
-        :attr:`scale` on the assembly's unknowns, and the rows of T at those nodes."""
-        if reduced:
-            vectors, info = scipy.linalg.lapack.dtrtrs(self._standard[0], vectors, lower=1, trans=1)
-        return (self._node_rows @ (self.scale[:, None] * vectors)).T
-
-    @functools.cached_property
-    def _node_rows(self):
-        """The rows of the assembly's T (scipy CSR) at the full DOFs of the points and
-        mass centres, which every mesh numbers first (:mod:`linmstmm.fe.layout`)."""
-        model = self.assembly.model
-        return scipy_csr(self.assembly.parts.T)[:6 * (len(model.points) + len(model.rigids))]
-
-
 def coarse_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
     """The :class:`CoarsePencil` of ``model`` meshed with ``elements_per_beam``: assembled
     on the first call for this model object (its nodes' constraints eliminated once
@@ -258,36 +152,8 @@ def coarse_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
     return _pencil(model, elements_per_beam)
 
 
-@functools.lru_cache(maxsize=PENCILS_KEPT)
-def _pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
-    """:func:`coarse_pencil` made anew."""
-    from linmstmm.determinant import kernels_loaded
-    from linmstmm.fe.assembly import assembled
-    from linmstmm.fe.rigid_motions import rigid_mode_count
-
-    forms = None
-    if kernels_loaded():  # compiled products where numba is loaded already: the same K and M
-        from linmstmm._product_kernels import pencil_forms as forms
-    fe = assembled(model, elements_per_beam, kept_node_constraints, forms)
-    rigid = rigid_mode_count(fe.model, fe.parts.layout, fe.parts.masters, fe.M)
-    return CoarsePencil(fe, rigid, _unit_scale(fe.K.diagonal(), fe.M.diagonal()), forms is not None)
-
-
-def _unit_scaled(K: np.ndarray, M: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(scale (n,), K (n, n), M (n, n)) of the pencil (K, M) scaled to unit mass per
-    unknown, or unit stiffness where it has none (:class:`CoarsePencil`): scale_i is
-    1 / √M_ii, or 1 / √|K_ii| where M_ii is not positive, or 1 where both are 0, and
-    each entry is multiplied by scale_i scale_j."""
-    scale = _unit_scale(np.diag(K), np.diag(M))
-    both = np.outer(scale, scale)
-    return scale, K * both, M * both
-
-
-def _unit_scale(stiffness: np.ndarray, mass: np.ndarray) -> np.ndarray:
-    """(n,) 1 / √M_ii, or 1 / √|K_ii| where M_ii is not positive, or 1 where both are 0,
-    from the diagonals ``stiffness`` K_ii and ``mass`` M_ii (n,) (:func:`_unit_scaled`)."""
-    size = np.where(mass > 0, mass, np.abs(stiffness))
-    return 1 / np.sqrt(np.where(size > 0, size, 1.0))
+#: :func:`coarse_pencil`'s store: the PENCILS_KEPT last used.
+_pencil = functools.lru_cache(maxsize=PENCILS_KEPT)(assembled_pencil)
 
 
 def _forget_pencils() -> None:

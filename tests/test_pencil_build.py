@@ -33,7 +33,8 @@ from random_models import KINDS, random_model, random_rotation
 from varied_models import varied_model
 
 from linmstmm._product_kernels import pencil_forms, unit_scaled
-from linmstmm.coarse_prediction import _unit_scaled, coarse_pencil
+from linmstmm.coarse_prediction import coarse_pencil
+from linmstmm.scaled_pencil import _unit_scaled
 from linmstmm.fe import products
 from linmstmm.fe.assembly import assemble, assembled
 from linmstmm.fe.masses import (

@@ -98,11 +98,13 @@ class PredictedModes:
 
 
 def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: float | None = None,
-                 nodal: bool = True, later: bool = False) -> PredictedModes:
+                 nodal: bool = True, later: bool = False, accuracy: float | None = None) -> PredictedModes:
     """:func:`coarse_predictions` with the modes at the nodes (``nodal``): the
     :class:`PredictedModes` of the mesh of ``elements_per_beam``; with ``later``, the
     modes are left to :attr:`PredictedModes.later` where the eigensolve can make them
-    afterwards (bisection), else made now.
+    afterwards (bisection), else made now. Where they are left so and the compiled
+    kernels are loaded, an ``accuracy`` (relative) takes the frequencies to that only
+    (:class:`~linmstmm.standard_eigen.Bisection`); else they are found to rounding.
 
     The vectors come from the same eigensolve as the frequencies (:func:`_lowest_eigenvalues`).
     Up to :data:`~linmstmm.standard_eigen.BISECTED` that is syevx's steps, which give
@@ -119,7 +121,11 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     rigid = pencil.rigid_body_modes
     wanted = min(count + rigid, pencil.size)
     now = nodal and not (later and _bisected(pencil, wanted, shift))
-    lam, vectors, reduced, bisection = _lowest_eigenvalues(pencil, wanted, shift, now)
+    from linmstmm.determinant import kernels_loaded  # imported where used: it imports the deduction
+
+    loose = accuracy is not None and later and not now and kernels_loaded()  # (λ = ω²: twice ω's accuracy)
+    lam, vectors, reduced, bisection = _lowest_eigenvalues(pencil, wanted, shift, now,
+                                                           2.0 * accuracy if loose else None)
     order = np.argsort(lam)[rigid:rigid + count]
     values = np.sqrt(np.maximum(lam[order], 0.0))
     if vectors is not None:
@@ -192,8 +198,8 @@ def _regular_pencil(K: np.ndarray, M: np.ndarray):
     return K[np.ix_(kept, kept)], M[np.ix_(kept, kept)]
 
 
-def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None, vectors: bool = False
-                        ) -> tuple[np.ndarray, np.ndarray | None, bool, Bisection | None]:
+def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None, vectors: bool = False,
+                        accuracy: float | None = None) -> tuple[np.ndarray, np.ndarray | None, bool, Bisection | None]:
     """(at least the ``count`` lowest eigenvalues of ``pencil`` (K, M), (rad/s)², in
     any order; their eigenvectors (n, m) if ``vectors`` asks and the route gives them,
     else None; whether those are of :attr:`CoarsePencil.reduced` (y), not of the scaled
@@ -203,7 +209,8 @@ def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None, v
     (:mod:`linmstmm.block_lanczos`, x) where a shift is given, every unknown carries
     mass and there are more than DENSE_PREDICTION; else on the kept standard form
     (:func:`~linmstmm.standard_eigen.lowest_eigenpairs`, y); by QZ where M is singular,
-    the infinite eigenvalues dropped, without vectors."""
+    the infinite eigenvalues dropped, without vectors. ``accuracy``: as
+    :func:`~linmstmm.standard_eigen.lowest_eigenpairs` takes it, of the eigenvalues."""
     if _sparse_route(pencil, shift):
         found = _sparse_lowest(pencil, count, shift, vectors)
         if found is not None:
@@ -212,7 +219,7 @@ def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None, v
         K, M = _regular_pencil(pencil.K, pencil.M)
         lam = scipy.linalg.eigvals(K, M)
         return lam[np.isfinite(lam)].real, None, True, None
-    lam, found_vectors, bisection = lowest_eigenpairs(pencil.reduced, count, vectors)
+    lam, found_vectors, bisection = lowest_eigenpairs(pencil.reduced, count, vectors, accuracy)
     return lam, found_vectors, True, bisection
 
 
@@ -277,7 +284,7 @@ def predict_frequencies(model: Model, count: int) -> np.ndarray:
     return _kept_modes(model, count, nodal=False).values.copy()
 
 
-def predicted_modes(model: Model, count: int, later: bool = False) -> PredictedModes:
+def predicted_modes(model: Model, count: int, later: bool = False, accuracy: float | None = None) -> PredictedModes:
     """:func:`predict_frequencies` with the modes at the model's points and mass
     centres where the eigensolver gives them (:class:`PredictedModes`), kept as the
     frequencies are (the frequencies are the same, to the bit, where the eigensolver
@@ -294,41 +301,49 @@ def predicted_modes(model: Model, count: int, later: bool = False) -> PredictedM
         eigensolve can make them afterwards (bisection: the launcher's 12 lowest on
         its 84 unknowns 0.27 ms, their modes 0.08 ms more, only where asked for);
         else they are made now.
+    accuracy : float or None
+        With ``later``, the relative accuracy the frequencies are wanted to, where less
+        than rounding saves time (:func:`coarse_modes`); None: to rounding.
 
     Returns
     -------
     PredictedModes
         Shared with later calls: not to be written into.
     """
-    return _kept_modes(model, count, nodal=True, later=later)
+    return _kept_modes(model, count, nodal=True, later=later, accuracy=accuracy)
 
 
-#: [((model, count, whether the modes at the nodes were asked for), PredictedModes)]: the last made.
+#: [((model, count, whether the modes at the nodes were asked for, the frequencies' accuracy
+#: or None), PredictedModes)]: the last made.
 _kept = [(None, None)]
 
 
-def _kept_modes(model: Model, count: int, nodal: bool, later: bool = False) -> PredictedModes:
-    """The last :class:`PredictedModes` made, where it was made for ``model`` and ``count``
-    with the modes at the nodes if ``nodal`` asks for them (now, or ``later`` where
-    they can come so); else made anew and kept."""
+def _kept_modes(model: Model, count: int, nodal: bool, later: bool = False,
+                accuracy: float | None = None) -> PredictedModes:
+    """The last :class:`PredictedModes` made, where it was made for ``model`` and ``count``,
+    its frequencies to rounding or to an ``accuracy`` no coarser than asked, with the modes
+    at the nodes if ``nodal`` asks for them (now, or ``later`` where they can come so);
+    else made anew and kept."""
     key, kept = _kept[0]  # read once: another thread may replace it
-    if key is not None and key[0] is model and key[1] == count:
+    if key is not None and key[0] is model and key[1] == count and (
+            key[3] is None or (accuracy is not None and later and key[3] <= accuracy)):
         if not nodal or kept.nodal is not None:
             return kept
         if kept.later is not None:  # the modes of the frequencies handed out already can come
             if later:
                 return kept
             made = PredictedModes(kept.values, kept.later())
-            _kept[0] = (model, count, True), made
+            _kept[0] = (model, count, True, key[3]), made
             return made
         if key[2]:  # asked for before, and the eigensolve gives none (QZ)
             return kept
-    made = _predicted_modes(model, count, nodal, later)
-    _kept[0] = (model, count, nodal), made
+    made = _predicted_modes(model, count, nodal, later, accuracy)
+    _kept[0] = (model, count, nodal, accuracy if later else None), made
     return made
 
 
-def _predicted_modes(model: Model, count: int, nodal: bool, later: bool = False) -> PredictedModes:
+def _predicted_modes(model: Model, count: int, nodal: bool, later: bool = False,
+                     accuracy: float | None = None) -> PredictedModes:
     """:func:`predicted_modes` made anew (the modes at the nodes only if ``nodal``, now or
     ``later`` where they can come so): two elements per beam, or as many as the highest
     frequency's bending waves need. The two-element mesh's frequencies decide; its
@@ -337,13 +352,14 @@ def _predicted_modes(model: Model, count: int, nodal: bool, later: bool = False)
     wanted, syevx's frequencies with the vectors and without differ at rounding,
     1e-13 on a varied model's 24 unknowns, and the finer mesh's shift with them.)"""
     with_first = nodal and not later and count <= BISECTED
-    predicted = coarse_modes(model, count, 2, nodal=with_first)
+    predicted = coarse_modes(model, count, 2, nodal=with_first, later=later, accuracy=accuracy)
     needed = 2
     if model.beams and predicted.values.size:
         beta_L = max(bending_wavenumber(beam, predicted.values[-1]) * beam.length for beam in model.beams)
         needed = min(int(np.ceil(beta_L / WAVE_PER_ELEMENT)), MAX_ELEMENTS, max(_finest_mesh(model), 2))
     if needed > 2 * 2:
-        return coarse_modes(model, count, needed, shift=0.5 * predicted.values[0] ** 2, nodal=nodal, later=later)
+        return coarse_modes(model, count, needed, shift=0.5 * predicted.values[0] ** 2, nodal=nodal, later=later,
+                            accuracy=accuracy)
     if with_first or not nodal or (later and predicted.later is not None):
         return predicted
     if predicted.later is not None:

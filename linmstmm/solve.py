@@ -1,6 +1,7 @@
 """Natural frequencies of a model: topology → deduction → roots → result."""
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import dataclass, field
 
@@ -132,8 +133,7 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     evaluator = system.determinant
     finder = RootFinder(evaluator.log_det, lambda omega: evaluator.matrix(omega)[0],
                         rigid_body_modes=system.rigid_body_modes,
-                        predictor=lambda n, later=False: predicted_modes(model, n, later), scale=system.scale,
-                        **options)
+                        predictor=functools.partial(predicted_modes, model), scale=system.scale, **options)
     finder.determinant = evaluator
     finder._evaluations_reported = evaluator.evaluations  # this finder's search counts from here
     if system.counter is not None:

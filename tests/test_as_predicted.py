@@ -14,7 +14,7 @@ import linmstmm.solve
 from linmstmm import load_model, natural_frequencies
 from linmstmm.coarse_prediction import predict_frequencies
 from linmstmm.fe import fe_frequencies
-from linmstmm.rayleigh import AS_PREDICTED_FROM
+from linmstmm.rayleigh import AS_PREDICTED_FROM, PREDICTED_TO
 from linmstmm.roots.settings import predictions_wanted
 from linmstmm.standard_eigen import Bisection
 from linmstmm.wittrick_williams import ModeCounter
@@ -58,11 +58,12 @@ def launcher_fe(launcher):
 
 @pytest.mark.parametrize("rtol", [1e-5, 1e-4])
 def test_the_launchers_ten_lowest_stand_as_predicted_without_modes(launcher, launcher_fe, made, rtol):
-    """Coarse values within 2.0e-6 of the roots: every one stands."""
+    """Coarse values within 2.0e-6 of the roots: every one stands, found only to
+    PREDICTED_TO × rtol."""
     result = natural_frequencies(launcher, 10, engine="compiled", rtol=rtol)
-    predicted = predict_frequencies(launcher, predictions_wanted(10))[:10] / (2 * np.pi)
+    predicted = predict_frequencies(launcher, predictions_wanted(10))[:10] / (2 * np.pi)  # to rounding
     assert made == {"vectors": 0, "refined": []} and result.evaluations == 0
-    assert np.array_equal(result.frequencies_hz, predicted)
+    assert np.all(np.abs(result.frequencies_hz / predicted - 1) <= PREDICTED_TO * rtol)
     assert np.max(np.abs(result.frequencies_hz / launcher_fe[:10] - 1)) <= rtol
 
 
@@ -91,7 +92,8 @@ def test_a_tighter_request_predicts_with_the_modes(launcher, monkeypatch, rtol):
     asked = []
     predicted_modes = linmstmm.solve.predicted_modes
     monkeypatch.setattr(linmstmm.solve, "predicted_modes",
-                        lambda model, count, later=False: asked.append(later) or predicted_modes(model, count, later))
+                        lambda model, count, later=False, accuracy=None:
+                        asked.append(later) or predicted_modes(model, count, later, accuracy))
     natural_frequencies(launcher, 10, engine="compiled", rtol=rtol)
     assert asked == [False]
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from linmstmm.counting import deflated
 from linmstmm.predicted import predicted_roots
-from linmstmm.rayleigh import AS_PREDICTED_FROM, refined_predictions
+from linmstmm.rayleigh import AS_PREDICTED_FROM, PREDICTED_TO, refined_predictions
 from linmstmm.roots import brackets, certify, fast_path, floor, pencil, segments
 from linmstmm.roots import clusters as close_roots
 from linmstmm.roots.result import RootSearchResult, search_result
@@ -39,9 +39,10 @@ class RootFinder:
     kinematics (:func:`linmstmm.rigid_motion.rigid_body_mode_count`); their
     zeros of det Ū_all at ω = 0 are divided out once they are confirmed
     (:meth:`divide_out_rigid_body_zeros`).
-    predictor : callable (n, later=False) -> :class:`~linmstmm.coarse_prediction.PredictedModes`,
+    predictor : callable (n, later=False, accuracy=None) -> :class:`~linmstmm.coarse_prediction.PredictedModes`,
     the lowest n elastic roots predicted (rad/s) and their modes at the nodes where
-    known, made now or, with ``later``, where the eigensolve can make them afterwards
+    known, made now or, with ``later``, where the eigensolve can make them afterwards,
+    and then to a relative ``accuracy`` where given
     (:func:`linmstmm.coarse_prediction.predicted_modes` of the model), or None; the
     modes refine the predictions by the Rayleigh functional of the counter's exact
     dynamic stiffness (:func:`linmstmm.rayleigh.refined_predictions`; only of those
@@ -263,7 +264,8 @@ class RootFinder:
         """The roots :meth:`find` returns, as a list (rad/s)."""
         if count is not None and self.predictor is not None:
             as_predicted = self.unpolished and self.rtol >= AS_PREDICTED_FROM and self.counter is not None
-            predicted = self.predictor(predictions_wanted(count), later=as_predicted)
+            predicted = self.predictor(predictions_wanted(count), later=as_predicted,
+                                       accuracy=PREDICTED_TO * self.rtol if as_predicted else None)
             wanted = count if predicted.values.size >= count else self._existing(count)
             if wanted == 0:
                 return []

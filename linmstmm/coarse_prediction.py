@@ -111,7 +111,10 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     the same frequencies with them, bit for bit, about 80 µs more on the launcher's 84
     unknowns for its 12 lowest, now or later (:attr:`PredictedModes.later`); beyond,
     syevd with them and syev without, whose frequencies agree to rounding only; on the
-    sparse route the Lanczos's Ritz vectors, with the same frequencies.
+    sparse route the Lanczos's Ritz vectors, with the same frequencies. An eigenvalue of
+    the dense standard form within its rounding level of zero
+    (:attr:`~linmstmm.scaled_pencil.CoarsePencil.rounding_level`) is zero, whatever sign
+    the eigensolver gave it: no prediction (:func:`linmstmm.roots.floor.usable`).
     """
     if elements_per_beam > _finest_mesh(model):  # a dense solve would cost more than the search it saves
         return PredictedModes(np.zeros(0), None)
@@ -126,6 +129,8 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     loose = accuracy is not None and later and not now and kernels_loaded()  # (λ = ω²: twice ω's accuracy)
     lam, vectors, reduced, bisection = _lowest_eigenvalues(pencil, wanted, shift, now,
                                                            2.0 * accuracy if loose else None)
+    if reduced and pencil.reduced is not None:  # (else QZ, or the sparse route's Ritz values)
+        lam = np.where(np.abs(lam) <= pencil.rounding_level, 0.0, lam)  # rounding, whatever its sign
     order = np.argsort(lam)[rigid:rigid + count]
     values = np.sqrt(np.maximum(lam[order], 0.0))
     if vectors is not None:

@@ -355,10 +355,7 @@ def _predicted_modes(model: Model, count: int, nodal: bool, later: bool = False,
     modes come with them where bisection finds them (up to BISECTED) and they are
     wanted now, else only where no finer mesh follows. (Where every eigenvalue is
     wanted, syevx's frequencies with the vectors and without differ at rounding,
-    1e-13 on a varied model's 24 unknowns, and the finer mesh's shift with them.)
-    Where the finer mesh's lowest frequency is rounding of its largest and the
-    two-element mesh's is not (its form spans less: stiffness grows as the cube of
-    elements per beam), the two-element mesh predicts."""
+    1e-13 on a varied model's 24 unknowns, and the finer mesh's shift with them.)"""
     with_first = nodal and not later and count <= BISECTED
     predicted = coarse_modes(model, count, 2, nodal=with_first, later=later, accuracy=accuracy)
     needed = 2
@@ -366,11 +363,8 @@ def _predicted_modes(model: Model, count: int, nodal: bool, later: bool = False,
         beta_L = max(bending_wavenumber(beam, predicted.values[-1]) * beam.length for beam in model.beams)
         needed = min(int(np.ceil(beta_L / WAVE_PER_ELEMENT)), MAX_ELEMENTS, max(_finest_mesh(model), 2))
     if needed > 2 * 2:
-        refined = coarse_modes(model, count, needed, shift=0.5 * predicted.values[0] ** 2, nodal=nodal, later=later,
-                               accuracy=accuracy)
-        if not (refined.values.size and refined.values[0] == 0 < predicted.values[0]):
-            return refined
-        # the finer mesh's lowest is its rounding (its form spans more), the coarse mesh's is not: the coarse one predicts
+        return coarse_modes(model, count, needed, shift=0.5 * predicted.values[0] ** 2, nodal=nodal, later=later,
+                            accuracy=accuracy)
     if with_first or not nodal or (later and predicted.later is not None):
         return predicted
     if predicted.later is not None:

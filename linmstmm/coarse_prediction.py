@@ -102,9 +102,10 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     """:func:`coarse_predictions` with the modes at the nodes (``nodal``): the
     :class:`PredictedModes` of the mesh of ``elements_per_beam``; with ``later``, the
     modes are left to :attr:`PredictedModes.later` where the eigensolve can make them
-    afterwards (bisection), else made now. Where they are left so and the compiled
-    kernels are loaded, an ``accuracy`` (relative) takes the frequencies to that only
-    (:class:`~linmstmm.standard_eigen.Bisection`); else they are found to rounding.
+    afterwards (bisection), else made now. Where they are left so, an ``accuracy``
+    (relative) takes the frequencies to that only, by a compiled kernel
+    (:class:`~linmstmm.standard_eigen.Bisection`; numba loads there); else they are
+    found to rounding.
 
     The vectors come from the same eigensolve as the frequencies (:func:`_lowest_eigenvalues`).
     Up to :data:`~linmstmm.standard_eigen.BISECTED` that is syevx's steps, which give
@@ -124,9 +125,7 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     rigid = pencil.rigid_body_modes
     wanted = min(count + rigid, pencil.size)
     now = nodal and not (later and _bisected(pencil, wanted, shift))
-    from linmstmm.determinant import kernels_loaded  # imported where used: it imports the deduction
-
-    loose = accuracy is not None and later and not now and kernels_loaded()  # (λ = ω²: twice ω's accuracy)
+    loose = accuracy is not None and later and not now  # (λ = ω²: twice ω's accuracy)
     lam, vectors, reduced, bisection = _lowest_eigenvalues(pencil, wanted, shift, now,
                                                            2.0 * accuracy if loose else None)
     if reduced and pencil.reduced is not None:  # (else QZ, or the sparse route's Ritz values)
@@ -308,7 +307,8 @@ def predicted_modes(model: Model, count: int, later: bool = False, accuracy: flo
         else they are made now.
     accuracy : float or None
         With ``later``, the relative accuracy the frequencies are wanted to, where less
-        than rounding saves time (:func:`coarse_modes`); None: to rounding.
+        than rounding saves time, found by a compiled kernel (:func:`coarse_modes`);
+        None: to rounding.
 
     Returns
     -------

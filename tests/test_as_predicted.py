@@ -115,3 +115,17 @@ def test_a_root_found_within_rtol_of_a_value_that_stood_takes_its_place(monkeypa
     fe = fe_frequencies(varied_model(41)[0], 20, rtol=1e-10)
     assert searched == []
     assert np.all(np.abs(result.frequencies_hz / fe.frequencies_hz - 1) <= 1e-4 + 3 * fe.error_estimate)
+
+
+def test_the_numpy_engine_finds_the_coarse_values_to_rounding_whatever_is_loaded(launcher):
+    """Only a compiled counter asks for the coarse frequencies to a fraction of rtol (the
+    compiled bracketing): the numpy engine's values are LAPACK's, to the bit, with the
+    compiled kernels loaded in the process or not, so its answers do not depend on what
+    ran before in it."""
+    from linmstmm.determinant import load_kernels
+
+    load_kernels()
+    predict_frequencies.cache_clear()
+    result = natural_frequencies(launcher, 10, engine="numpy", rtol=1e-4)
+    predicted = predict_frequencies(launcher, predictions_wanted(10))[:10] / (2 * np.pi)  # to rounding
+    assert np.array_equal(result.frequencies_hz, predicted)

@@ -42,7 +42,9 @@ class RootFinder:
     predictor : callable (n, later=False, accuracy=None) -> :class:`~linmstmm.coarse_prediction.PredictedModes`,
     the lowest n elastic roots predicted (rad/s) and their modes at the nodes where
     known, made now or, with ``later``, where the eigensolve can make them afterwards,
-    and then to a relative ``accuracy`` where given
+    and then to a relative ``accuracy`` where given (by a compiled kernel: given
+    only where the counter is compiled, so the numpy engine's answers do not
+    depend on what else the process has loaded)
     (:func:`linmstmm.coarse_prediction.predicted_modes` of the model), or None; the
     modes refine the predictions by the Rayleigh functional of the counter's exact
     dynamic stiffness (:func:`linmstmm.rayleigh.refined_predictions`; only of those
@@ -264,8 +266,9 @@ class RootFinder:
         """The roots :meth:`find` returns, as a list (rad/s)."""
         if count is not None and self.predictor is not None:
             as_predicted = self.unpolished and self.rtol >= AS_PREDICTED_FROM and self.counter is not None
+            compiled = as_predicted and getattr(self.counter, "engine", None) == "compiled"
             predicted = self.predictor(predictions_wanted(count), later=as_predicted,
-                                       accuracy=PREDICTED_TO * self.rtol if as_predicted else None)
+                                       accuracy=PREDICTED_TO * self.rtol if compiled else None)
             wanted = count if predicted.values.size >= count else self._existing(count)
             if wanted == 0:
                 return []

@@ -432,7 +432,7 @@ def _deflated_polished(finder, roots: list[float], starts: list[float], predicti
         found, steps = secant_roots(deflated(finder.log_det, roots), np.array(starts), finder.xtol, 0.0)
         left, this_round = [], []
         for start, root, step in zip(starts, found, steps):
-            if not np.isnan(root):
+            if not np.isnan(root):  # converged (NaN otherwise): the root of a value it is within rtol of
                 stood_for.absorbed(float(root), roots)
             if (np.isnan(root) or step > finder.xtol or abs(root - start) > cluster_reach(predictions, start)
                     or _known(root, roots, NEAR_KNOWN) or _known(root, this_round, _same_root(finder))):

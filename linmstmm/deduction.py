@@ -238,12 +238,16 @@ class Deduction:
             0 a displacement, 1 a rotation, 2 a moment, 3 a force.
         """
         if self._row_kinds is None:
-            _, rows, _ = self._carry(np.ones(1), stable=False)
-            self._row_kinds = np.concatenate([np.arange(12) // 3]
-                                             + [_row_kinds(("row", row, row[1], row[2])) for row in rows[1:]])
+            self._remember_row_kinds(self._carry(np.ones(1), stable=False)[1])
         if not self.released_columns.size:  # nothing released (most models): no copies to make
             return self._row_kinds, self._column_kinds
         return np.delete(self._row_kinds, self.released_rows), np.delete(self._column_kinds, self.released_columns)
+
+    def _remember_row_kinds(self, rows: list) -> None:
+        """Keep the kinds of Ū_all's rows before release (:meth:`kinds`) from the ``rows``
+        of a plain :meth:`_carry`, at any frequency: they follow from the topology alone."""
+        self._row_kinds = np.concatenate([np.arange(12) // 3]
+                                         + [_row_kinds(("row", row, row[1], row[2])) for row in rows[1:]])
 
     def adopt_row_kinds(self, row_kinds: np.ndarray) -> None:
         """Take the kinds of Ū_all's rows before release (0 a displacement, 1 a rotation,
@@ -437,6 +441,8 @@ class Deduction:
         """
         omega = frequencies(omega)
         outputs, rows, scale = self._carry(omega, stable)
+        if self._row_kinds is None and not stable:  # so that kinds() needs no carry of its own
+            self._remember_row_kinds(rows)
         ubar = self._assemble(omega, outputs, rows)
         return (ubar, scale) if stable else ubar
 

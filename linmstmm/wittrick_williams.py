@@ -478,23 +478,23 @@ def _factorised_inertia(matrix: np.ndarray, singular: float) -> int | None:
 
 def _block_inertia(factor: np.ndarray, pivots: np.ndarray, singular: float) -> int | None:
     """Negative eigenvalues of the block-diagonal D of LAPACK's ``?sytrf`` (lower),
-    None where a 1 × 1 pivot or a 2 × 2 block's eigenvalue is below ``singular``."""
-    negatives, k, n = 0, 0, len(pivots)
+    None where a 1 × 1 pivot or a 2 × 2 block's eigenvalue is below ``singular``.
+
+    ``pivots`` (n,) is sytrf's ipiv: positive at a 1 × 1 pivot, negative on both rows
+    of a 2 × 2 block, so that a run of negative entries is a run of blocks, each
+    starting at an even offset into the run. All blocks at once (a Python loop over
+    them cost the numpy count 2 ms in 21 on the launcher)."""
     diagonal = factor.diagonal()
-    if np.all(pivots > 0):  # 1 × 1 pivots only (the common case), at once
+    single = pivots > 0
+    if single.all():  # 1 × 1 pivots only (the common case)
         return None if np.min(np.abs(diagonal)) < singular else int(np.sum(diagonal < 0))
-    while k < n:
-        if pivots[k] > 0:
-            if abs(diagonal[k]) < singular:
-                return None
-            negatives += diagonal[k] < 0
-            k += 1
-            continue
-        a, b, c = diagonal[k], factor[k + 1, k], diagonal[k + 1]
-        half_trace, root = (a + c) / 2, np.hypot((a - c) / 2, b)
-        eigenvalues = (half_trace - root, half_trace + root)
-        if min(abs(e) for e in eigenvalues) < singular:
-            return None
-        negatives += sum(e < 0 for e in eigenvalues)
-        k += 2
-    return negatives
+    index = np.arange(len(pivots))
+    run_start = np.maximum.accumulate(np.where(single, index + 1, 0))  # of the run of blocks a row is in
+    first = ~single & ((index - run_start) % 2 == 0)                   # the rows that start a 2 × 2 block
+    k = index[first]
+    a, b, c = diagonal[k], factor[k + 1, k], diagonal[k + 1]
+    half_trace, root = (a + c) / 2, np.hypot((a - c) / 2, b)
+    eigenvalues = np.concatenate([diagonal[single], half_trace - root, half_trace + root])
+    if np.min(np.abs(eigenvalues)) < singular:
+        return None
+    return int(np.sum(eigenvalues < 0))

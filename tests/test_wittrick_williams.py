@@ -163,15 +163,35 @@ def test_free_free_beam_counts_its_six_rigid_body_modes():
     assert counter(first * 1.01) == 7
 
 
+def _pivot_sizes(factor, pivots) -> list[float]:
+    """|eigenvalue| of each 1 × 1 pivot and 2 × 2 block of sytrf's D, block by block."""
+    sizes, k = [], 0
+    while k < len(pivots):
+        width = 1 if pivots[k] > 0 else 2
+        sizes += list(abs(la.eigvalsh(factor[k:k + width, k:k + width], lower=True)))
+        k += width
+    return sizes
+
+
 def test_block_inertia_kernel_mirrors_the_reference():
     rng = np.random.default_rng(7)
-    for n in (1, 2, 5, 12, 40):
-        matrix = rng.standard_normal((n, n))
-        matrix = matrix + matrix.T
-        factor, pivots, info = la.lapack.dsytrf(matrix, lower=1)
-        assert info == 0
-        reference = _block_inertia(factor, pivots, 1e-11)
-        assert kernels.block_inertia(factor, pivots, 1e-11) == reference == int(np.sum(la.eigvalsh(matrix) < 0))
+    blocks = 0
+    for zero_diagonal in (False, True):  # zero: Bunch–Kaufman takes 2 × 2 blocks, runs of them side by side
+        for n in (2, 5, 12, 40) if zero_diagonal else (1, 2, 5, 12, 40):
+            matrix = rng.standard_normal((n, n))
+            matrix = matrix + matrix.T
+            if zero_diagonal:
+                np.fill_diagonal(matrix, 0.0)
+            factor, pivots, info = la.lapack.dsytrf(matrix, lower=1)
+            assert info == 0
+            blocks += int(np.sum(pivots < 0)) // 2
+            reference = _block_inertia(factor, pivots, 1e-11)
+            assert kernels.block_inertia(factor, pivots, 1e-11) == reference == int(np.sum(la.eigvalsh(matrix) < 0))
+            # a threshold above the smallest pivot or block eigenvalue: undecided in both
+            threshold = 1.01 * min(_pivot_sizes(factor, pivots))
+            assert _block_inertia(factor, pivots, threshold) is None
+            assert kernels.block_inertia(factor, pivots, threshold) == -1
+    assert blocks > 20  # 2 × 2 blocks were exercised
 
 
 def test_clamped_pivots_leave_the_count_undecided():

@@ -7,12 +7,13 @@ of the augmented eigenvectors are integrated from them (:class:`_Fields`).
 """
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 
 from linmstmm.deduction import Deduction
-from linmstmm.elements.beam import beam_transfer
+from linmstmm.elements.beam import beam_states
 from linmstmm.model import Model
 
 #: Gauss–Legendre points along a beam beyond its largest wavenumber × length.
@@ -42,16 +43,15 @@ class _Fields:
         topology = deduction.topology
         states = _element_states(deduction, omega, zbar)
         index = {el.name: e for e, el in enumerate(topology.elements)}
-        stations, quadrature, at_stations, at_nodes = {}, {}, {}, {}
+        stations, rules, at_stations, at_nodes = {}, {}, {}, {}
         for beam in model.beams:
             e = index[beam.name]
             stations[beam.name] = np.linspace(0.0, beam.length, n_stations)
-            quadrature[beam.name] = _quadrature(beam, omega.max(initial=0.0))
-            at_stations[beam.name] = _beam_states(beam, topology.elements[e], omega, states[e],
-                                                  stations[beam.name])
-            at_nodes[beam.name] = _beam_states(beam, topology.elements[e], omega, states[e],
-                                               quadrature[beam.name][0])
-        return cls(tuple(index), tuple(model.points), states, at_stations, at_nodes, zbar, topology, stations, quadrature)
+            rules[beam.name] = quadrature(beam, omega.max(initial=0.0))
+            both = _beam_states(beam, topology.elements[e], omega, states[e],
+                                np.concatenate([stations[beam.name], rules[beam.name][0]]))
+            at_stations[beam.name], at_nodes[beam.name] = both[:, :n_stations], both[:, n_stations:]
+        return cls(tuple(index), tuple(model.points), states, at_stations, at_nodes, zbar, topology, stations, rules)
 
     def apply(self, transform: np.ndarray) -> _Fields:
         """The fields of the modes ``transform.T @ raw modes`` (transform (n_raw, n))."""
@@ -192,28 +192,28 @@ def _beam_states(beam, element, omega, port_states, stations) -> np.ndarray:
     part nearer the input exerts on the part beyond).
     """
     reverse = element.inputs[0] == 1
-    z_in = port_states[:, element.inputs[0]]
     distances = beam.length - stations if reverse else stations
-    out = np.empty((omega.size, stations.size, 12))
-    for s, distance in enumerate(distances):
-        if distance > 0:
-            out[:, s] = np.einsum("nij,nj->ni", beam_transfer(beam, omega, reverse=reverse,
-                                                              length=distance), z_in)
-        else:
-            out[:, s] = z_in
-    return out
+    return beam_states(beam, omega, port_states[:, element.inputs[0]], distances, reverse)
 
 
-def _quadrature(beam, omega_max: float):
-    """Gauss–Legendre (nodes (q,), weights (q,)) on [0, L], enough for the highest mode.
+def quadrature(beam, omega_max: float) -> tuple[np.ndarray, np.ndarray]:
+    """Gauss–Legendre (nodes (q,) m, weights (q,) m) on [0, L], enough for the highest mode.
 
     q = (largest wavenumber at omega_max) × L + EXTRA_QUADRATURE_POINTS, where
     the wavenumbers are bending (ρAω²/EI)^¼, axial ω√(ρ/E), torsion ω√(ρIp/GJ).
     """
     count = int(np.ceil(max(beam.wavenumbers(omega_max).values()) * beam.length)) + EXTRA_QUADRATURE_POINTS
-    nodes, weights = np.polynomial.legendre.leggauss(count)
+    nodes, weights = _gauss_legendre(count)
     half = beam.length / 2
     return half * (nodes + 1), half * weights
+
+
+@functools.lru_cache(maxsize=64)
+def _gauss_legendre(count: int) -> tuple[np.ndarray, np.ndarray]:
+    """numpy's ``leggauss(count)`` on [−1, 1], made once per count (0.5 ms each), read-only."""
+    nodes, weights = np.polynomial.legendre.leggauss(count)
+    nodes.flags.writeable = weights.flags.writeable = False
+    return nodes, weights
 
 
 def _station_positions(model: Model, beam, fields: _Fields) -> np.ndarray:

@@ -29,8 +29,8 @@ from __future__ import annotations
 import numpy as np
 
 from linmstmm.eigenspaces import SAME_FREQUENCY
-from linmstmm.elements.beam import beam_transfer
-from linmstmm.mode_fields import EXTRA_QUADRATURE_POINTS
+from linmstmm.elements.beam import beam_states, beam_transfer
+from linmstmm.mode_fields import quadrature
 from linmstmm.model import Model, ModelError
 from linmstmm.modes import ModalResult
 from linmstmm.parameters import Key, parse_key
@@ -156,12 +156,9 @@ def _beam_integrals(beam, modes: ModalResult) -> dict[str, np.ndarray]:
     twist (1/m), translations (m) and torsional rotation: the exact transfer-matrix field."""
     omega = modes.omega
     start = _start_state(beam, modes)
-    reach = max(beam.wavenumbers(omega.max(initial=0.0)).values()) * beam.length
-    nodes, weights = np.polynomial.legendre.leggauss(int(np.ceil(reach)) + EXTRA_QUADRATURE_POINTS)
-    nodes, weights = beam.length / 2 * (nodes + 1), beam.length / 2 * weights
+    nodes, weights = quadrature(beam, omega.max(initial=0.0))
     axes = np.asarray(beam.axes, float)
-    states = np.stack([np.einsum("nij,nj->ni", beam_transfer(beam, omega, length=x), start)
-                       for x in nodes], axis=1)  # (n, q, 12), local values below
+    states = beam_states(beam, omega, start, nodes)  # (n, q, 12), local values below
     translation, rotation = states[..., 0:3] @ axes.T, states[..., 3:6] @ axes.T
     moment, force = states[..., 6:9] @ axes.T, states[..., 9:12] @ axes.T
     root = np.sqrt(weights)

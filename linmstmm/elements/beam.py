@@ -96,14 +96,18 @@ _SIGN = np.outer([1, 1, -1, 1], [1, 1, -1, 1])
 
 def bending_transfers(EIs, rhoA, L, omega) -> list[np.ndarray]:
     """(n, 4, 4) transfer of (v, θ, m, q) in the x-y form of the bending equations,
-    one per bending stiffness in ``EIs`` (one Krylov evaluation for all)."""
+    one per bending stiffness in ``EIs`` (one Krylov evaluation for all); ``L`` m, one
+    length for all, or float64 (n,), one per frequency."""
     w = np.concatenate([rhoA * omega**2 * L**4 / EI for EI in EIs])
     functions = np.moveaxis(krylov(w)[_KRYLOV_INDEX], -1, 0)  # (len(EIs)·n, 4, 4)
     powers = np.where(_W_POWER, w[:, None, None], 1)
     out = []
     for k, EI in enumerate(EIs):
-        constants = np.array([[int(_SIGN[i, j]) * L ** int(_L_POWER[i, j]) * EI ** int(_EI_POWER[i, j])
-                               for j in range(4)] for i in range(4)])
+        if np.ndim(L):  # a length per frequency: (n, 4, 4)
+            constants = _SIGN * L[:, None, None] ** _L_POWER * EI ** _EI_POWER
+        else:
+            constants = np.array([[int(_SIGN[i, j]) * L ** int(_L_POWER[i, j]) * EI ** int(_EI_POWER[i, j])
+                                   for j in range(4)] for i in range(4)])
         part = slice(k * omega.size, (k + 1) * omega.size)
         out.append(constants * powers[part] * functions[part])
     return out
@@ -136,7 +140,8 @@ def rod_transfer(stiffness, inertia, L, omega, rigid=False) -> np.ndarray:
 def beam_local_transfer(beam, omega, length=None) -> np.ndarray:
     """(n, 12, 12) transfer matrix of ``beam`` in its local axes.
 
-    length : m, a piece of the beam (default: the whole beam).
+    length : m, a piece of the beam (default: the whole beam); or, in float64, an
+    array (n,) of positive lengths, one piece per frequency.
     """
     omega = frequencies(omega)
     # In mpmath, products of the section properties are formed at the working
@@ -148,7 +153,7 @@ def beam_local_transfer(beam, omega, length=None) -> np.ndarray:
         exact = mpmath.mpf
     E, G, rho, A, Iy, Iz, J, Ip = (exact(getattr(beam, name))
                                    for name in ("E", "G", "rho", "A", "Iy", "Iz", "J", "Ip"))
-    L = exact(beam.length if length is None else length)
+    L = exact(beam.length if length is None else length) if np.ndim(length) == 0 else np.asarray(length, float)
     out = zeros_like_stack(omega, (12, 12))
     xy, xz = bending_transfers((E * Iz, E * Iy), rho * A, L, omega)
     out[:, _BENDING_XY[:, None], _BENDING_XY] = xy
@@ -173,7 +178,8 @@ def beam_transfer(beam, omega, reverse=False, length=None) -> np.ndarray:
     """(n, 12, 12) inertial-frame transfer matrix of ``beam`` (or a piece of it).
 
     reverse : transfer from ends[1] to ends[0].
-    length : m, the piece starting at the input end (default: whole beam).
+    length : m, the piece starting at the input end (default: whole beam), or
+    float64 (n,), one piece per frequency (:func:`beam_states`).
     """
     rotation = _state_rotation(tuple(np.ravel(beam.axes)), reverse)
     local = beam_local_transfer(beam, omega, length)
@@ -182,6 +188,22 @@ def beam_transfer(beam, omega, reverse=False, length=None) -> np.ndarray:
     # mpmath: only the rotation's non-zero entries multiply (three quarters are zero)
     turned = constant_times(rotation, local)
     return np.swapaxes(constant_times(rotation, np.swapaxes(turned, 1, 2)), 1, 2)
+
+
+def beam_states(beam, omega, start: np.ndarray, distances, reverse: bool = False) -> np.ndarray:
+    """(n, s, 12) states along ``beam`` at ``distances`` (s,) m from its input end, carried
+    from the states ``start`` (n, 12) there at each of ``omega`` (n,) rad/s by the exact
+    transfer of each piece (:func:`beam_transfer`, ``reverse`` as there), every piece
+    of every frequency in one evaluation; a distance of 0 is ``start`` itself."""
+    omega = np.asarray(omega, dtype=float)
+    distances = np.asarray(distances, dtype=float)
+    out = np.empty((omega.size, distances.size, 12))
+    out[:, distances <= 0] = start[:, None]
+    inside = np.flatnonzero(distances > 0)
+    if inside.size:
+        transfers = beam_transfer(beam, np.tile(omega, inside.size), reverse, np.repeat(distances[inside], omega.size))
+        out[:, inside] = np.einsum("snij,nj->nsi", transfers.reshape(inside.size, omega.size, 12, 12), start)
+    return out
 
 
 @functools.lru_cache(maxsize=256)

@@ -15,6 +15,9 @@ from linmstmm.nullspace import NULL_TOLERANCE, characteristic_frequencies, equil
 SAME_FREQUENCY = 1e-9
 #: Relative frequency offset of the matrices that scale Ū_all for its null space.
 SCALE_PROBE = 1e-3
+#: Entries of the Ū_all matrices :func:`null_bases` asks for in one call, at most
+#: (unless one eigenspace's three need more): 32 MB in float64.
+BATCH_ENTRIES = 1 << 22
 
 
 def _group(omegas) -> list[tuple[float, int]]:
@@ -42,8 +45,41 @@ def _whole_last_eigenspace(finder, omegas: np.ndarray) -> np.ndarray:
     return np.r_[omegas, np.full(max(wanted - present, 0), last)]
 
 
-def _null_basis(deduction: Deduction, omega: float, dimension: int) -> np.ndarray:
-    """(dimension, N) basis of the null space of Ū_all(omega), on all N unknowns.
+def null_bases(deduction: Deduction, eigenspaces: list[tuple[float, int]], plain=None) -> np.ndarray:
+    """(Σ dimensions, N) the :func:`_null_basis` of each (ω rad/s, dimension) of
+    ``eigenspaces``, in order, one above the other.
+
+    Ū_all at every frequency they look at comes from one call: ``plain`` (a compiled
+    determinant's :meth:`~linmstmm.determinant.CompiledDeterminant.plain_matrix`, the
+    same to rounding and some ten times faster) where given, else ``deduction.matrix``
+    (one batch of the numpy carry, vectorised over the frequencies); at ω = 0 always
+    the latter.
+    """
+    bases = [np.zeros((0, deduction.full_order))]
+    batch = max(1, BATCH_ENTRIES // (3 * deduction.order ** 2))  # eigenspaces a call serves
+    for first in range(0, len(eigenspaces), batch):
+        part = eigenspaces[first:first + batch]
+        probes = np.concatenate([_probes(deduction, omega) for omega, _ in part])
+        matrices = np.empty((probes.size, deduction.order, deduction.order))
+        by_carry = np.repeat([plain is None or omega == 0 for omega, _ in part], 3)
+        for source, chosen in ((deduction.matrix, by_carry), (plain, ~by_carry)):
+            if chosen.any():
+                matrices[chosen] = source(probes[chosen])
+        bases += [_null_basis(deduction, omega, matrices[3 * k:3 * k + 3], dimension)
+                  for k, (omega, dimension) in enumerate(part)]
+    return np.concatenate(bases)
+
+
+def _probes(deduction: Deduction, omega: float) -> np.ndarray:
+    """(3,) rad/s: ``omega`` and the two frequencies that scale Ū_all there (:func:`_null_basis`)."""
+    near = omega if omega > 0 else SCALE_PROBE * min(characteristic_frequencies(deduction.topology))
+    return np.array([omega, near * (1 - SCALE_PROBE), near * (1 + SCALE_PROBE)])
+
+
+def _null_basis(deduction: Deduction, omega: float, matrices: np.ndarray, dimension: int) -> np.ndarray:
+    """(dimension, N) basis of the null space of Ū_all(omega), on all N unknowns, from
+    ``matrices`` (3, N', N'): Ū_all (less released unknowns) at the three frequencies
+    of :func:`_probes`, omega first.
 
     Works on the equilibrated matrix S = ``rows · Ū · cols`` (the basis is
     mapped back by ``cols``), whose scales come from Ū at ω(1 ± SCALE_PROBE) (at
@@ -61,8 +97,7 @@ def _null_basis(deduction: Deduction, omega: float, dimension: int) -> np.ndarra
     unknowns are zero. Raises RuntimeError if any of the ``dimension``
     singular values is not below NULL_TOLERANCE × the largest.
     """
-    near = omega if omega > 0 else SCALE_PROBE * min(characteristic_frequencies(deduction.topology))
-    matrix, below, above = deduction.matrix(np.array([omega, near * (1 - SCALE_PROBE), near * (1 + SCALE_PROBE)]))
+    matrix, below, above = matrices
     rows, cols = equilibration(np.maximum(np.abs(below), np.abs(above)), start=own_units_start(deduction))
     scaled = rows[:, None] * matrix * cols
     u, sigma, vh = np.linalg.svd(scaled)

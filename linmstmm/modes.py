@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from linmstmm.eigenspaces import _group, _null_basis, _whole_last_eigenspace
+from linmstmm.eigenspaces import _group, _whole_last_eigenspace, null_bases
 from linmstmm.mode_fields import _Fields, _station_positions
 from linmstmm.model import Model, ModelError
 from linmstmm.results import Result, decode_array, decode_arrays, encode_array
@@ -347,7 +347,11 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         How the root search evaluates det Ū_all, as for
         :func:`linmstmm.solve.natural_frequencies` ("auto", "numpy" or "compiled");
         with the same engine the frequencies are that function's to the last
-        digit, across engines they agree to rounding.
+        digit, across engines they agree to rounding. The compiled engine also
+        forms the Ū_all whose null spaces give the shapes
+        (:func:`~linmstmm.eigenspaces.null_bases`), the same to rounding, so the
+        shapes of the two engines agree to their own accuracy (the launchers'
+        orthogonality: 1e-12 to 1e-9).
 
     Returns
     -------
@@ -380,7 +384,7 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
             key="fmax" if count is None else None)
     omega = np.repeat([w for w, _ in eigenspaces], [m for _, m in eigenspaces])
     report("mode shapes")
-    zbar = np.concatenate([_null_basis(deduction, w, m) for w, m in eigenspaces])
+    zbar = null_bases(deduction, eigenspaces, finder.determinant.plain_matrix)
     raw = _Fields.of(model, deduction, omega, zbar, stations)
     gram = raw.mass_gram()
     transform = _mass_orthonormal(gram, raw.mass_gram(_AXIS_WEIGHTS), [m for _, m in eigenspaces])

@@ -149,9 +149,18 @@ def unseparated_among(finder, roots) -> dict:
 
 
 def multiplicity(finder, root: float, others=()) -> int | None:
-    """How many roots sit at ``root``: the circle count already made for it while
-    finding the roots, else one made now (:meth:`multiplicities`)."""
-    return finder._counted.get(root) or finder.multiplicities([root], others)[0]
+    """How many roots sit at ``root`` (rad/s, a root found): the circle count already
+    made for it while finding the roots, else the natural frequencies within the
+    circle :meth:`multiplicities` would count over (:func:`_counts_within`: the
+    Wittrick–Williams count across it where it decides, some 40 evaluations of det
+    fewer than the argument principle, which counts where it does not); None where
+    neither can be made."""
+    if finder._counted.get(root):
+        return finder._counted[root]
+    radius = finder._circle_radius(root, others)
+    finder._circles[root] = radius
+    count = _counts_within(finder, [root], [radius])[0]
+    return None if count is None else max(count, 1)
 
 
 def separated(finder, roots: list[float]) -> list[float]:

@@ -56,6 +56,7 @@ def null_bases(deduction: Deduction, eigenspaces: list[tuple[float, int]], plain
     the latter.
     """
     bases = [np.zeros((0, deduction.full_order))]
+    start = own_units_start(deduction)  # the same for every eigenspace
     batch = max(1, BATCH_ENTRIES // (3 * deduction.order ** 2))  # eigenspaces a call serves
     for first in range(0, len(eigenspaces), batch):
         part = eigenspaces[first:first + batch]
@@ -65,7 +66,7 @@ def null_bases(deduction: Deduction, eigenspaces: list[tuple[float, int]], plain
         for source, chosen in ((deduction.matrix, by_carry), (plain, ~by_carry)):
             if chosen.any():
                 matrices[chosen] = source(probes[chosen])
-        bases += [_null_basis(deduction, omega, matrices[3 * k:3 * k + 3], dimension)
+        bases += [_null_basis(deduction, omega, matrices[3 * k:3 * k + 3], dimension, start)
                   for k, (omega, dimension) in enumerate(part)]
     return np.concatenate(bases)
 
@@ -76,10 +77,11 @@ def _probes(deduction: Deduction, omega: float) -> np.ndarray:
     return np.array([omega, near * (1 - SCALE_PROBE), near * (1 + SCALE_PROBE)])
 
 
-def _null_basis(deduction: Deduction, omega: float, matrices: np.ndarray, dimension: int) -> np.ndarray:
+def _null_basis(deduction: Deduction, omega: float, matrices: np.ndarray, dimension: int, start) -> np.ndarray:
     """(dimension, N) basis of the null space of Ū_all(omega), on all N unknowns, from
     ``matrices`` (3, N', N'): Ū_all (less released unknowns) at the three frequencies
-    of :func:`_probes`, omega first.
+    of :func:`_probes`, omega first; ``start``: the deduction's
+    :func:`~linmstmm.nullspace.own_units_start`.
 
     Works on the equilibrated matrix S = ``rows · Ū · cols`` (the basis is
     mapped back by ``cols``), whose scales come from Ū at ω(1 ± SCALE_PROBE) (at
@@ -98,7 +100,7 @@ def _null_basis(deduction: Deduction, omega: float, matrices: np.ndarray, dimens
     singular values is not below NULL_TOLERANCE × the largest.
     """
     matrix, below, above = matrices
-    rows, cols = equilibration(np.maximum(np.abs(below), np.abs(above)), start=own_units_start(deduction))
+    rows, cols = equilibration(np.maximum(np.abs(below), np.abs(above)), start=start)
     scaled = rows[:, None] * matrix * cols
     u, sigma, vh = np.linalg.svd(scaled)
     worst = sigma[sigma.size - dimension] / sigma[0]

@@ -28,6 +28,8 @@ Measured per model (the launcher-size files in models/):
   shift-invert ``eigsh``, assembly excluded, the faster of the two taken as
   the FE baseline; and the ``fe`` command's own automatic refinement
   (``fe_frequencies``);
+* the first 10 and 20 mode shapes by both engines beside FE ``eigsh`` returning its
+  eigenvectors on the same mesh;
 * the start-up of a new process running the README's main command, and new processes
   of the ``response`` command on the bundled load cases.
 """
@@ -60,6 +62,7 @@ from linmstmm.deduction import Deduction  # noqa: E402
 from linmstmm.determinant import CompiledDeterminant, NumpyDeterminant, load_kernels  # noqa: E402
 from linmstmm.fe import assemble, fe_frequencies  # noqa: E402
 from linmstmm.model import Beam, Model, load_model  # noqa: E402
+from linmstmm.modes import mode_shapes  # noqa: E402
 from linmstmm.nullspace import release_indeterminate  # noqa: E402
 from linmstmm.solve import natural_frequencies  # noqa: E402
 from linmstmm.threads import one_blas_thread  # noqa: E402
@@ -297,6 +300,31 @@ def fe_eigensolves(model, count: int, target: np.ndarray, tolerance: float, roun
     return {"per_beam": per_beam, "dof": K.shape[0], "error": error, "eigh": eigh_time, "eigsh": eigsh_time}
 
 
+def shapes_table(model, meshes: dict, rounds: int) -> list[str]:
+    """Markdown lines: ``mode_shapes`` (21 stations per beam, mass-normalised) by both engines
+    on a model compiled already, beside FE shift-invert ``eigsh`` with its eigenvectors on
+    the mesh of the frequency table (``meshes``: first N -> elements per beam), assembly
+    excluded, best of ``rounds`` each."""
+    lines = ["Mode shapes: `mode_shapes(model, N)` (21 stations per beam, mass-normalised; the model "
+             "compiled already, its predictions kept) against FE `eigsh` returning its eigenvectors on the "
+             "mesh of the first table (assembly excluded). The numpy engine is what `linmstmm modes` runs "
+             "in a new process.", "",
+             "| first N | MSTMM compiled | MSTMM numpy | FE eigsh with vectors | FE / MSTMM compiled |",
+             "|---:|---:|---:|---:|---:|"]
+    for count, per_beam in meshes.items():
+        compiled = best_time(lambda: mode_shapes(model, count, engine="compiled"), rounds)[0]
+        numpy_engine = best_time(lambda: mode_shapes(model, count, engine="numpy"), rounds)[0]
+        fe = assemble(model, per_beam)
+        K, M = fe.K.tocsc(), fe.M.tocsc()
+        first = natural_frequencies(model, 1).frequencies_hz[0]
+        wanted = min(count + fe.rigid_modes.shape[1], K.shape[0] - 2)
+        eigsh = best_time(lambda: sla.eigsh(K, k=wanted, M=M, sigma=-0.5 * (2 * np.pi * first) ** 2, which="LM"),
+                          rounds)[0]
+        lines.append(f"| {count} | {compiled * 1e3:.1f} ms | {numpy_engine * 1e3:.1f} ms | {eigsh * 1e3:.1f} ms "
+                     f"({per_beam} el./beam) | {eigsh / compiled:.2f} |")
+    return lines
+
+
 def budget_table(model, counts) -> list[str]:
     """Markdown lines: where the first solve of ``model`` for each count spends its time
     and evaluations (its compilation included)."""
@@ -375,7 +403,7 @@ def main() -> None:
                       "FE eigsh | `fe` command | fastest FE eigensolver / MSTMM compiled (first) | "
                       "`fe` / MSTMM first solve |",
                       "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
-            asked_lines = []
+            asked_lines, meshes = [], {}
             for count in counts:
                 repeats = rounds if count <= 20 else 1
                 first_time, asked_first, fe_time, asked = first_solves_beside_fe(model, count, repeats + 1)
@@ -385,6 +413,7 @@ def main() -> None:
                 solves = fe_eigensolves(model, count, result.frequencies_hz, tolerance, repeats)
                 per_root = result.evaluations / max(len(result.frequencies_hz), 1)
                 fastest = np.nanmin([solves.get("eigh", np.nan), solves.get("eigsh", np.nan)])
+                meshes[count] = solves.get("per_beam")
                 lines.append(
                     f"| {count} | {first_time * 1e3:.1f} ms | {mstmm_time * 1e3:.1f} ms | {per_root:.1f} | "
                     f"{rel_diff(result.frequencies_hz, fe_result.frequencies_hz):.1e} | "
@@ -409,7 +438,8 @@ def main() -> None:
                       "diff. from the default | diff. from FE rtol 1e-10 | fastest FE eigensolver / MSTMM "
                       "compiled (first) | `fe` / MSTMM first solve |", "|---:|---:|---:|---:|---:|---:|---:|---:|",
                       *asked_lines]
-            lines += ["", *budget_table(model, counts), "", *rtol_table(model, counts[:2], 2 * rounds), ""]
+            lines += ["", *budget_table(model, counts), "", *rtol_table(model, counts[:2], 2 * rounds), "",
+                      *shapes_table(model, {c: meshes[c] for c in counts[:2]}, rounds), ""]
         lines += ["## Beyond the launchers", "", *close_roots_table(rounds)]
     lines += ["**Reading the FE columns.** The FE mesh is the coarsest of 1, 2, 4, … 128 elements per "
               "beam whose first N frequencies by eigsh are within 1e-9 of the transfer-matrix ones (1e-6 "

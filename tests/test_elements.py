@@ -7,7 +7,8 @@ import scipy.linalg
 from builders import make_beam
 from scipy.spatial.transform import Rotation
 
-from linmstmm.elements.beam import beam_transfer
+import linmstmm.elements.beam as beam_module
+from linmstmm.elements.beam import beam_states, beam_transfer
 from linmstmm.elements.frames import SYMPLECTIC_FORM, state_rotation
 from linmstmm.elements.rigid import rigid_transfer
 from linmstmm.elements.spring import spring_transfer
@@ -54,6 +55,23 @@ def test_beam_of_length_L_is_two_halves_multiplied():
     whole = beam_transfer(beam, OMEGA)
     scale = np.abs(whole).max(axis=(1, 2), keepdims=True)
     assert (np.abs(half @ half - whole) / scale).max() < 1e-13
+
+
+@pytest.mark.parametrize("batch", [10_000, 7])  # one evaluation, or distances in several
+def test_beam_states_are_each_piece_transferred(batch, monkeypatch):
+    """beam_states (every distance and frequency in one evaluation) against beam_transfer of
+    each piece alone, both directions."""
+    monkeypatch.setattr(beam_module, "STATES_BATCH", batch)
+    beam = a_beam()
+    start = np.random.default_rng(3).standard_normal((OMEGA.size, 12))
+    distances = np.array([0.0, 0.1, 0.5, 0.77, 1.0]) * beam.length
+    for reverse in (False, True):
+        got = beam_states(beam, OMEGA, start, distances, reverse)
+        for s, distance in enumerate(distances):
+            want = start if distance == 0 else np.einsum(
+                "nij,nj->ni", beam_transfer(beam, OMEGA, reverse=reverse, length=distance), start)
+            scale = np.abs(want).max(axis=1, keepdims=True)
+            assert (np.abs(got[:, s] - want) / scale).max() < 1e-13
 
 
 def test_beam_matches_matrix_exponential_of_its_state_equation():

@@ -190,6 +190,11 @@ def beam_transfer(beam, omega, reverse=False, length=None) -> np.ndarray:
     return np.swapaxes(constant_times(rotation, np.swapaxes(turned, 1, 2)), 1, 2)
 
 
+#: Transfer matrices :func:`beam_states` forms in one evaluation, at most (unless one distance
+#: needs more: one per frequency): 19 MB each of the evaluation's few (n, 12, 12) arrays.
+STATES_BATCH = 1 << 14
+
+
 def beam_states(beam, omega, start: np.ndarray, distances, reverse: bool = False) -> np.ndarray:
     """(n, s, 12) states along ``beam`` at ``distances`` (s,) m from its input end, carried
     from the states ``start`` (n, 12) there at each of ``omega`` (n,) rad/s by the exact
@@ -200,9 +205,11 @@ def beam_states(beam, omega, start: np.ndarray, distances, reverse: bool = False
     out = np.empty((omega.size, distances.size, 12))
     out[:, distances <= 0] = start[:, None]
     inside = np.flatnonzero(distances > 0)
-    if inside.size:
-        transfers = beam_transfer(beam, np.tile(omega, inside.size), reverse, np.repeat(distances[inside], omega.size))
-        out[:, inside] = np.einsum("snij,nj->nsi", transfers.reshape(inside.size, omega.size, 12, 12), start)
+    batch = max(1, STATES_BATCH // max(omega.size, 1))  # distances an evaluation takes
+    for first in range(0, inside.size, batch):
+        some = inside[first:first + batch]
+        transfers = beam_transfer(beam, np.tile(omega, some.size), reverse, np.repeat(distances[some], omega.size))
+        out[:, some] = np.einsum("snij,nj->nsi", transfers.reshape(some.size, omega.size, 12, 12), start)
     return out
 
 

@@ -307,8 +307,10 @@ def shapes_table(model, meshes: dict, rounds: int) -> list[str]:
     excluded, best of ``rounds`` each."""
     lines = ["Mode shapes: `mode_shapes(model, N)` (21 stations per beam, mass-normalised; the model "
              "compiled already, its predictions kept) against FE `eigsh` returning its eigenvectors on the "
-             "mesh of the first table (assembly excluded). The numpy engine is what `linmstmm modes` runs "
-             "in a new process.", "",
+             "mesh of the first table (assembly excluded). The numpy engine forms det Ū_all, the counts and "
+             "the shapes' Ū_all by the numpy carry; `linmstmm modes` runs it in a new process, where the "
+             "coarse FE pencil is assembled without the kernels this process has loaded (the same numbers, "
+             "a few ms slower).", "",
              "| first N | MSTMM compiled | MSTMM numpy | FE eigsh with vectors | FE / MSTMM compiled |",
              "|---:|---:|---:|---:|---:|"]
     for count, per_beam in meshes.items():

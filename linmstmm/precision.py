@@ -25,6 +25,7 @@ read, and are taken as they are.
 """
 from __future__ import annotations
 
+import inspect
 import math
 
 import mpmath
@@ -279,7 +280,7 @@ def _split_cluster(deduction, centre, multiplicity: int, radius, tolerance) -> l
     taylor = [sum(v / turn ** k for v, turn in zip(values, turns)) / points / radius ** k
               for k in range(degree + 1)]
     try:
-        offsets = mpmath.polyroots(taylor[::-1], maxsteps=200, extraprec=2 * mpmath.mp.prec)
+        offsets = _polynomial_roots(taylor)
     except mpmath.libmp.NoConvergence as error:
         raise RuntimeError(str(error)) from None
     offsets = sorted(offsets, key=abs)[:multiplicity]
@@ -287,11 +288,34 @@ def _split_cluster(deduction, centre, multiplicity: int, radius, tolerance) -> l
         raise RuntimeError("the cluster's roots are not real and inside the circle")
     slopes = [k * taylor[k] for k in range(degree, 0, -1)]  # det' about centre, highest power first
     members = sorted(_secant(deduction, centre + mpmath.re(t), tolerance,
-                             mpmath.re(mpmath.polyval(slopes, mpmath.re(t)))) for t in offsets)
+                             mpmath.re(_horner(slopes, mpmath.re(t)))) for t in offsets)
     if (any(abs(a - centre) >= radius for a in members)
             or any(b - a <= tolerance * abs(a) for a, b in zip(members, members[1:]))):
         raise RuntimeError("the cluster's members polish onto one root, or out of the circle")
     return members
+
+
+#: Whether this mpmath's polyroots takes its coefficients lowest power first (``asc``, from
+#: mpmath 1.4, which deprecates the highest-first order that 1.3 alone knows).
+_ASCENDING = "asc" in inspect.signature(mpmath.polyroots).parameters
+
+
+def _polynomial_roots(ascending: list) -> list:
+    """The roots of the polynomial with coefficients ``ascending`` (lowest power first),
+    at twice the working precision, by mpmath.polyroots in the order this mpmath takes."""
+    options = {"maxsteps": 200, "extraprec": 2 * mpmath.mp.prec}
+    if _ASCENDING:
+        return mpmath.polyroots(ascending, asc=True, **options)
+    return mpmath.polyroots(ascending[::-1], **options)
+
+
+def _horner(descending: list, x):
+    """The polynomial with coefficients ``descending`` (highest power first) at ``x``, by
+    Horner's rule as mpmath.polyval forms it (whose default order mpmath 1.4 deprecates)."""
+    value = descending[0]
+    for coefficient in descending[1:]:
+        value = value * x + coefficient
+    return value
 
 
 def separated_cluster(deduction, model, omega: float, multiplicity: int, radius: float, digits: int):

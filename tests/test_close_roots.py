@@ -51,6 +51,24 @@ def first_bending_hz(second_moment) -> mp.mpf:
     return (beta / mp.mpf(1.5)) ** 2 * mp.sqrt(stiffness) / (2 * mp.pi)
 
 
+def test_cluster_polynomial_roots_and_slope_whatever_the_mpmath_order():
+    """The cluster separation's polynomial, lowest power first, gives the same roots and
+    slope in mpmath 1.3 (highest power first only) and 1.4 (which deprecates that order)."""
+    from linmstmm.precision import _horner, _polynomial_roots
+
+    with mp.workdps(30):
+        roots = [mp.mpf("0.25"), mp.mpf("-1.5"), mp.mpf(3)]
+        ascending = [-roots[0] * roots[1] * roots[2], roots[0] * roots[1] + roots[0] * roots[2]
+                     + roots[1] * roots[2], -sum(roots), mp.mpf(1)]  # (t − r0)(t − r1)(t − r2)
+        got = sorted(_polynomial_roots(ascending), key=lambda t: mp.re(t))
+        assert max(abs(g - r) for g, r in zip(got, sorted(roots))) < mp.mpf(10) ** -25
+        slopes = [k * ascending[k] for k in range(3, 0, -1)]
+        t = mp.mpf("0.7")
+        product_rule = sum((t - a) * (t - b) for a, b in ((roots[1], roots[2]), (roots[0], roots[2]),
+                                                          (roots[0], roots[1])))
+        assert abs(_horner(slopes, t) - product_rule) < mp.mpf(10) ** -25
+
+
 def test_bending_pair_one_ulp_apart_refines_to_twenty_digits():
     """Iz one ulp above Iy: ω = (β₁/L)² √(E I / ρA) for I = Iy and I = Iz,
     β₁ the first root of cos β cosh β + 1 (``digits=20`` stopped: the 2-fold

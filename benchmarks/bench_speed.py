@@ -173,7 +173,9 @@ def rtol_table(model, counts, rounds: int) -> list[str]:
              "default of the same engine and kind of solve, every rtol timed in turn in each round "
              "(best of the rounds), so that a busy spell of the machine falls on all of them alike. "
              "The numpy engine is what a new process runs (`engine=\"auto\"` before the kernels are "
-             "loaded).", "",
+             "loaded); timed here, where the kernels are loaded, its coarse FE pencil is assembled "
+             "compiled (the same numbers, a few ms faster than in a new process: "
+             "`reports/speed_accuracy.md` times it there).", "",
              "| first N | rtol | compiled: first solve | speed-up | compiled: compiled model | speed-up | "
              "evaluations | numpy: first solve | speed-up | numpy: compiled model | speed-up | "
              "largest diff. from the default |", "|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]

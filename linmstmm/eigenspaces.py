@@ -57,7 +57,7 @@ def null_bases(deduction: Deduction, eigenspaces: list[tuple[float, int]], plain
     """
     bases = [np.zeros((0, deduction.full_order))]
     start = own_units_start(deduction)  # the same for every eigenspace
-    batch = max(1, BATCH_ENTRIES // (3 * deduction.order ** 2))  # eigenspaces a call serves
+    batch = max(1, BATCH_ENTRIES // max(3 * deduction.order ** 2, 1))  # eigenspaces a call serves
     for first in range(0, len(eigenspaces), batch):
         part = eigenspaces[first:first + batch]
         probes = np.concatenate([_probes(deduction, omega) for omega, _ in part])

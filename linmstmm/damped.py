@@ -229,7 +229,8 @@ def _secant(log_det, start: complex, power: int) -> complex:
     for _ in range(MAX_STEPS):
         change = l0 - l1
         change = change.real + 1j * np.angle(np.exp(1j * change.imag))
-        step = (x1 - x0) / (1 - np.exp(change / power))
+        with np.errstate(divide="ignore", invalid="ignore"):  # det equal at both points: no step, stop below
+            step = (x1 - x0) / (1 - np.exp(change / power))
         if not np.isfinite(step):
             break
         x0, l0 = x1, l1

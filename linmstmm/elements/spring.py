@@ -114,7 +114,8 @@ def damped_spring_transfer(k, c, axes, rate, release=None) -> np.ndarray:
     """
     axes = np.asarray(axes, dtype=float)
     rate = np.reshape(np.asarray(rate, dtype=complex), (-1, 1))
-    with np.errstate(divide="ignore"):  # k = 0, c = 0: a released direction, zeroed below
+    with np.errstate(divide="ignore", invalid="ignore"):  # k = 0, c = 0: a released direction, zeroed below
+        # (1 / 0 in complex is nan, an invalid value; a direction kept has k > 0)
         compliance = 1.0 / (np.asarray(k, dtype=float) + rate * np.asarray(c, dtype=float))  # (n, 6)
     if release is not None:
         compliance[:, np.asarray(release, bool)] = 0.0

@@ -14,6 +14,7 @@ import numpy as np
 
 from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import beam_states
+from linmstmm.geometry import cross_rows
 from linmstmm.model import Model
 
 #: Gauss–Legendre points along a beam beyond its largest wavenumber × length.
@@ -145,11 +146,7 @@ class _Fields:
         element = self.topology.elements[e]
         port = self.element_states[e][:, 0]
         arm = np.asarray(rigid.com, float) - np.asarray(element.ports[0].position, float)
-        turn = port[:, 3:6]
-        # θ × arm component by component, as numpy.cross forms it (which costs 0.2 ms a call)
-        swept = np.stack([turn[:, 1] * arm[2] - turn[:, 2] * arm[1], turn[:, 2] * arm[0] - turn[:, 0] * arm[2],
-                          turn[:, 0] * arm[1] - turn[:, 1] * arm[0]], axis=1)
-        return np.concatenate([port[:, :3] + swept, turn], axis=1)
+        return np.concatenate([port[:, :3] + cross_rows(port[:, 3:6], arm), port[:, 3:6]], axis=1)
 
     def _beams(self):
         for element in self.topology.elements:

@@ -143,7 +143,6 @@ class CoarsePencil:
         return scipy_csr(self.assembly.parts.T)[:6 * (len(model.points) + len(model.rigids))]
 
 
-
 def assembled_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:
     """The :class:`CoarsePencil` of ``model`` meshed with ``elements_per_beam`` (>= 1),
     made anew (:func:`linmstmm.coarse_prediction.coarse_pencil` keeps it per model): its

@@ -1,11 +1,11 @@
-"""The 3-vector arithmetic of a model's checks and edits (linmstmm.geometry: cross3, norm3)
+"""The 3-vector arithmetic of a model's checks, edits and mode shapes (linmstmm.geometry: cross3, cross_rows, norm3)
 gives numpy.cross's and numpy.linalg.norm's bits, on vectors whose components span
 the whole float64 range: subnormals, signed zeros, overflow to inf, and every sign."""
 from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.geometry import cross3, norm3
+from linmstmm.geometry import cross3, cross_rows, norm3
 
 
 def _vectors(rng, count: int) -> np.ndarray:
@@ -33,6 +33,14 @@ def test_cross3_is_numpy_cross_bit_for_bit():
             assert _same(cross3(x, y), np.cross(x, y)), (x, y)
         for x in a[:2000]:  # a float32 partner is taken to float64 as numpy.cross takes it
             assert _same(cross3(x, x[::-1].astype(np.float32)), np.cross(x, x[::-1].astype(np.float32))), x
+
+
+def test_cross_rows_is_numpy_cross_bit_for_bit():
+    rng = np.random.default_rng(9)
+    rows, others = _vectors(rng, 2000), _vectors(rng, 50)
+    with np.errstate(all="ignore"):
+        for y in others:
+            assert _same(cross_rows(rows, y), np.cross(rows, y)), y
 
 
 def test_norm3_is_numpy_norm_bit_for_bit():

@@ -305,3 +305,30 @@ def test_free_beam_modes_far_above_its_first_agree_with_fe_or_say_they_are_not_a
     path.write_text(to_toml(model))
     assert main(["modes", str(path), "--count", "60"]) == 0
     assert "are not accurate in float64" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("engine", ["numpy", "compiled"])
+def test_the_root_boundary_keeps_its_conditions_in_every_mode(engine):
+    """A random tree rooted at a clamped spring end (``p3``): its three highest of twelve
+    modes (650–1150 Hz) showed the root moving by up to 0.75 % of the mode's largest
+    displacement, the carried root state's residual of the main transfer equation, and
+    the twelfth mode's MAC against FE fell to 1 − 2.9e-4 (compiled) and 1 − 6.9e-6
+    (numpy). The root's port now holds the root's own state: zero where the end is
+    fixed. Reference: the FE route (Hermite beams, 128 elements per beam) on the same
+    model, its eigenvectors at every point."""
+    from random_models import random_model
+
+    from linmstmm.fe import assemble, fe_modes
+
+    model = random_model("tree", 29)
+    modes = mode_shapes(model, 12, engine=engine)
+    assert np.all(modes.point_displacements["p3"] == 0.0)
+    fe = assemble(model, 128)
+    lam, X, _ = fe_modes(fe, 12)
+    full = fe.T @ X
+    points = list(model.points)
+    fe_shapes = np.stack([np.concatenate([full[fe.dof_index.point(p), k] for p in points])
+                          for k in range(lam.size)])
+    # the same modes in the same order (this mesh's own frequency error reaches 2.5e-5 at the twelfth)
+    np.testing.assert_allclose(modes.omega, np.sqrt(lam), rtol=1e-4)
+    assert np.diag(modes.mac(fe_shapes, points)).min() > 1 - 1e-6

@@ -116,7 +116,7 @@ def _certified(finder, predictions: np.ndarray, count: int, stood: set[float] | 
         # three of its 30 lowest, and the full search took 29,453 evaluations): the
         # predictions not polished stand in for them to place the count's upper end,
         # and counts find them below it.
-        roots = _repaired(finder, roots, None, gap_above(sorted(roots + beyond), count, _same_root(finder), []),
+        roots = _repaired(finder, roots, None, gap_above(sorted(roots + beyond), count, finder.same_root, []),
                           REPAIR_DEPTH)
     if roots is None or len(roots) < count:
         return None
@@ -138,7 +138,7 @@ def _stood_certified(finder, predictions: np.ndarray, spans: np.ndarray, roots: 
     counts alone asked again. Where those cannot decide (a count by a close pair), or
     still disagree, the values that stood are polished (:func:`_stood_polished`) before
     the argument principle's count; where one does not settle, every prediction is."""
-    upper = gap_above(roots, count, _same_root(finder), beyond)
+    upper = gap_above(roots, count, finder.same_root, beyond)
     missing = finder.stiffness_other_zeros(roots, None, upper)
     if missing == 0:
         return _cut(roots, upper)
@@ -192,7 +192,7 @@ def _closed(finder, roots: list[float], count: int, beyond: list[float]) -> tupl
     not polished: the argument principle's count with them divided out, and where it
     does not come to zero, the stretch that holds the difference searched
     (:func:`_repaired`) and the count made again."""
-    upper = gap_above(roots, count, _same_root(finder), beyond)
+    upper = gap_above(roots, count, finder.same_root, beyond)
     # The predictions not polished above the count's contour, divided out too, change
     # no count but smooth its phase near the contour's upper end.
     beyond = [p for p in beyond if p > upper]
@@ -202,7 +202,7 @@ def _closed(finder, roots: list[float], count: int, beyond: list[float]) -> tupl
         roots = _repaired(finder, roots, None, upper, REPAIR_DEPTH)
         if roots is None or len(roots) < count:
             return None, upper
-        upper = gap_above(roots, count, _same_root(finder), beyond)
+        upper = gap_above(roots, count, finder.same_root, beyond)
         if not finder.confirm_no_other_zeros(roots + beyond, upper):
             return None, upper
     return roots, upper
@@ -345,7 +345,7 @@ def _settled(finder, predictions: np.ndarray, in_cluster: list[bool], indices: n
     """(n,) bool: which secant results ``found`` (rad/s) of ``predictions[indices]``, with
     their last relative ``steps``, stand (:func:`_secant_polished`; ``placing``: those
     polished to PLACING only)."""
-    values, same = predictions.tolist(), _same_root(finder)
+    values, same = predictions.tolist(), finder.same_root
     roots = found.tolist()
     bounds = [PLACING if loose else finder.xtol if in_cluster[i] else finder.rtol
               for i, loose in zip(indices.tolist(), placing.tolist())]
@@ -389,7 +389,7 @@ def _pencil_polished(finder, roots: list[float], starts: list[float],
         if root is None:
             return False
         stood_for.absorbed(root, roots)
-        if _known(root, roots, _same_root(finder)):
+        if _known(root, roots, finder.same_root):
             return False
         roots.append(root)
         return True
@@ -397,7 +397,7 @@ def _pencil_polished(finder, roots: list[float], starts: list[float],
     for start, (root, offsets) in zip(starts, finder.polish(starts)):
         if taken(root):
             continue
-        partner = None if root is None else _partner(root, offsets, _same_root(finder), finder.NEWTON_REACH)
+        partner = None if root is None else _partner(root, offsets, finder.same_root, finder.NEWTON_REACH)
         if partner is None:
             troubled.append(start)
         else:
@@ -435,7 +435,7 @@ def _deflated_polished(finder, roots: list[float], starts: list[float], predicti
             if not np.isnan(root):  # converged (NaN otherwise): the root of a value it is within rtol of
                 stood_for.absorbed(float(root), roots)
             if (np.isnan(root) or step > finder.xtol or abs(root - start) > cluster_reach(predictions, start)
-                    or _known(root, roots, NEAR_KNOWN) or _known(root, this_round, _same_root(finder))):
+                    or _known(root, roots, NEAR_KNOWN) or _known(root, this_round, finder.same_root)):
                 left.append(start)
             else:
                 this_round.append(float(root))
@@ -477,14 +477,6 @@ def _repaired(finder, roots: list[float], lo: float, hi: float, depth: int):
     middle = float(np.sqrt(inside[len(inside) // 2 - 1] * inside[len(inside) // 2]))
     roots = _repaired(finder, roots, lo, middle, depth - 1)
     return None if roots is None else _repaired(finder, roots, middle, hi, depth - 1)
-
-
-def _same_root(finder) -> float:
-    """Relative distance within which two polished values are one root: the finder's
-    SAME_ROOT, or its xtol where that is coarser (a loose rtol polishes to rtol/100
-    only: the secant and Newton on the pencil placed one root of a random tree
-    2e-9 apart at rtol 1e-4, and it was taken twice)."""
-    return max(finder.SAME_ROOT, finder.xtol)
 
 
 def _known(root: float, roots: list[float], same: float) -> bool:

@@ -13,6 +13,15 @@ method narrows to xtol. A narrow piece that holds several
 matrix pencil (:meth:`RootFinder.cluster`), which must find exactly that many
 inside.
 
+A segment's ends are often roots already found (the neighbours of a stretch
+the polish left troubled), where the count cannot decide (K(ω) is singular
+there). Such an end is moved outward by the narrowest width at which the
+count decides (:func:`~linmstmm.roots.certify.near_widths`), and the roots
+found beyond the ends are left out (those within the finder's same-root
+distance of an end are that end: the lower stays out, the upper in): a rod whose bending pairs are
+1e-7 apart had every one of its troubled stretches end so, and the
+argument-principle search took 1,800 evaluations of det for them.
+
 Where a count cannot decide, or a piece does not give up its roots this way,
 the search answers None and the argument-principle segment search runs
 (:func:`linmstmm.roots.segments.segment`).
@@ -42,10 +51,26 @@ def counted_segment(finder, lo: float, hi: float) -> list[float] | None:
     argument-principle segment search)."""
     if finder.counter is None:
         return None
-    below, above = finder.counter(lo), finder.counter(hi)
+    (start, below), (stop, above) = _decided_end(finder, lo, -1), _decided_end(finder, hi, 1)
     if below is None or above is None:
         return None
-    return _pieces(finder, lo, hi, below, above, 0)
+    found = _pieces(finder, start, stop, below, above, 0)
+    if found is None or (start, stop) == (lo, hi):
+        return found
+    same = finder.same_root  # lo found again stays out, hi found again is in; no other beyond them
+    return [root for root in found if lo * (1 + same) < root <= hi * (1 + same)]
+
+
+def _decided_end(finder, omega: float, outward: int) -> tuple[float, int | None]:
+    """(end, J(end)): ``omega`` (rad/s) where the count there decides, else ``omega``
+    moved by the narrowest of :func:`~linmstmm.roots.certify.near_widths` at which it
+    does, down (``outward`` −1) or up (+1); J None where none decides."""
+    for width in (0.0, *near_widths(finder.rtol)):
+        end = omega * (1 + outward * width)
+        count = finder.counter(end)
+        if count is not None:
+            return end, count
+    return omega, None
 
 
 def _pieces(finder, lo: float, hi: float, below: int, above: int, depth: int) -> list[float] | None:

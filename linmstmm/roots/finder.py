@@ -195,6 +195,14 @@ class RootFinder:
         """Number of zero-frequency (rigid-body) modes, as given at construction."""
         return self._rigid
 
+    @property
+    def same_root(self) -> float:
+        """Relative distance within which two polished values are one root: SAME_ROOT,
+        or xtol where that is coarser (a loose rtol polishes to rtol/100 only: the
+        secant and Newton on the pencil placed one root of a random tree 2e-9 apart
+        at rtol 1e-4, and it was taken twice)."""
+        return max(self.SAME_ROOT, self.xtol)
+
     def _existing(self, count: int) -> int | None:
         """How many of ``count`` elastic roots exist below the ceiling where the
         Wittrick–Williams count says fewer do (the model has fewer than ``count``

@@ -41,7 +41,7 @@ import numpy as np
 
 from linmstmm.counting import deflated
 from linmstmm.prediction_groups import (CLUSTER, Stood, cluster_reach, clustered, gap, gap_above,
-                                        intervals_around, polished_up_to, standing)
+                                        intervals_around, polished_up_to, repair_split, standing)
 from linmstmm.secant import secant_roots
 
 #: Halvings of the range by counts before a stretch that misses a root is searched whole.
@@ -474,7 +474,7 @@ def _repaired(finder, roots: list[float], lo: float, hi: float, depth: int):
             return sorted(outside + finder.segment(lo, hi))
         except RuntimeError:  # a count there cannot be made: the full search decides
             return None
-    middle = float(np.sqrt(inside[len(inside) // 2 - 1] * inside[len(inside) // 2]))
+    middle = repair_split(inside)
     roots = _repaired(finder, roots, lo, middle, depth - 1)
     return None if roots is None else _repaired(finder, roots, middle, hi, depth - 1)
 

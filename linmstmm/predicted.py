@@ -474,7 +474,7 @@ def _repaired(finder, roots: list[float], lo: float, hi: float, depth: int):
             return sorted(outside + finder.segment(lo, hi))
         except RuntimeError:  # a count there cannot be made: the full search decides
             return None
-    middle = repair_split(inside)
+    middle = repair_split(inside, finder.fine_rtol)
     roots = _repaired(finder, roots, lo, middle, depth - 1)
     return None if roots is None else _repaired(finder, roots, middle, hi, depth - 1)
 

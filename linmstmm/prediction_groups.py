@@ -115,12 +115,21 @@ def cluster_reach(predictions: np.ndarray, start: float) -> float:
                                          np.abs(outside - predictions[group[-1]]))))
 
 
-def repair_split(inside: list[float]) -> float:
-    """Where (rad/s) :func:`linmstmm.predicted._repaired` halves a stretch holding the distinct known roots
-    ``inside`` (ascending, three or more): the geometric middle of the widest gap
-    (relative) between neighbours among its middle half. Not beside a close pair: the
-    count 5e-8 from each of a pair 1e-7 apart cannot decide, and the argument
-    principle counted in its place (494 evaluations of det for a rod's 30 lowest)."""
+def repair_split(inside: list[float], widest: bool) -> float:
+    """Where (rad/s) :func:`linmstmm.predicted._repaired` halves a stretch holding the
+    distinct known roots ``inside`` (ascending, three or more).
+
+    With ``widest`` (a search certifying to the default rtol): the geometric middle
+    of the widest gap (relative) between neighbours among its middle half, not beside
+    a close pair: the count 5e-8 from each of a pair 1e-7 apart cannot decide, and the
+    argument principle counted in its place (494 evaluations of det for a rod's 30
+    lowest). Else the middle of the median gap, even inside a close pair: at a looser
+    rtol both searches of a stretch that holds a whole pair closer than rtol (the
+    counted one, whose counts across a cluster are made at ±rtol, and the argument
+    principle's) may keep it as one double root (that rod at rtol 1e-6: nine false
+    double roots), where a split between the members parts it."""
+    if not widest:
+        return float(np.sqrt(inside[len(inside) // 2 - 1] * inside[len(inside) // 2]))
     quarter = len(inside) // 4
     gaps = range(max(quarter, 1), len(inside) - quarter)
     k = max(gaps, key=lambda i: inside[i] / inside[i - 1])

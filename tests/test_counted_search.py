@@ -30,6 +30,10 @@ class KnownRoots:
         self.roots, self.undecided, self.blind = np.sort(roots), undecided, blind
         self.last_step, self.evaluations = {}, 0
 
+    @property
+    def fine_rtol(self):
+        return self.rtol <= 1e-9  # the finder's default
+
     def counter(self, omega):
         if any(abs(omega - u) <= self.blind * u for u in self.undecided):
             return None
@@ -78,9 +82,12 @@ def test_ends_on_roots_where_the_count_cannot_decide_move_outward():
     np.testing.assert_allclose(counted_segment(finder, 4.0, 15.0), roots[1:], rtol=1e-13)
     wider = KnownRoots(roots, undecided=(4.0, 15.0), blind=5e-9)  # 1e-9 undecided too: 1e-8 decides
     np.testing.assert_allclose(counted_segment(wider, 4.0, 15.0), roots[1:], rtol=1e-13)
-    # roots between an end and where it moved to are not in (lo, hi]
-    beyond = KnownRoots([4.0 * (1 - 5e-8), *roots, 15.0 * (1 + 5e-8)], undecided=(4.0, 15.0), blind=5e-8)
-    np.testing.assert_allclose(counted_segment(beyond, 4.0, 15.0), roots[1:], rtol=1e-13)
+    # a root between an end and where it moved to is not in (lo, hi]
+    beyond = KnownRoots([4.0 * (1 - 5e-8), *roots[1:]], undecided=(4.0,), blind=5e-8)
+    np.testing.assert_allclose(counted_segment(beyond, 4.0, 20.0), roots[1:], rtol=1e-13)
+    # two there, a pair astride the end, which values cannot place: the search gives up
+    astride = KnownRoots([4.0 * (1 - 5e-8), *roots, 15.0 * (1 + 5e-8)], undecided=(4.0, 15.0), blind=5e-8)
+    assert counted_segment(astride, 4.0, 15.0) is None
 
 
 def test_an_undecided_count_or_an_unresolved_cluster_hands_the_segment_back():

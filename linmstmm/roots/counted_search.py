@@ -15,12 +15,19 @@ inside.
 
 A segment's ends are often roots already found (the neighbours of a stretch
 the polish left troubled), where the count cannot decide (K(ω) is singular
-there). Such an end is moved outward by the narrowest width at which the
-count decides (:func:`~linmstmm.roots.certify.near_widths`), and the roots
-found beyond the ends are left out (those within the finder's same-root
-distance of an end are that end: the lower stays out, the upper in): a rod whose bending pairs are
-1e-7 apart had every one of its troubled stretches end so, and the
-argument-principle search took 1,800 evaluations of det for them.
+there). Such an end is moved outward by the narrowest of
+:data:`~linmstmm.roots.certify.NEAR_WIDTHS` (1e-9 … 1e-6, relative) at which
+the count decides, and the roots found beyond the ends are left out (those
+within the finder's same-root distance of an end are that end: the lower
+stays out, the upper in); where more than one root lies that close to a moved
+end, a pair astride it, the search gives up. Only for a finder that certifies
+to the default rtol or finer (:attr:`RootFinder.fine_rtol`): at a looser rtol
+the cluster polish inside may keep a pair closer than rtol as one double root
+(its counts across are made at ±rtol), where the argument principle's search
+of a stretch that ends on a member parts it (a rod with planes 1e-7 apart at
+rtol 1e-6 came back with nine false double roots). At the default rtol the same
+rod's troubled stretches all end on roots, and the argument-principle search
+took 1,800 evaluations of det for them.
 
 Where a count cannot decide, or a piece does not give up its roots this way,
 the search answers None and the argument-principle segment search runs
@@ -31,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from linmstmm.roots.certify import near_widths
+from linmstmm.roots.certify import NEAR_WIDTHS, near_widths
 
 #: A piece narrower than this (relative) that still holds several roots is polished
 #: as a cluster on the pencil rather than halved again.
@@ -51,26 +58,39 @@ def counted_segment(finder, lo: float, hi: float) -> list[float] | None:
     argument-principle segment search)."""
     if finder.counter is None:
         return None
-    (start, below), (stop, above) = _decided_end(finder, lo, -1), _decided_end(finder, hi, 1)
+    outward = 1 if finder.fine_rtol else 0
+    (start, below), (stop, above) = _decided_end(finder, lo, -outward), _decided_end(finder, hi, outward)
     if below is None or above is None:
         return None
     found = _pieces(finder, start, stop, below, above, 0)
     if found is None or (start, stop) == (lo, hi):
         return found
+    if _crowded(found, lo, start) or _crowded(found, hi, stop):
+        return None
     same = finder.same_root  # lo found again stays out, hi found again is in; no other beyond them
     return [root for root in found if lo * (1 + same) < root <= hi * (1 + same)]
 
 
 def _decided_end(finder, omega: float, outward: int) -> tuple[float, int | None]:
     """(end, J(end)): ``omega`` (rad/s) where the count there decides, else ``omega``
-    moved by the narrowest of :func:`~linmstmm.roots.certify.near_widths` at which it
-    does, down (``outward`` −1) or up (+1); J None where none decides."""
-    for width in (0.0, *near_widths(finder.rtol)):
+    moved by the narrowest of NEAR_WIDTHS at which it does, down (``outward`` −1) or
+    up (+1), not at all (0); J None where none decides."""
+    for width in (0.0, *(NEAR_WIDTHS if outward else ())):
         end = omega * (1 + outward * width)
         count = finder.counter(end)
         if count is not None:
             return end, count
     return omega, None
+
+
+def _crowded(found: list[float], end: float, moved: float) -> bool:
+    """Whether more than one of ``found`` (rad/s) lies within the distance between a
+    segment's ``end`` and where it was ``moved`` to (rad/s) of ``end``: a close pair
+    astride the end, which the values cannot tell apart on either side (the pencil's
+    cluster polish returned one pair 2e-8 apart as one member twice, and the member
+    inside was lost). One root there is the end's own, or a root that far off."""
+    reach = abs(moved - end)
+    return sum(abs(root - end) <= reach for root in found) > 1
 
 
 def _pieces(finder, lo: float, hi: float, below: int, above: int, depth: int) -> list[float] | None:

@@ -196,6 +196,14 @@ class RootFinder:
         return self._rigid
 
     @property
+    def fine_rtol(self) -> bool:
+        """Whether this finder certifies to CERTIFIED_STEP (the default rtol) or finer,
+        where its searches of a stretch part a close pair whole inside it; at a looser
+        rtol they may keep a pair closer than rtol as one double root
+        (:mod:`~linmstmm.roots.counted_search`, :func:`~linmstmm.prediction_groups.repair_split`)."""
+        return self.rtol <= CERTIFIED_STEP
+
+    @property
     def same_root(self) -> float:
         """Relative distance within which two polished values are one root: SAME_ROOT,
         or xtol where that is coarser (a loose rtol polishes to rtol/100 only: the

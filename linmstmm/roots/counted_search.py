@@ -86,9 +86,10 @@ def _decided_end(finder, omega: float, outward: int) -> tuple[float, int | None]
 def _crowded(found: list[float], end: float, moved: float) -> bool:
     """Whether more than one of ``found`` (rad/s) lies within the distance between a
     segment's ``end`` and where it was ``moved`` to (rad/s) of ``end``: a close pair
-    astride the end, which the values cannot tell apart on either side (the pencil's
-    cluster polish returned one pair 2e-8 apart as one member twice, and the member
-    inside was lost). One root there is the end's own, or a root that far off."""
+    astride the end, which the values cannot tell apart on either side (at rtol 1e-7,
+    before the ends moved at the default rtol only, the pencil's cluster polish returned
+    a pair 2e-8 apart as its outer member twice, and the inner one was lost). One root
+    there is the end's own, or a root that far off."""
     reach = abs(moved - end)
     return sum(abs(root - end) <= reach for root in found) > 1
 

@@ -9,7 +9,8 @@ counterpart that stays the readable reference and the test oracle:
 * :func:`evaluate` — :meth:`linmstmm.deduction.Deduction.matrix` and
   :meth:`~linmstmm.deduction.Deduction.log_det` with ``stable=True``: the carry
   with Godunov orthonormalisation (:class:`linmstmm.godunov._Orthonormaliser`),
-  beams cut into pieces of βL ≤ 4, Ū_all assembled, LU.
+  beams cut into pieces of βL ≤ 4, Ū_all assembled, LU (of what remains once
+  its lone columns are expanded along: :func:`_block_log_det`).
 
 Two intrinsics build array views directly in LLVM, where numba's own cost more
 than the arithmetic around them: :func:`_view` (a slot's block of the workspace)
@@ -643,6 +644,38 @@ def _log_det(matrix):
     return sign, log_abs
 
 
+@njit(cache=True)
+def _block_log_det(work_m, sources, targets, blocks, offsets, orders, permutation_sign):
+    """(sign or phase, log|det Ū_all|) of one frequency's workspace ``work_m`` from the
+    diagonal blocks of Ū_all's block-triangular form: ``blocks`` (F,) is overwritten
+    with them (entry ``sources[e]`` of the workspace added at ``targets[e]``, each block
+    Fortran-ordered from ``offsets[k]``, of order ``orders[k]``), and det Ū_all =
+    ``permutation_sign`` · Π det(block) (:func:`linmstmm._assembly_kernels.determinant_blocks`).
+    As :func:`_log_det`: (NaN, NaN) where an entry is not finite, (+0, −inf) where a
+    pivot is exactly zero; a block of order one is its own pivot."""
+    blocks[:] = 0.0
+    for e in range(sources.size):
+        blocks[targets[e]] += work_m[sources[e]]
+    sign = permutation_sign + 0.0 * work_m[0]
+    log_abs = 0.0
+    for k in range(orders.size):
+        if orders[k] == 1:
+            pivot = blocks[offsets[k]]
+            magnitude = np.abs(pivot)
+            block_sign, block_log = (pivot / magnitude if magnitude > 0.0 else pivot - pivot), np.log(magnitude)
+            if math.isnan(block_log) or block_log == np.inf:
+                block_log = np.nan
+        else:
+            block_sign, block_log = _log_det(_view(blocks, offsets[k], orders[k], orders[k]).T)
+        if math.isnan(block_log):
+            return np.nan + 0.0 * sign, np.nan
+        sign = sign * block_sign
+        log_abs += block_log
+    if log_abs == -np.inf:
+        return sign - sign, -np.inf  # a zero of sign's type, +0
+    return sign, log_abs
+
+
 @njit(cache=True, nogil=True)
 def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out, log_scale_out):
     """Stable Ū_all over ``omegas`` (n,) in groups of ``group`` consecutive frequencies.
@@ -651,7 +684,7 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
     log_abs_out : (n,) sign (phase) and log|det Ū_all| (log-scale included);
     log_scale_out : (n,) the log-scale alone (det Ū_all = det(matrix) e^log_scale).
     """
-    workspace, n_slots, kept, sources, targets = layout
+    workspace, n_slots, kept, sources, targets, block_sources, block_targets, offsets, orders, block_sign = layout
     n = omegas.size
     largest = min(group, n)
     # every operation writes the whole of its target: the workspace needs no clearing
@@ -660,7 +693,8 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
     orthos, ortho_blocks = program[8], program[9]
     ortho_scratch = _orthonormal_scratch(orthos, ortho_blocks, largest, omegas)
     beam_scratch = _beam_scratch(program, largest, omegas)
-    transposed = np.empty(kept * kept, dtype=omegas.dtype)
+    transposed = np.empty(kept * kept if matrices_out.shape[0] else 0, dtype=omegas.dtype)
+    blocks = np.empty(offsets[-1], dtype=omegas.dtype)
     for start in range(0, n, group):
         stop = min(start + group, n)
         size = stop - start
@@ -669,10 +703,11 @@ def evaluate(program, layout, omegas, group, matrices_out, sign_out, log_abs_out
         log_scale[:] = 0.0
         _run(program, omegas[start:stop], work, reference, log_scale, ortho_scratch, beam_scratch)
         for m in range(size):
-            ubar = _assembled(work[m], sources, targets, transposed, kept)
             if matrices_out.shape[0]:
-                matrices_out[start + m] = ubar
-            sign, log_abs = _log_det(ubar)  # NaN where not finite, which the root counts step round
+                matrices_out[start + m] = _assembled(work[m], sources, targets, transposed, kept)
+            # NaN where not finite, which the root counts step round
+            sign, log_abs = _block_log_det(work[m], block_sources, block_targets, blocks, offsets, orders,
+                                           block_sign)
             sign_out[start + m] = sign
             log_abs_out[start + m] = log_abs + log_scale[m]
             log_scale_out[start + m] = log_scale[m]

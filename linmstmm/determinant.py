@@ -173,7 +173,8 @@ class CompiledDeterminant(EvaluationCount):
         deduction.adopt_row_kinds(self.program.row_kinds)
         p = self.program
         self._operations = _kernel_operations(p, p.orthos)
-        self._layout = (p.workspace, p.slot_rows.size, p.kept_columns.size, p.assembly_sources, p.assembly_targets)
+        self._layout = (p.workspace, p.slot_rows.size, p.kept_columns.size, p.assembly_sources, p.assembly_targets,
+                        p.block_sources, p.block_targets, p.block_offsets, p.block_orders, p.block_sign)
 
     @property
     def order(self) -> int:

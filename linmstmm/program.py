@@ -381,14 +381,40 @@ def _program(deduction: Deduction, beams, slot_rows: np.ndarray, slot_width: np.
 
 def _assembly(layout: dict) -> dict:
     """Where each entry of Ū_all comes from in a program of the fields ``layout``: its
-    ``assembly_sources`` and ``assembly_targets`` (:func:`linmstmm._assembly_kernels.assembly`).
-    Found once per walk: a program with new numbers keeps them (:func:`_revalued`)."""
-    from linmstmm._assembly_kernels import assembly  # numba loads here, not at import
+    ``assembly_sources`` and ``assembly_targets`` (:func:`linmstmm._assembly_kernels.assembly`),
+    and where those that can be nonzero go among the diagonal blocks of Ū_all's
+    block-triangular form, which alone enter its determinant
+    (:func:`~linmstmm._assembly_kernels.determinant_blocks`). Found once per walk: a
+    program with new numbers keeps them (:func:`_revalued`)."""
+    from linmstmm._assembly_kernels import assembly, determinant_blocks  # numba loads here, not at import
 
     blocks = np.concatenate(([layout["root"], layout["root_row"]], layout["geometric_rows"])).astype(np.int64)
     slots = [layout[name] for name in ("slot_offset", "slot_rows", "slot_width", "slot_columns", "slot_columns_start")]
     sources, targets = assembly(*slots, blocks, layout["kept_rows"], layout["kept_columns"], layout["order"])
-    return {"assembly_sources": sources, "assembly_targets": targets}
+    can_be_nonzero = ~_held_at_zero(layout, sources)
+    block_sources, block_targets, offsets, orders, sign = determinant_blocks(
+        sources[can_be_nonzero], targets[can_be_nonzero], layout["kept_columns"].size)
+    return {"assembly_sources": sources, "assembly_targets": targets, "block_sources": block_sources,
+            "block_targets": block_targets, "block_offsets": offsets, "block_orders": orders,
+            "block_sign": float(sign)}
+
+
+def _held_at_zero(layout: dict, sources: np.ndarray) -> np.ndarray:
+    """(E,) bool: which of the workspace entries ``sources`` (E,) are zero at every ω:
+    those of the root's known side (−Z_root, its slot ``root_row``) that its selection
+    holds at zero, where that slot keeps the selection its TIP operation writes (no
+    other operation writes it, no orthonormalisation takes it in). A root end's
+    unknowns enter Ū_all there alone, each with one entry in its column."""
+    slot, operations, ortho_blocks = layout["root_row"], layout["operations"], layout["ortho_blocks"]
+    writers = operations[(operations[:, 0] != ORTHO) & (operations[:, 1] == slot)]
+    if len(writers) != 1 or writers[0, 0] != TIP or np.any(ortho_blocks[:, :2] == slot):
+        return np.zeros(sources.size, dtype=bool)
+    width, start = layout["slot_width"][slot], layout["slot_offset"][slot]
+    inside = (sources >= start) & (sources < start + 12 * width)
+    rows, columns = np.divmod(sources[inside] - start, width)
+    held = np.zeros(sources.size, dtype=bool)
+    held[inside] = layout["matrices"][writers[0, 2]][rows, columns] == 0.0
+    return held
 
 
 def _starts(counts: np.ndarray) -> np.ndarray:

@@ -72,6 +72,10 @@ class Program:
     assembly_sources, assembly_targets : (E,) int64, entry ``assembly_sources[e]`` of a
         frequency's workspace is added to entry ``assembly_targets[e]`` of the
         transposed Ū_all (N, N) flattened (:func:`linmstmm._assembly_kernels.assembly`).
+    block_sources, block_targets, block_offsets, block_orders, block_sign : the entries
+        of the diagonal blocks of Ū_all's block-triangular form, where each block starts
+        and its order, and the sign of the permutations: det Ū_all = block_sign ·
+        Π det(block) (:func:`linmstmm._assembly_kernels.determinant_blocks`).
     """
 
     slot_offset: np.ndarray
@@ -98,3 +102,8 @@ class Program:
     row_kinds: np.ndarray
     assembly_sources: np.ndarray
     assembly_targets: np.ndarray
+    block_sources: np.ndarray
+    block_targets: np.ndarray
+    block_offsets: np.ndarray
+    block_orders: np.ndarray
+    block_sign: float

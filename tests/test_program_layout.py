@@ -43,9 +43,11 @@ def models():
 RELEASED = ("varied 24", "varied 358 (two)", "random loops 25", "random tree 19 with joints")
 
 
-#: Fields left out of the digest: the constants' matrices, and where each entry of Ū_all
-#: comes from (found from the walk's arrays by linmstmm._assembly_kernels, not by the walk).
-NOT_DIGESTED = ("matrices", "assembly_sources", "assembly_targets")
+#: Fields left out of the digest: the constants' matrices, where each entry of Ū_all comes
+#: from and where it goes for the determinant (found from the walk's arrays by
+#: linmstmm._assembly_kernels, not by the walk).
+NOT_DIGESTED = ("matrices", "assembly_sources", "assembly_targets", "block_sources", "block_targets",
+                "block_offsets", "block_orders", "block_sign")
 
 
 def layout_digest(model) -> str:

@@ -18,6 +18,15 @@ import numpy as np
 FIRST_STEP = -1e-7
 #: Secant steps before a root that has not settled is handed to the pencil.
 SECANT_STEPS = 12
+#: A secant from the ends of a bracket whose signs agree that comes back within this many
+#: half-widths of its start may have met det's rounding noise, not a root beside the start,
+#: and is tested (:func:`_in_noise`): on launcher 2's 67th root det's sign is noise over
+#: ±5e-9, 50 half-widths, where the secant stopped 1.1e-10 to 1.5e-10 off its exact start
+#: (by the BLAS threads' rounding), claiming a last step of 3.4e-14.
+NOISE_SPANS = 100
+#: The test's points lie this many times the secant result's distance from the start
+#: either side of it: a simple root's det is linear there, ten times the start's.
+NOISE_REACH = 10.0
 
 
 def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: float, spans: np.ndarray | None = None):
@@ -34,8 +43,9 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: f
     root, with no further evaluation and the bracket's width (relative) as its
     last step (the secant's error there is of the order of the width squared
     over the distance to the next root); elsewhere the secant goes on from them,
-    and where it comes back within its last step of the start, det cannot tell
-    them apart and the start is the root (the step stays its uncertainty).
+    and where it comes back into det's rounding noise about the start
+    (:func:`_in_noise`), the start is the root, its distance from the secant's
+    point (or the last step, the larger) its uncertainty.
     Each step evaluates det once per root still moving, all in one call;
     det's ratio at two points is formed from the log magnitudes, so no value
     overflows. Returns (roots, last relative steps); a root that did not
@@ -58,7 +68,8 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: f
     previous = before = np.full(x.size, np.inf)
     oldest = np.full(x.size, np.nan)  # the point evaluated before x_old (none yet)
     bracketed = bracketing & ((sign * sign_old).real < 0)  # a bracket's ends: ended by the first step
-    unconfirmed = bracketing & ~bracketed  # a bracket whose ends det does not tell apart
+    unconfirmed = np.flatnonzero(bracketing & ~bracketed)  # a bracket whose ends' signs agree
+    level = np.maximum(log_old, log_abs)  # log|det| at a bracket's ends, the larger
     for _ in range(SECANT_STEPS):
         with np.errstate(divide="ignore", invalid="ignore"):  # sign 0: det exactly 0, x is a root
             ratio = (sign_old / sign).real * np.exp(np.clip(log_old - log_abs, -700, 700))  # det(x_old)/det(x)
@@ -99,12 +110,41 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: f
         x_old, sign_old, log_old = x[keep], sign[keep], log_abs[keep]
         x = new[keep]
         sign, log_abs = log_det(x)
-    # Where det does not change sign across a bracket and the secant from its ends comes
-    # back within its own last step of the start, det cannot tell the two apart at its
-    # rounding floor, and the start (a Rayleigh value: 1e-16 to 1e-13 off on the
-    # launchers) is the nearer: launcher 2's 67th root, 1.1e-10 off by the secant, is the
-    # start to the bit. The step stays what det can confirm.
-    with np.errstate(invalid="ignore"):
-        indistinct = unconfirmed & (np.abs(roots - starts) <= steps * np.abs(roots))
-    roots[indistinct] = starts[indistinct]
+    noise = _in_noise(log_det, roots, steps, starts, unconfirmed, spans, level)
+    steps[noise] = np.maximum(steps[noise], np.abs(roots[noise] - starts[noise]) / np.abs(starts[noise]))
+    roots[noise] = starts[noise]
     return roots, steps
+
+
+def _in_noise(log_det, roots: np.ndarray, steps: np.ndarray, starts: np.ndarray, unconfirmed: np.ndarray,
+              spans: np.ndarray, level: np.ndarray) -> np.ndarray:
+    """(n,) bool: which secant results ``roots`` (rad/s) from the ends of a bracket whose
+    signs agree (indices ``unconfirmed``) lie in det's rounding noise about their start.
+
+    Near some roots det's sign is noise (launcher 2 at 780 Hz: over ±5e-9), where the
+    secant settles on a sign flip with a last step far shorter than its distance d from
+    the start, a Rayleigh value that is 1e-16 to 1e-13 off on the launchers. A result
+    within its own last step of the start cannot be told from it; one within
+    NOISE_SPANS half-widths is tested: det at NOISE_REACH · d either side of it must
+    change sign, and a det linear through those two points must give the bracket's
+    farther end (``level``: the larger log|det| at its ends) within a factor of
+    √NOISE_REACH, as a simple root's det does (one evaluation each side, all in one
+    call); else det there is noise (flat at its rounding floor, or the secant's point is
+    not where the sign changes): two evaluations more per tested result, only where a
+    bracket failed."""
+    noise = np.zeros(roots.size, dtype=bool)
+    with np.errstate(invalid="ignore"):
+        distance = np.abs(roots - starts) / np.abs(starts)
+        noise[unconfirmed] = distance[unconfirmed] <= steps[unconfirmed]
+        tested = unconfirmed[~noise[unconfirmed] & (distance[unconfirmed] <= NOISE_SPANS * spans[unconfirmed])]
+    if not tested.size:
+        return noise
+    root, start = roots[tested], starts[tested]
+    reach = NOISE_REACH * np.abs(root - start)
+    signs, logs = log_det(np.concatenate([root - reach, root + reach]))
+    (below, above), (log_below, log_above) = np.split(signs, 2), np.split(logs, 2)
+    farther = np.maximum(np.abs(root - start * (1 - spans[tested])), np.abs(root - start * (1 + spans[tested])))
+    expected = 0.5 * (log_below + log_above) + np.log(farther / reach)  # a linear det's at the farther end
+    linear = ((below * above).real < 0) & (np.abs(level[tested] - expected) < 0.5 * np.log(NOISE_REACH))
+    noise[tested[~linear]] = True
+    return noise

@@ -274,15 +274,32 @@ def noisy(root: float, band: float):
     return log_det
 
 
-def test_a_start_det_cannot_tell_from_the_secants_root_is_kept():
-    """det's sign is noise within 1e-9 of the root, so the bracket of ±1e-10 about a start
-    on the root (a Rayleigh value, exact) shows no sign change and the secant wanders in
-    the noise: its result, within its own last step of the start, gives way to the
-    start. (A start the secant tells apart from its root keeps the secant's: the test
-    above, 3e-9 off.)"""
+def flipped(root: float, flip: float, band: float):
+    """log_det of (ω − root) outside ``band`` (relative) of the root; inside, det at its
+    rounding floor (1e-12 within a factor of 3, at random), its sign flipping at
+    root (1 + ``flip``) instead of at the root."""
+    def log_det(omega):
+        omega = np.asarray(omega, dtype=float)
+        floor = 1e-12 * (1 + 0.5 * np.sin(omega.view(np.int64) * 0.7548776662466927))
+        value = np.where(np.abs(omega / root - 1) > band, omega - root,
+                         np.where(omega > root * (1 + flip), floor, -floor))
+        return np.sign(value), np.log(np.abs(value))
+    return log_det
+
+
+@pytest.mark.parametrize("det", ["noise", "a flip beside the root"])
+def test_a_secant_on_dets_rounding_noise_keeps_the_start(det):
+    """Within 5e-9 of the root det is at its rounding floor, so the bracket of ±1e-10
+    about a start on the root (a Rayleigh value, exact) shows no sign change and the
+    secant settles in the noise (on a random sign; or 1.5e-9 off, the floor flipping
+    sign 1.5e-10 below the root). The start is kept, with an uncertainty no smaller
+    than the bracket's. (A start 3e-9 off a clean det's root keeps the secant's root:
+    the test above.)"""
     root = 4900.778745994314
-    found, steps = secant_roots(noisy(root, 1e-9), np.array([root]), 1e-14, 1e-7, np.array([1e-10]))
-    assert found[0] == root and steps[0] > 1e-10  # the step: what det confirms, no better
+    log_det = noisy(root, 1e-9) if det == "noise" else flipped(root, -1.5e-10, 5e-9)
+    found, steps = secant_roots(log_det, np.array([root]), 1e-14, 1e-7, np.array([1e-10]))
+    assert found[0] == root
+    assert steps[0] >= 1e-10  # what det confirms, no better
 
 
 @pytest.mark.parametrize("path", LAUNCHERS)

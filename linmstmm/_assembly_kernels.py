@@ -131,7 +131,7 @@ def determinant_blocks(sources, targets, kept):
         for k in range(row_starts[row], row_starts[row + 1]):
             queue[queued] = by_row[k]  # it may stand alone now
             queued += 1
-    return _laid_out(sources, row_of, column_of, lone_rows[:lone], lone_columns[:lone], taken, n)
+    return _laid_out(sources, row_of, column_of, lone_rows[:lone], lone_columns[:lone], taken, alone)
 
 
 @njit(cache=True)
@@ -149,11 +149,11 @@ def _grouped(keys, values, n):
 
 
 @njit(cache=True)
-def _laid_out(sources, row_of, column_of, lone_rows, lone_columns, taken, n):
+def _laid_out(sources, row_of, column_of, lone_rows, lone_columns, taken, alone):
     """:func:`determinant_blocks`' layout of the lone columns (at ``lone_rows``) as blocks
     of order one, in the order taken, then of every other row and column as one block,
-    each ascending."""
-    lone = lone_rows.size
+    each ascending (``taken``, ``alone`` (n,): the rows and columns of lone ones)."""
+    n, lone = taken.size, lone_rows.size
     rest = n - lone
     blocks = lone + (1 if rest else 0)
     block_orders = np.ones(blocks, np.int64)
@@ -164,18 +164,16 @@ def _laid_out(sources, row_of, column_of, lone_rows, lone_columns, taken, n):
     block_of_row, block_of_column = np.full(n, blocks - 1, np.int64), np.full(n, blocks - 1, np.int64)
     local_row, local_column = np.zeros(n, np.int64), np.zeros(n, np.int64)
     rows_in_order, columns_in_order = np.empty(n, np.int64), np.empty(n, np.int64)
-    is_lone_column = np.zeros(n, np.bool_)
     for k in range(lone):
         block_of_row[lone_rows[k]], block_of_column[lone_columns[k]] = k, k
         rows_in_order[k], columns_in_order[k] = lone_rows[k], lone_columns[k]
-        is_lone_column[lone_columns[k]] = True
     placed_rows = placed_columns = lone
     for i in range(n):
         if not taken[i]:
             local_row[i] = placed_rows - lone
             rows_in_order[placed_rows] = i
             placed_rows += 1
-        if not is_lone_column[i]:
+        if not alone[i]:
             local_column[i] = placed_columns - lone
             columns_in_order[placed_columns] = i
             placed_columns += 1

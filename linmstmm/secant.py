@@ -110,16 +110,18 @@ def secant_roots(log_det, starts: np.ndarray, xtol: float | np.ndarray, floor: f
         x_old, sign_old, log_old = x[keep], sign[keep], log_abs[keep]
         x = new[keep]
         sign, log_abs = log_det(x)
-    noise = _in_noise(log_det, roots, steps, starts, unconfirmed, spans, level)
-    steps[noise] = np.maximum(steps[noise], np.abs(roots[noise] - starts[noise]) / np.abs(starts[noise]))
+    distance = np.abs(roots - starts) / np.abs(starts)  # NaN where the secant did not settle
+    noise = _in_noise(log_det, roots, steps, starts, distance, unconfirmed, spans, level)
+    steps[noise] = np.maximum(steps[noise], distance[noise])
     roots[noise] = starts[noise]
     return roots, steps
 
 
-def _in_noise(log_det, roots: np.ndarray, steps: np.ndarray, starts: np.ndarray, unconfirmed: np.ndarray,
-              spans: np.ndarray, level: np.ndarray) -> np.ndarray:
+def _in_noise(log_det, roots: np.ndarray, steps: np.ndarray, starts: np.ndarray, distance: np.ndarray,
+              unconfirmed: np.ndarray, spans: np.ndarray, level: np.ndarray) -> np.ndarray:
     """(n,) bool: which secant results ``roots`` (rad/s) from the ends of a bracket whose
-    signs agree (indices ``unconfirmed``) lie in det's rounding noise about their start.
+    signs agree (indices ``unconfirmed``) lie in det's rounding noise about their start
+    (``distance``: relative, from it).
 
     Near some roots det's sign is noise (launcher 2 at 780 Hz: over ±5e-9), where the
     secant settles on a sign flip with a last step far shorter than its distance d from
@@ -133,10 +135,8 @@ def _in_noise(log_det, roots: np.ndarray, steps: np.ndarray, starts: np.ndarray,
     not where the sign changes): two evaluations more per tested result, only where a
     bracket failed."""
     noise = np.zeros(roots.size, dtype=bool)
-    with np.errstate(invalid="ignore"):
-        distance = np.abs(roots - starts) / np.abs(starts)
-        noise[unconfirmed] = distance[unconfirmed] <= steps[unconfirmed]
-        tested = unconfirmed[~noise[unconfirmed] & (distance[unconfirmed] <= NOISE_SPANS * spans[unconfirmed])]
+    noise[unconfirmed] = distance[unconfirmed] <= steps[unconfirmed]
+    tested = unconfirmed[~noise[unconfirmed] & (distance[unconfirmed] <= NOISE_SPANS * spans[unconfirmed])]
     if not tested.size:
         return noise
     root, start = roots[tested], starts[tested]

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from linmstmm.geometry import local_axes, norm3
 from linmstmm.model import COMPONENTS, Beam, Model, Rigid, Spring
 
 #: Structural steel: E and G in Pa, rho in kg/m^3.
@@ -28,32 +29,31 @@ STEEL = dict(E=2.1e11, G=8.1e10, rho=7850.0)
 
 
 def beam_axes(a, b, y_hint=None) -> np.ndarray:
-    """Local axes of a beam from ``a`` to ``b``, by the model format's rule.
+    """Local axes of a beam from ``a`` to ``b``, by the model format's rule
+    (:func:`linmstmm.geometry.local_axes`, as the loader forms them).
 
     Parameters
     ----------
     a, b : array_like, shape (3,)
         End positions, m, inertial frame (local x runs from a to b).
     y_hint : array_like, shape (3,), optional
-        Direction of local y before it is made normal to x. Default
-        e_Z × x; e_Y is used instead wherever that (or the hint) is parallel
-        to the beam.
+        Direction of local y before it is made normal to x (a file's ``y_axis``).
+        Default e_Z × x, or e_Y where the beam is vertical.
 
     Returns
     -------
     numpy.ndarray, shape (3, 3)
         Rows: local x, y, z unit vectors in the inertial frame (right-handed).
+
+    Raises
+    ------
+    ValueError
+        Where ``y_hint`` is zero or parallel to the beam.
     """
-    x = np.asarray(b, float) - np.asarray(a, float)
-    x /= np.linalg.norm(x)
-    # Both candidates have unit scale, so the parallel test below is relative.
-    y = np.cross([0.0, 0.0, 1.0], x) if y_hint is None else \
-        np.asarray(y_hint, float) / np.linalg.norm(y_hint)
-    if np.linalg.norm(y - (y @ x) * x) < 1e-9:
-        y = np.array([0.0, 1.0, 0.0])
-    y = y - (y @ x) * x
-    y /= np.linalg.norm(y)
-    return np.array([x, y, np.cross(x, y)])
+    along = np.asarray(b, float) - np.asarray(a, float)
+    if y_hint is not None and (size := norm3(np.asarray(y_hint, float))) > 0:
+        y_hint = np.asarray(y_hint, float) / size  # unit length first: the same direction, the frames built so far to the bit (tests pin them)
+    return local_axes(along / norm3(along), y_hint)
 
 
 def make_beam(name, a, b, points, A=1e-3, Iy=2e-7, Iz=2e-7, J=4e-7, Ip=None, y_hint=None,

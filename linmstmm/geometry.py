@@ -1,5 +1,5 @@
 """The geometry a model's checks and edits read: the distance within which two of its
-points coincide, and the length and cross product of 3-vectors.
+points coincide, the length and cross product of 3-vectors, and a beam's local axes.
 
 Lengths and cross products are formed in numpy's own arithmetic, operation for
 operation, so every result is the one numpy gives bit for bit
@@ -18,6 +18,10 @@ import numpy as np
 _REL_TOL = 1e-9
 #: ... with this absolute floor, m.
 _ABS_TOL = 1e-12
+#: A direction whose part normal to a beam's axis is this small (relative) is parallel to it.
+PARALLEL_TOL = 1e-9
+_E_Y = np.array([0.0, 1.0, 0.0])
+_E_Z = np.array([0.0, 0.0, 1.0])
 
 
 def length_tolerance(points: dict) -> float:
@@ -97,3 +101,39 @@ def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """
     return np.stack([a[:, 1] * b[2] - a[:, 2] * b[1], a[:, 2] * b[0] - a[:, 0] * b[2],
                      a[:, 0] * b[1] - a[:, 1] * b[0]], axis=1)
+
+
+def local_axes(x: np.ndarray, y_axis=None) -> np.ndarray:
+    """A beam's local axes by the model format's rule (``y_axis`` of a beam, docs/model-format.md).
+
+    Parameters
+    ----------
+    x : numpy.ndarray of float64, shape (3,)
+        Unit vector along the beam (local x), inertial frame.
+    y_axis : array_like, shape (3,), optional
+        The direction local y is to take, made normal to x (any length, any unit).
+        Default e_Z × x, or e_Y made normal to x where x is vertical.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3, 3)
+        Rows: local x, y, z unit vectors (right-handed).
+
+    Raises
+    ------
+    ValueError
+        Where ``y_axis`` is zero or parallel to x (its part normal to x at most
+        PARALLEL_TOL of its length).
+    """
+    if y_axis is not None:
+        given = np.asarray(y_axis, float)
+        size = norm3(given)
+        y = given - (given @ x) * x
+        if size == 0 or norm3(y) <= PARALLEL_TOL * size:
+            raise ValueError(f"{given.tolist()} is zero or parallel to the beam axis")
+    else:
+        y = cross3(_E_Z, x)
+        if norm3(y) <= PARALLEL_TOL:
+            y = _E_Y - (_E_Y @ x) * x
+    y = y / norm3(y)
+    return np.array([x, y, cross3(x, y)])

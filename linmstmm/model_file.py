@@ -39,7 +39,7 @@ import tomllib
 import numpy as np
 
 from linmstmm.connected import unreached
-from linmstmm.geometry import cross3, length_tolerance, norm3
+from linmstmm.geometry import length_tolerance, local_axes, norm3
 
 #: Names of the six displacement components, in state-vector order.
 COMPONENTS = ("x", "y", "z", "rx", "ry", "rz")
@@ -71,12 +71,8 @@ _ORTHO_TOL = 1e-9
 _PSD_TOL = 1e-12
 #: Principal moments must keep I3 <= I1 + I2 within this fraction of the trace.
 _TRIANGLE_TOL = 1e-9
-#: A direction whose part normal to the beam axis is this small (relative) is parallel.
-_PARALLEL_TOL = 1e-9
 _REQUIRED = object()
 _BOUNDARY_WORDS = {"free": (), "fixed": COMPONENTS, "pinned": ("x", "y", "z")}
-_E_Y = np.array([0.0, 1.0, 0.0])
-_E_Z = np.array([0.0, 0.0, 1.0])
 
 
 def _read_toml(path, file):
@@ -447,19 +443,11 @@ def _check_beam(t, points, tol):
 
 
 def _beam_axes(t, x):
-    """Rows local x, y, z: y from ``y_axis`` projected normal to x, else e_Z × x (e_Y if x ∥ e_Z)."""
-    if "y_axis" in t:
-        given = t.vector("y_axis", 3)
-        size = norm3(given)
-        y = given - (given @ x) * x
-        if size == 0 or norm3(y) <= _PARALLEL_TOL * size:
-            raise t.error("y_axis", f"{given.tolist()} is zero or parallel to the beam axis")
-    else:
-        y = cross3(_E_Z, x)
-        if norm3(y) <= _PARALLEL_TOL:
-            y = _E_Y - (_E_Y @ x) * x
-    y = y / norm3(y)
-    return np.array([x, y, cross3(x, y)])
+    """Rows local x, y, z (:func:`linmstmm.geometry.local_axes`), from the beam's ``y_axis`` if given."""
+    try:
+        return local_axes(x, t.vector("y_axis", 3) if "y_axis" in t else None)
+    except ValueError as error:
+        raise t.error("y_axis", str(error)) from None
 
 
 def _check_boundary(t, points):

@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from linmstmm.geometry import local_axes, norm3
 from linmstmm.model import Model, load_model
 from linmstmm.parameters import parse_key, with_values
 from linmstmm.sweep import SweepResult, sweep
@@ -98,11 +99,10 @@ def beam_props(beam, points) -> MassProps:
 
 
 def tube_frame(along) -> np.ndarray:
-    """(3, 3) rows: along the tubes, lateral (left, e_Z × along), normal (upwards)."""
-    along = np.asarray(along, float) / np.linalg.norm(along)
-    lateral = np.cross([0.0, 0.0, 1.0], along)
-    lateral /= np.linalg.norm(lateral)
-    return np.array([along, lateral, np.cross(along, lateral)])
+    """(3, 3) rows: along the tubes, lateral (left, e_Z × along), normal (upwards): the
+    local axes of a beam along the tubes (:func:`linmstmm.geometry.local_axes`)."""
+    along = np.asarray(along, float)
+    return local_axes(along / norm3(along))
 
 
 @dataclass(frozen=True)

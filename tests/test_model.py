@@ -8,6 +8,7 @@ element and the key. CLI tests run ``python -m linmstmm freqs`` on the files in
 from __future__ import annotations
 
 import dataclasses
+import json
 import math
 import subprocess
 import sys
@@ -541,6 +542,33 @@ def test_beam_default_axes_oblique(tmp_path):
 def test_beam_y_axis_is_projected_and_normalised(tmp_path):
     axes = _beam_axes(tmp_path, "[2.0, 0.0, 1.0]", "y_axis = [3.0, 0.0, 7.0]")
     np.testing.assert_allclose(axes, [[0, 0, 1], [1, 0, 0], [0, 1, 0]], atol=1e-15)
+
+
+@pytest.mark.parametrize("top, y_axis", [("[2.0, 0.0, 1.0]", None), ("[2.0, 0.0, -3.0]", None),
+                                         ("[3.0, 1.0, 1.0]", None), ("[2.0, 1.0, 0.0]", None),
+                                         ("[3.0, -2.0, 0.5]", None), ("[2.0, 0.0, 1.0]", [3.0, 0.0, 7.0])])
+def test_builders_and_scenes_frame_beams_as_the_loader_does(tmp_path, top, y_axis):
+    """One rule for a beam's local axes (linmstmm.geometry.local_axes): the loader's, the
+    builders' and the launcher scenes' tube frame agree with each other."""
+    from linmstmm.builders import beam_axes
+    from linmstmm.scenes import tube_frame
+
+    extra = "" if y_axis is None else f"y_axis = {y_axis}"
+    loaded = _beam_axes(tmp_path, top, extra)
+    end = np.array(json.loads(top))
+    np.testing.assert_allclose(beam_axes([2.0, 0.0, 0.0], end, y_axis), loaded, atol=1e-15)
+    if y_axis is None and end[0] != 2.0:  # not vertical: a tube's frame is a beam's default one
+        np.testing.assert_allclose(tube_frame(end - [2.0, 0.0, 0.0]), loaded, atol=1e-15)
+
+
+@pytest.mark.parametrize("hint", [[0.0, 0.0, 0.0], [0.0, 0.0, -2.0], [1e-12, 0.0, 1.0]])
+def test_builders_refuse_a_y_hint_along_the_beam(hint):
+    """A builder's zero or parallel y hint is refused, as a file's y_axis is (it was
+    replaced by e_Y without a word)."""
+    from linmstmm.builders import beam_axes
+
+    with pytest.raises(ValueError, match="zero or parallel to the beam axis"):
+        beam_axes([2.0, 0.0, 0.0], [2.0, 0.0, 1.0], hint)
 
 
 def test_beam_rigidity_flags(tmp_path):

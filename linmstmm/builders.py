@@ -52,7 +52,8 @@ def beam_axes(a, b, y_hint=None) -> np.ndarray:
     """
     along = np.asarray(b, float) - np.asarray(a, float)
     if y_hint is not None and (size := norm3(np.asarray(y_hint, float))) > 0:
-        y_hint = np.asarray(y_hint, float) / size  # unit length first: the same direction, the frames built so far to the bit (tests pin them)
+        # unit length first: the same direction, and the frames built so far to the bit (tests pin them)
+        y_hint = np.asarray(y_hint, float) / size
     return local_axes(along / norm3(along), y_hint)
 
 

@@ -75,3 +75,42 @@ def test_jointed_models_count_what_the_fe_route_counts(kind):
     for seed in range(3):
         model = with_joints(random_model(kind, seed), seed)
         assert rigid_body_mode_count(model) == fe_frequencies(model, count=1).rigid_body_modes
+
+
+def reached_by_passes(joined) -> list:
+    """The elements of ``joined`` not reached from the first one: passes over the
+    elements, each adding those that share a point with the reached, until one
+    adds none (what the model check did, quadratic in the elements)."""
+    reached, points, grown = {0}, set(joined[0][1]), True
+    while grown:
+        grown = False
+        for i, (_, ends) in enumerate(joined):
+            if i not in reached and points.intersection(ends):
+                reached.add(i)
+                points.update(ends)
+                grown = True
+    return [entry for i, entry in enumerate(joined) if i not in reached]
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_the_model_checks_connection_as_passes_over_the_elements_do(seed):
+    """linmstmm.connected.unreached (union–find over the points) against repeated passes,
+    on random element lists: several parts, elements of one to four points, any order."""
+    from linmstmm.connected import unreached
+
+    rng = np.random.default_rng(seed)
+    points = [f"p{i}" for i in range(int(rng.integers(2, 40)))]
+    joined = [(f"e{i}", tuple(rng.choice(points, size=int(rng.integers(1, min(4, len(points)) + 1)), replace=False)))
+              for i in range(int(rng.integers(1, 30)))]
+    assert unreached(joined) == reached_by_passes(joined)
+
+
+def test_a_long_chain_listed_backwards_is_connected():
+    """Bodies first, then the springs between them (the builders' order), so that each
+    pass of the old check reached one more body: 2,000 of them, found connected."""
+    from linmstmm.connected import unreached
+
+    bodies = [(f"b{i}", (f"p{i}", f"q{i}")) for i in range(2000)]
+    springs = [(f"s{i}", (f"q{i}", f"p{i + 1}")) for i in range(1999)]
+    assert unreached(bodies + springs) == []
+    assert unreached(bodies + springs[:999] + springs[1000:]) == bodies[1000:] + springs[1000:]

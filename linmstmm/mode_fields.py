@@ -142,11 +142,17 @@ class _Fields:
 
     def _com(self, rigid) -> np.ndarray:
         """(n, 6) mass-centre displacement u_c = u_p + θ × (c − p) from the body's first port."""
-        e = self.names.index(rigid.name)
+        e = self._element_index[rigid.name]
         element = self.topology.elements[e]
         port = self.element_states[e][:, 0]
         arm = np.asarray(rigid.com, float) - np.asarray(element.ports[0].position, float)
         return np.concatenate([port[:, :3] + cross_rows(port[:, 3:6], arm), port[:, 3:6]], axis=1)
+
+    @functools.cached_property
+    def _element_index(self) -> dict[str, int]:
+        """Transfer element name -> its index in :attr:`names` (a search of the names for each
+        body made a 20,000-body chain's shapes quadratic in its length)."""
+        return {name: e for e, name in enumerate(self.names)}
 
     def _beams(self):
         for element in self.topology.elements:

@@ -24,7 +24,7 @@ from linmstmm.coarse_prediction import coarse_pencil
 from linmstmm.collector import collector_paused
 from linmstmm.counting import count_in_disc
 from linmstmm.deduction import Deduction
-from linmstmm.determinant import determinant, kernels_loaded, resolved_engine
+from linmstmm.determinant import determinant, kernels_loaded, kernels_pay, load_kernels, resolved_engine
 from linmstmm.model import Model
 from linmstmm.model_structure import MODELS_KEPT, forget_structures
 from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
@@ -81,7 +81,10 @@ def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: st
     engine : str
         "auto", "numpy" or "compiled" (:func:`linmstmm.determinant.determinant`; a
         system made for "auto" before the kernels were loaded is not taken for one
-        made after).
+        made after). For a model large enough that the numpy carry would take longer
+        than the kernels' start-up (:func:`~linmstmm.determinant.kernels_pay`), "auto"
+        loads them first, and a later call for the same model, finding them loaded,
+        makes its system once more.
 
     Returns
     -------
@@ -102,6 +105,8 @@ def _compiled(model: Model, root: str | None, cut_at: tuple, engine: str, loaded
 def _compiled_now(model: Model, root: str | None, cut_at: tuple, engine: str) -> CompiledSystem:
     """The :class:`CompiledSystem` of ``model``, built."""
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
+    if engine == "auto" and not kernels_loaded() and kernels_pay(deduction):
+        load_kernels()  # a large model: the kernels' start-up costs less than the numpy carry's solve
     evaluator = determinant(deduction, engine)  # compiled first: its plain Ū_all screens the probes
     scales = characteristic_frequencies(deduction.topology)  # of the elements alone: a release keeps them
     released = release_indeterminate(deduction, screen=evaluator.plain_matrix, scales=scales)

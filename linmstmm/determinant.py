@@ -25,7 +25,9 @@ unknowns it was compiled for, so after a release it is compiled anew.
 where they are already loaded in this process (a long session, a parameter
 study: :func:`load_kernels`), the numpy carry otherwise, and for a model
 made mostly of one repeated cell (a long chain), whose runs the numpy carry
-powers.
+powers. A model large enough that its numpy solve would cost more than the
+kernels' start-up has them loaded for it (:func:`kernels_pay`, asked by
+:func:`linmstmm.compiled_model.compiled_system`).
 """
 from __future__ import annotations
 
@@ -92,6 +94,44 @@ def determinant(deduction: Deduction, engine: str = "auto"):
     if chosen == "compiled" and engine == "auto" and repeated_cells_dominate(deduction):
         chosen = "numpy"
     return CompiledDeterminant(deduction) if chosen == "compiled" else NumpyDeterminant(deduction)
+
+
+#: Elements the numpy carry takes one at a time, each beam counted BEAM_WEIGHT times, from
+#: which ``engine="auto"`` loads the kernels in a process that has not (:func:`kernels_pay`).
+#: First 20 frequencies, one process, best of two, numpy against compiled (the kernels loaded
+#: already): chains of 100, 150, 200, 250 unequal bodies (twice the elements) 0.41/0.07,
+#: 0.60/0.12, 0.92/0.18, 1.33/0.22 s; cantilevers of 60, 100, 150, 200 beam elements
+#: 0.23/0.09, 0.52/0.26, 1.70/0.12, 2.18/0.16 s. A new process spends about 0.6 s more on
+#: the kernels' start-up and first calls (a 100-element cantilever: 0.81 s against 0.52 s by
+#: numpy; 300 elements 0.82 s against 2.6 s; 1,000 elements 1.3 s against 7.9 s): the
+#: numpy carry is as fast or faster up to about 400, the kernels 3 to 6 times beyond.
+KERNELS_PAY_FROM = 400
+#: A beam's weight in that count: the numpy carry's cost of a beam element against a rigid
+#: body's or a spring's (the measurements above: about 2.5 to 3).
+BEAM_WEIGHT = 3
+
+
+def kernels_pay(deduction: Deduction) -> bool:
+    """True where loading the compiled kernels costs less than the numpy carry would take:
+    at least KERNELS_PAY_FROM elements carried one at a time (each beam BEAM_WEIGHT times),
+    the runs of a repeated cell, which the numpy carry powers, left out (they are looked
+    for only where the model has that many elements at all).
+
+    Parameters
+    ----------
+    deduction : Deduction
+        The model's deduction.
+
+    Returns
+    -------
+    bool
+    """
+    elements = [deduction.topology.elements[e] for e in deduction.topology.order]
+    weight = sum(BEAM_WEIGHT if element.kind == "beam" else 1 for element in elements)
+    if weight < KERNELS_PAY_FROM:
+        return False
+    powered = sum(len(run.cell) * run.repetitions for run in deduction.periodic_runs())  # never beams
+    return weight - powered >= KERNELS_PAY_FROM
 
 
 #: Transfer elements from which a model may be mostly repeated cells

@@ -4,6 +4,7 @@ with the same work, nothing found before carried over."""
 from __future__ import annotations
 
 import pickle
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -78,6 +79,48 @@ def test_auto_leaves_a_long_chain_to_the_numpy_carry_that_powers_its_cells():
     lowest = 2 * np.sqrt(k / m) * np.sin(np.pi / (2 * (2 * n + 1)))
     result = natural_frequencies(chain, count=3)
     assert np.allclose(2 * np.pi * result.frequencies_hz, lowest, rtol=1e-9)
+
+
+def test_kernels_pay_for_a_large_model_carried_element_by_element():
+    """"auto" loads the kernels for a model of KERNELS_PAY_FROM elements carried one at a
+    time (a beam weighs BEAM_WEIGHT): not for the launchers, nor for a long chain of equal
+    cells (powered by the numpy carry), but for a long cantilever and a chain of unequal
+    bodies."""
+    from builders import cantilever_of_beams, unequal_chain
+    from linmstmm.deduction import Deduction
+    from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM, kernels_pay
+    from linmstmm.topology import build_topology
+
+    def pays(model):
+        return kernels_pay(Deduction(build_topology(model)))
+
+    beams = -(-KERNELS_PAY_FROM // BEAM_WEIGHT)  # the fewest beams that weigh that much
+    assert not pays(load_model("models/mlrs/mlrs.toml")) and not pays(load_model("models/launcher2/launcher2.toml"))
+    assert not pays(spring_chain(3000))  # equal cells: the numpy carry powers them
+    assert not pays(cantilever_of_beams(beams - 1)) and pays(cantilever_of_beams(beams))
+    bodies = KERNELS_PAY_FROM // 2  # a body and a spring each
+    assert not pays(unequal_chain(bodies - 1)) and pays(unequal_chain(bodies))
+
+
+def test_auto_loads_the_kernels_for_a_large_model_in_a_new_process():
+    """In a new process "auto" solves a launcher by the numpy carry and a 200-element
+    cantilever by the kernels it loads for it; the frequencies are numpy's to rounding."""
+    import subprocess
+    import sys
+
+    code = (f"import sys, numpy as np; sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
+            "from builders import cantilever_of_beams\n"
+            "from linmstmm import load_model, natural_frequencies\n"
+            "from linmstmm.determinant import kernels_loaded\n"
+            "natural_frequencies(load_model('models/mlrs/mlrs.toml'), 10); print(kernels_loaded())\n"
+            "auto = natural_frequencies(cantilever_of_beams(200), 12); print(kernels_loaded())\n"
+            "plain = natural_frequencies(cantilever_of_beams(200), 12, engine='numpy')\n"
+            "print(np.abs(auto.frequencies_hz / plain.frequencies_hz - 1).max())\n")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    launcher, cantilever, difference = run.stdout.split()
+    assert (launcher, cantilever) == ("False", "True")
+    assert float(difference) < 1e-12
 
 
 def test_a_model_built_in_code_cannot_be_changed_under_its_compiled_solve():

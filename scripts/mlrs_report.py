@@ -70,7 +70,7 @@ MODES = 6           # mode shapes drawn, frequencies per scene
 TARGET = 1e-9       # accuracy of the timing comparison (max relative error)
 REFERENCE_DIGITS = 20
 REPEATS = 5         # best of, for the timing table
-SWEEP_REPEATS = 2   # best of, for the sweep timings
+SWEEP_REPEATS = 5   # best of, for the sweep timings (a busy spell of the shared machine inflates a run by 1.5-2x)
 DESCRIPTION_DRIFT = 5e-3  # a mode description is flagged when its frequency moved more
 
 #: What each of the first six modes does, written after looking at the figures
@@ -227,7 +227,7 @@ def sweeps(model, bundle, engine: str = "numpy"):
         cold_table = np.array([f for _, f in results[False]])
         out[label] = dict(results=results[True], fired=fired, warm_s=times[True], cold_s=times[False],
                           warm_vs_cold=float(np.max(np.abs(warm_table / cold_table - 1))))
-        log(f"sweep '{label}' ({engine}): warm {times[True]:.2f} s, cold {times[False]:.2f} s")
+        log(f"sweep '{label}' ({engine}): warm {times[True]:.3f} s, cold {times[False]:.3f} s")
     return out
 
 
@@ -663,8 +663,8 @@ def render(model, bundle, report, rows, mstmm, fe, reference_result, reference_s
     add("|---|---|---:|---:|---:|---:|---:|")
     for label, numpy_data in sweep_data.items():
         for engine, data in (("numpy (a new process)", numpy_data), ("compiled kernels", numpy_data["compiled"])):
-            add(f"| {label} | {engine} | {data['cold_s']:.2f} s | {data['warm_s']:.2f} s | "
-                f"{data['warm_s'] / 18 * 1e3:.0f} ms | {data['cold_s'] / data['warm_s']:.1f}× | "
+            add(f"| {label} | {engine} | {data['cold_s']:.3f} s | {data['warm_s']:.3f} s | "
+                f"{data['warm_s'] / 18 * 1e3:.1f} ms | {data['cold_s'] / data['warm_s']:.1f}× | "
                 f"{data['warm_vs_cold']:.1e} |")
     add("")
     step = np.max(np.abs(np.diff(fired, axis=0) / fired[:-1]))

@@ -66,8 +66,9 @@ from benchmarks.common import (  # noqa: E402
     spring_chain_reference_hz,
 )
 from linmstmm import deduction as deduction_module  # noqa: E402
-from linmstmm.compiled_model import forget_compiled_models  # noqa: E402
+from linmstmm.compiled_model import compiled_system, forget_compiled_models  # noqa: E402
 from linmstmm.deduction import Deduction  # noqa: E402
+from linmstmm.determinant import CompiledDeterminant  # noqa: E402
 from linmstmm.fe import fe_frequencies  # noqa: E402
 from linmstmm.label_layout import line_samples, place_label  # noqa: E402
 from linmstmm.model import load_model  # noqa: E402
@@ -317,7 +318,8 @@ def scaling(kind: str, sizes, count: int, fe_auto_max: int, quick: bool) -> list
                        solve_failure=f"{type(error).__name__}: {error}")
         else:
             row.update(solve=seconds, solve_cpu=cpu, solve_runs=runs,
-                       solve_error=max_relative_error(result.frequencies_hz, reference), precision=result.precision)
+                       solve_error=max_relative_error(result.frequencies_hz, reference), precision=result.precision,
+                       compiled=isinstance(compiled_system(model).determinant, CompiledDeterminant))
         fe_options = dict(elements_per_beam=1, estimate_error=False) if kind == "beam" else {}
         seconds, result, _, cpu = best_of(lambda: fe_frequencies(model, count, **fe_options), 3, 2.0)
         row.update(fe=seconds, fe_cpu=cpu, fe_error=max_relative_error(result.frequencies_hz, reference))
@@ -357,8 +359,11 @@ def plot_scaling(springs, beams, path: Path) -> None:
         left.plot(n, [r["det_single_cpu"] for r in rows], "s--", color=colour, alpha=0.7,
                   label=f"{name}: single frequency{slope(rows, 'det_single_cpu')}")
         failed = [f"{r['n']:,}" for r in rows if "solve_failure" in r]
+        compiled = [r["n"] for r in rows if r.get("compiled")]
         right.plot(n, [r["solve"] for r in rows], "o-", color=colour,
-                   label=f"{name}: MSTMM natural_frequencies{slope(rows, 'solve')}"
+                   label=f"{name}: MSTMM natural_frequencies"
+                         + (f"; compiled kernels from N = {min(compiled):,} (auto loads them)" if compiled
+                            else slope(rows, 'solve'))
                          + (f"; raised an error at N = {', '.join(failed)}" if failed else ""))
         right.plot(n, [r["build"] for r in rows], ":", color=colour, alpha=0.8,
                    label=f"{name}: of which topology + deduction build{slope(rows, 'build')}")
@@ -428,8 +433,10 @@ def certification_floor(model, rounds: int) -> dict:
 # 4. one MLRS solve, profiled
 
 def profile_solve(model) -> dict:
-    """cProfile of one natural_frequencies call, and how many Ū_all evaluations it made."""
-    natural_frequencies(model, COUNT)  # warm
+    """cProfile of one natural_frequencies call by the numpy carry (what a new process runs on
+    this model; the beam chains before have loaded the kernels, which "auto" would take), and
+    how many Ū_all evaluations it made."""
+    natural_frequencies(model, COUNT, engine="numpy")  # warm
     calls = {"real, stable": [0, 0], "complex (counting contour)": [0, 0], "real, plain": [0, 0]}
     original = deduction_module.Deduction.matrix
 
@@ -443,13 +450,13 @@ def profile_solve(model) -> dict:
     deduction_module.Deduction.matrix = counting
     try:
         forget_compiled_models()  # a first solve, its compilation included
-        natural_frequencies(model, COUNT)
+        natural_frequencies(model, COUNT, engine="numpy")
     finally:
         deduction_module.Deduction.matrix = original
     profiler = cProfile.Profile()
     forget_compiled_models()
     start = time.perf_counter()
-    profiler.runcall(natural_frequencies, model, COUNT)
+    profiler.runcall(natural_frequencies, model, COUNT, engine="numpy")
     total = time.perf_counter() - start
     stats = pstats.Stats(profiler, stream=io.StringIO())
     entries = []
@@ -965,7 +972,11 @@ def write_report(args, command, facts, loads, elapsed, beam_model, beam_referenc
       "the first 20, divided by 64, and for one frequency; `plain` = `stable=False`; determinant columns are CPU "
       "time (best of up to 9 runs), less disturbed by the other users' load than wall time (the fits give "
       "both: keys ending in `_cpu` are CPU time). Full solve = "
-      "`natural_frequencies(model, 20)` including the topology build. FE = `fe_frequencies(model, 20)`: exact "
+      "`natural_frequencies(model, 20)` including the topology build, by the numpy carry unless marked "
+      "*compiled*: with `engine=\"auto\"`, the default, a model of 400 or more elements carried one at a time "
+      "(each beam counted three times; `linmstmm.determinant.kernels_pay`) has the compiled kernels loaded for "
+      "it, so from the first such beam chain on this process solves by them, as a new process would solve that "
+      "chain. FE = `fe_frequencies(model, 20)`: exact "
       "for springs; for beam chains one element per beam (the same element count, but a coarse "
       f"discretisation: see its error), and the automatic refinement up to N = {args.fe_auto_max}.")
     w("")
@@ -988,13 +999,17 @@ def write_report(args, command, facts, loads, elapsed, beam_model, beam_referenc
                 extra = (f" {fmt_time(r['fe_auto'])} ({r['fe_auto_mesh']}/beam) | {fmt_error(r['fe_auto_error'])} |"
                          if "fe_auto" in r else " — | — |")
             w(f"| {r['n']:,} | {fmt_time(r['build'])} | {fmt_time(r['det_batch_cpu'])} | {fmt_time(r['det_single_cpu'])}"
-              f" | {fmt_time(r['det_batch_plain_cpu'])} | {fmt_time(r['solve'])} ({fmt_time(r['solve_cpu'])}) | "
+              f" | {fmt_time(r['det_batch_plain_cpu'])} | {fmt_time(r['solve'])} ({fmt_time(r['solve_cpu'])})"
+              f"{' compiled' if r.get('compiled') else ''} | "
               f"{fmt_error(r['solve_error'])} | {fmt_time(r['fe'])} | {fmt_error(r['fe_error'])} |" + extra)
         w("")
+        two_engines = any(r.get("compiled") for r in rows)  # the solve's rows: no one exponent
         fits = {key: exponent(rows, key) for key in ("det_batch_cpu", "det_single_cpu", "det_batch_plain_cpu",
-                                                      "det_batch", "det_single", "solve", "solve_cpu", "build", "fe")}
+                                                      "det_batch", "det_single", "solve", "solve_cpu", "build", "fe")
+                if not (two_engines and key.startswith("solve"))}
         w("Fitted exponents p (time ∝ N^p, least squares over N ≥ 100): "
-          + ", ".join(f"{key} {value:.2f}" for key, value in fits.items() if np.isfinite(value)) + ".")
+          + ", ".join(f"{key} {value:.2f}" for key, value in fits.items() if np.isfinite(value))
+          + (" (none for the solve, whose rows are by two engines)" if two_engines else "") + ".")
         w("")
     if args.max_chain < 10000:
         w(f"The spring–mass chains were capped at N = {args.max_chain} in this run (`--max-chain`).")
@@ -1004,7 +1019,8 @@ def write_report(args, command, facts, loads, elapsed, beam_model, beam_referenc
     w("## Where the time of one MLRS solve goes")
     w("")
     calls = profile["calls"]
-    w(f"One `natural_frequencies(mlrs, 10)` under cProfile: {profile['total']:.2f} s (profiling roughly "
+    w(f"One `natural_frequencies(mlrs, 10, engine=\"numpy\")` (what a new process runs on this model) under "
+      f"cProfile, a first solve: {profile['total']:.2f} s (profiling roughly "
       f"doubles the time of this Python-bound code; read the shares, not the seconds). Ū_all evaluations: "
       + "; ".join(f"{kind}: {c[0]} calls, {c[1]} frequencies" for kind, c in calls.items()) + ".")
     w("")

@@ -52,7 +52,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))
 
-from common import cantilever_reference  # noqa: E402
+from common import beam_chain_file, cantilever_reference  # noqa: E402
 from time_budget import time_budget  # noqa: E402
 
 from linmstmm import spread  # noqa: E402
@@ -363,6 +363,23 @@ def startup(command: list[str], rounds: int) -> float:
     return float(np.median(times[1:]))
 
 
+#: Beam elements of the cantilever whose new-process solve :func:`large_model_rows` times.
+LARGE_CANTILEVER = 1000
+
+
+def large_model_rows() -> list[str]:
+    """Rows of the new-process table: the first 20 frequencies of a cantilever of
+    LARGE_CANTILEVER beam elements (a model file written for it), by the default engine,
+    which loads the kernels for a model that large (linmstmm.determinant.kernels_pay),
+    and by the numpy carry; median of three processes each."""
+    with tempfile.TemporaryDirectory() as folder:
+        path = beam_chain_file(LARGE_CANTILEVER, Path(folder))
+        command = [sys.executable, "-m", "linmstmm", "freqs", str(path), "--count", "20", "--quiet"]
+        return [f"| `linmstmm freqs` on a cantilever of {LARGE_CANTILEVER:,} beam elements (a model file), "
+                f"first 20 (engine auto: the kernels loaded for a model that large) | {startup(command, 2):.2f} s |",
+                f"| the same with `--engine numpy` | {startup(command + ['--engine', 'numpy'], 2):.2f} s |"]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="counts 10 and 20 only, fewer rounds")
@@ -463,7 +480,8 @@ def main() -> None:
               f"{startup(command + ['--engine', 'compiled'], rounds):.2f} s |",
               *[f"| `linmstmm response {model} {loads}` (the bundled load case; BLAS threads as the "
                 f"machine sets them) | {startup([sys.executable, '-m', 'linmstmm', 'response', model, loads], rounds):.2f} s |"
-                for model, loads in RESPONSE_CASES], ""]
+                for model, loads in RESPONSE_CASES],
+              *large_model_rows(), ""]
     figure = draw(curves, out / "figures" / "speed_vs_fe.png")
     lines += [f"![time against the number of frequencies]({figure.relative_to(out).as_posix()})", "",
               "*Wall time against the number of frequencies asked for, both launcher models; "

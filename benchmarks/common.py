@@ -176,6 +176,23 @@ def beam_chain(n: int, length: float = 2.0) -> Model:
     return Model(f"beam chain N={n}", points, beams=beams, boundary={"p0": np.ones(6, dtype=bool)})
 
 
+def beam_chain_file(n: int, folder: Path, length: float = 2.0) -> Path:
+    """:func:`beam_chain` written as a model file ``folder``/beam_chain_<n>.toml, for a new
+    process's command to read (the same model, but for the rounding of the beams' lengths,
+    which the loader takes from the points)."""
+    s = BEAM_CHAIN_SECTION
+    lines = [f'name = "beam chain N={n}"', "", "[points]"]
+    lines += [f"p{i} = [{length * i / n!r}, 0.0, 0.0]" for i in range(n + 1)]
+    for i in range(n):
+        lines += ["", "[[beam]]", f'name = "b{i}"', f'ends = ["p{i}", "p{i + 1}"]',
+                  *(f"{key} = {value!r}" for key, value in (("E", STEEL["E"]), ("G", STEEL["G"]),
+                                                           ("rho", STEEL["rho"]), *s.items()))]
+    lines += ["", "[boundary]", 'p0 = "fixed"']
+    path = folder / f"beam_chain_{n}.toml"
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    return path
+
+
 def cantilever_reference(E, G, rho, A, Iy, Iz, J, Ip, L, tip_mass=0.0, count=10, dps=30):
     """Lowest ``count`` natural frequencies (Hz, mpf, ascending) of a uniform
     Euler–Bernoulli cantilever with a point tip mass (no rotary inertia).

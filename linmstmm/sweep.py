@@ -38,11 +38,13 @@ from functools import partial
 
 import numpy as np
 
-from linmstmm.determinant import resolved_engine
+from linmstmm.deduction import Deduction
+from linmstmm.determinant import kernels_pay, resolved_engine
 from linmstmm.model import Model, ModelError
 from linmstmm.parameters import get_value, parse_key, with_values
 from linmstmm.results import Result, decode_array, decode_arrays
 from linmstmm.sweep_runners import run_steps
+from linmstmm.topology import build_topology
 from linmstmm.tracking import SAME_MODE_MAC, length_scale, track
 from linmstmm.warm_starts import largest_difference, prediction_error, warm_starts
 
@@ -376,7 +378,9 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
         A tqdm bar on stderr (only when stderr is a terminal).
     engine : str
         How every step evaluates det Ū_all: "numpy", "compiled", or "auto"
-        (what this process has loaded, :func:`linmstmm.determinant.resolved_engine`;
+        (what this process has loaded, :func:`linmstmm.determinant.resolved_engine`,
+        and the kernels for a model large enough that they pay for their start-up,
+        :func:`linmstmm.determinant.kernels_pay`, as a solve of it would take them;
         the runners all use that engine).
     warm_start : bool
         Start each step's root search from the frequencies of its neighbour
@@ -401,7 +405,7 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
     steps = list(steps)
     shape = tuple(shape) if shape is not None else (len(steps),)
     _check_steps(steps, shape)
-    engine = resolved_engine(engine)
+    engine = _step_engine(model, engine)
     keys = [parse_key(model, text) for text in steps[0]]
     models = [_edited(model, keys, step) for step in steps]
     names = tuple(key.text for key in keys)
@@ -426,6 +430,16 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
         np.array([s.rigid_body_modes for s in solutions], dtype=int),
         {i: s.note for i, s in enumerate(solutions) if s.note}, time.perf_counter() - start, label,
         engine, warm_start)
+
+
+def _step_engine(model: Model, engine: str) -> str:
+    """"numpy" or "compiled": ``engine`` as this process resolves it, "auto" taking the
+    kernels for a model large enough (:func:`linmstmm.determinant.kernels_pay`), as
+    :func:`linmstmm.compiled_model.compiled_system` does for one solve."""
+    resolved = resolved_engine(engine)
+    if engine == "auto" and resolved == "numpy" and kernels_pay(Deduction(build_topology(model))):
+        return "compiled"
+    return resolved
 
 
 def _check_steps(steps: list, shape: tuple) -> None:

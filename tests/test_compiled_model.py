@@ -104,7 +104,8 @@ def test_kernels_pay_for_a_large_model_carried_element_by_element():
 
 def test_auto_loads_the_kernels_for_a_large_model_in_a_new_process():
     """In a new process "auto" solves a launcher by the numpy carry and a 200-element
-    cantilever by the kernels it loads for it; the frequencies are numpy's to rounding."""
+    cantilever by the kernels it loads for it (a sweep's steps likewise); the frequencies
+    are numpy's to rounding."""
     import subprocess
     import sys
 
@@ -112,14 +113,18 @@ def test_auto_loads_the_kernels_for_a_large_model_in_a_new_process():
             "from builders import cantilever_of_beams\n"
             "from linmstmm import load_model, natural_frequencies\n"
             "from linmstmm.determinant import kernels_loaded\n"
+            "from linmstmm.sweep import _step_engine\n"
             "natural_frequencies(load_model('models/mlrs/mlrs.toml'), 10); print(kernels_loaded())\n"
+            "print(_step_engine(load_model('models/mlrs/mlrs.toml'), 'auto'), "
+            "_step_engine(cantilever_of_beams(200), 'auto'))\n"
             "auto = natural_frequencies(cantilever_of_beams(200), 12); print(kernels_loaded())\n"
             "plain = natural_frequencies(cantilever_of_beams(200), 12, engine='numpy')\n"
             "print(np.abs(auto.frequencies_hz / plain.frequencies_hz - 1).max())\n")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr
-    launcher, cantilever, difference = run.stdout.split()
+    launcher, sweep_launcher, sweep_cantilever, cantilever, difference = run.stdout.split()
     assert (launcher, cantilever) == ("False", "True")
+    assert (sweep_launcher, sweep_cantilever) == ("numpy", "compiled")  # a sweep's steps follow the same rule
     assert float(difference) < 1e-12
 
 

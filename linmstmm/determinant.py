@@ -31,8 +31,10 @@ kernels' start-up has them loaded for it (:func:`kernels_pay`, asked by
 """
 from __future__ import annotations
 
+import os
 import sys
 import threading
+from pathlib import Path
 
 import numpy as np
 
@@ -98,16 +100,19 @@ def determinant(deduction: Deduction, engine: str = "auto"):
 
 #: Elements the numpy carry takes one at a time, each beam counted BEAM_WEIGHT times, from
 #: which ``engine="auto"`` loads the kernels in a process that has not (:func:`kernels_pay`).
-#: First 20 frequencies, one process, best of two, numpy against compiled (the kernels loaded
-#: already): chains of 100, 150, 200, 250 unequal bodies (twice the elements) 0.41/0.07,
-#: 0.60/0.12, 0.92/0.18, 1.33/0.22 s; cantilevers of 60, 100, 150, 200 beam elements
-#: 0.23/0.09, 0.52/0.26, 1.70/0.12, 2.18/0.16 s. A new process spends about 0.6 s more on
-#: the kernels' start-up and first calls (a 100-element cantilever: 0.81 s against 0.52 s by
-#: numpy; 300 elements 0.82 s against 2.6 s; 1,000 elements 1.3 s against 7.9 s): the
-#: numpy carry is as fast or faster up to about 400, the kernels 3 to 6 times beyond.
-KERNELS_PAY_FROM = 400
+#: Measured end to end, ``linmstmm freqs FILE`` in new processes, numpy against the kernels
+#: (cached), best of 5 to 11: cantilevers of 134, 300, 1,000 beam elements, first 10:
+#: 0.86/1.19, 1.75/1.56, 5.2/1.9 s; first 20: 1.73/1.41, 3.43/1.71, 7.2/2.0 s; first 3,
+#: 134 elements: 0.80/1.27 s; chains of 200, 250, 400 unequal bodies, first 20: 1.3/1.5,
+#: 1.5/1.4 s, and 1.13-1.17 times faster at 400. The kernels' start-up (0.5-1.1 s) outweighs
+#: the saving below a few hundred beams, the more so for few frequencies, and chains of
+#: bodies and springs gain little. At 1,500 the kernels are ahead at the command's ten
+#: frequencies (500 beam elements 1.54 against 2.68 s, 750 unequal bodies 2.04 against
+#: 2.77 s) and within 10 % behind at three (1.87/1.71, 1.97/1.90 s).
+KERNELS_PAY_FROM = 1500
 #: A beam's weight in that count: the numpy carry's cost of a beam element against a rigid
-#: body's or a spring's (the measurements above: about 2.5 to 3).
+#: body's or a spring's, taken low (in one process, first 20, 200 elements: a cantilever
+#: 2.18 s, a chain of 100 unequal bodies 0.41 s).
 BEAM_WEIGHT = 3
 
 
@@ -115,7 +120,9 @@ def kernels_pay(deduction: Deduction) -> bool:
     """True where loading the compiled kernels costs less than the numpy carry would take:
     at least KERNELS_PAY_FROM elements carried one at a time (each beam BEAM_WEIGHT times),
     the runs of a repeated cell, which the numpy carry powers, left out (they are looked
-    for only where the model has that many elements at all).
+    for only where the model has that many elements at all), and the kernels compiled on
+    this machine already (:func:`kernels_compiled`): a first compilation takes about a
+    minute, more than the numpy carry saves on one solve.
 
     Parameters
     ----------
@@ -131,7 +138,20 @@ def kernels_pay(deduction: Deduction) -> bool:
     if weight < KERNELS_PAY_FROM:
         return False
     powered = sum(len(run.cell) * run.repetitions for run in deduction.periodic_runs())  # never beams
-    return weight - powered >= KERNELS_PAY_FROM
+    return weight - powered >= KERNELS_PAY_FROM and kernels_compiled()
+
+
+def kernels_compiled() -> bool:
+    """Whether numba's cache holds the evaluation kernel for this Python (its index file,
+    ``_kernels.evaluate-<line>.py<version>.nbi``, in the package's ``__pycache__`` or under
+    NUMBA_CACHE_DIR), without importing numba: a run with the compiled engine leaves it.
+    An index written for an older source is taken too (the kernels are then compiled again,
+    announced); a cache numba keeps elsewhere is not found, and "auto" then stays on numpy."""
+    name = f"_kernels.evaluate-*.py{sys.version_info.major}{sys.version_info.minor}.nbi"
+    if any((Path(__file__).parent / "__pycache__").glob(name)):
+        return True
+    folder = os.environ.get("NUMBA_CACHE_DIR")
+    return bool(folder) and any(Path(folder).rglob(name))
 
 
 #: Transfer elements from which a model may be mostly repeated cells

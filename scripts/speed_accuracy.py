@@ -973,7 +973,7 @@ def write_report(args, command, facts, loads, elapsed, beam_model, beam_referenc
       "time (best of up to 9 runs), less disturbed by the other users' load than wall time (the fits give "
       "both: keys ending in `_cpu` are CPU time). Full solve = "
       "`natural_frequencies(model, 20)` including the topology build, by the numpy carry unless marked "
-      "*compiled*: with `engine=\"auto\"`, the default, a model of 400 or more elements carried one at a time "
+      "*compiled*: with `engine=\"auto\"`, the default, a model of 1,500 or more elements carried one at a time "
       "(each beam counted three times; `linmstmm.determinant.kernels_pay`) has the compiled kernels loaded for "
       "it, so from the first such beam chain on this process solves by them, as a new process would solve that "
       "chain. FE = `fe_frequencies(model, 20)`: exact "

@@ -82,14 +82,17 @@ def test_auto_leaves_a_long_chain_to_the_numpy_carry_that_powers_its_cells():
 
 
 def test_kernels_pay_for_a_large_model_carried_element_by_element():
-    """"auto" loads the kernels for a model of KERNELS_PAY_FROM elements carried one at a
-    time (a beam weighs BEAM_WEIGHT): not for the launchers, nor for a long chain of equal
-    cells (powered by the numpy carry), but for a long cantilever and a chain of unequal
-    bodies."""
+    """"auto" loads the kernels (compiled here already) for a model of KERNELS_PAY_FROM
+    elements carried one at a time (a beam weighs BEAM_WEIGHT): not for the launchers, nor
+    for a long chain of equal cells (powered by the numpy carry), but for a long cantilever
+    and a chain of unequal bodies."""
     from builders import cantilever_of_beams, unequal_chain
     from linmstmm.deduction import Deduction
-    from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM, kernels_pay
+    from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM, kernels_compiled, kernels_pay
     from linmstmm.topology import build_topology
+
+    natural_frequencies(load_model("models/mlrs/mlrs.toml"), 1, engine="compiled")  # compiled here, cached
+    assert kernels_compiled()
 
     def pays(model):
         return kernels_pay(Deduction(build_topology(model)))
@@ -103,11 +106,13 @@ def test_kernels_pay_for_a_large_model_carried_element_by_element():
 
 
 def test_auto_loads_the_kernels_for_a_large_model_in_a_new_process():
-    """In a new process "auto" solves a launcher by the numpy carry and a 200-element
-    cantilever by the kernels it loads for it (a sweep's steps likewise); the frequencies
-    are numpy's to rounding."""
+    """In a new process "auto" solves a launcher by the numpy carry and a 500-element
+    cantilever by the kernels (compiled on this machine) it loads for it (a sweep's steps
+    likewise); the frequencies are numpy's to rounding."""
     import subprocess
     import sys
+
+    natural_frequencies(load_model("models/mlrs/mlrs.toml"), 1, engine="compiled")  # compiled here, cached
 
     code = (f"import sys, numpy as np; sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
             "from builders import cantilever_of_beams\n"
@@ -116,9 +121,9 @@ def test_auto_loads_the_kernels_for_a_large_model_in_a_new_process():
             "from linmstmm.sweep import _step_engine\n"
             "natural_frequencies(load_model('models/mlrs/mlrs.toml'), 10); print(kernels_loaded())\n"
             "print(_step_engine(load_model('models/mlrs/mlrs.toml'), 'auto'), "
-            "_step_engine(cantilever_of_beams(200), 'auto'))\n"
-            "auto = natural_frequencies(cantilever_of_beams(200), 12); print(kernels_loaded())\n"
-            "plain = natural_frequencies(cantilever_of_beams(200), 12, engine='numpy')\n"
+            "_step_engine(cantilever_of_beams(500), 'auto'))\n"
+            "auto = natural_frequencies(cantilever_of_beams(500), 6); print(kernels_loaded())\n"
+            "plain = natural_frequencies(cantilever_of_beams(500), 6, engine='numpy')\n"
             "print(np.abs(auto.frequencies_hz / plain.frequencies_hz - 1).max())\n")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr

@@ -108,7 +108,7 @@ def determinant(deduction: Deduction, engine: str = "auto"):
 #: the saving below a few hundred beams, the more so for few frequencies, and chains of
 #: bodies and springs gain little. At 1,500 the kernels are ahead at the command's ten
 #: frequencies (500 beam elements 1.54 against 2.68 s, 750 unequal bodies 2.04 against
-#: 2.77 s) and within 10 % behind at three (1.87/1.71, 1.97/1.90 s).
+#: 2.77 s) and within 10 % behind at three (numpy 1.71 and 1.90 s, the kernels 1.87 and 1.97 s).
 KERNELS_PAY_FROM = 1500
 #: A beam's weight in that count: the numpy carry's cost of a beam element against a rigid
 #: body's or a spring's, taken low (in one process, first 20, 200 elements: a cantilever

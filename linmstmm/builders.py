@@ -51,10 +51,11 @@ def beam_axes(a, b, y_hint=None) -> np.ndarray:
         Where ``y_hint`` is zero or parallel to the beam.
     """
     along = np.asarray(b, float) - np.asarray(a, float)
-    if y_hint is not None and (size := norm3(np.asarray(y_hint, float))) > 0:
+    hint = None if y_hint is None else np.asarray(y_hint, float)
+    if hint is not None and (size := norm3(hint)) > 0:
         # unit length first: the same direction, and the frames built so far to the bit (tests pin them)
-        y_hint = np.asarray(y_hint, float) / size
-    return local_axes(along / norm3(along), y_hint)
+        hint = hint / size
+    return local_axes(along / norm3(along), hint)
 
 
 def make_beam(name, a, b, points, A=1e-3, Iy=2e-7, Iz=2e-7, J=4e-7, Ip=None, y_hint=None,

@@ -286,8 +286,8 @@ class SweepResult(Result):
     notes: dict
     seconds: float
     workers: str
-    engine: str = ENGINE
-    warm_start: bool = False
+    engine: str
+    warm_start: bool
 
     kind = "sweep"
 
@@ -328,7 +328,7 @@ class SweepResult(Result):
                    decode_array(data["tracking_mac"], ndim=2),
                    decode_arrays(data.get("sensitivity_hz_per_unit", {}), ndim=2),
                    decode_array(data["rigid_body_modes"], int), {int(step): note for step, note in data["notes"].items()},
-                   data["seconds"], data["workers"])
+                   data["seconds"], data["workers"], data["engine"], data["warm_start"])
 
     def plot(self, log_x: bool = False):
         """The tracked frequencies against the first varied key (:func:`linmstmm.plot.sweep_figure`):

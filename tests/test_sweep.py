@@ -25,7 +25,7 @@ from linmstmm.determinant import load_kernels
 from linmstmm.model import ModelError, load_model
 from linmstmm.parameters import get_value, parameter_keys, parse_key, with_values
 from linmstmm.solve import natural_frequencies
-from linmstmm.sweep import Vary, grid, neighbours, sweep
+from linmstmm.sweep import SweepResult, Vary, grid, neighbours, sweep
 
 REPO = Path(__file__).resolve().parents[1]
 CHAIN = REPO / "models" / "spring_mass_chain.toml"
@@ -309,6 +309,8 @@ def test_compiled_engine_and_warm_starts_give_freqs_to_rounding_whoever_runs_the
         {k: v for k, v in outputs[1].items() if k not in ("seconds", "workers")}
     np.testing.assert_allclose(outputs[0]["frequencies_hz_by_rank"], reference(CHAIN, steps, 4, tmp_path),
                                rtol=1e-12)
+    loaded = SweepResult.from_dict(outputs[0])  # how it ran is kept too
+    assert (loaded.engine, loaded.warm_start) == ("compiled", True)
 
 
 def test_a_study_without_tracking_gives_the_same_frequencies_by_rank():

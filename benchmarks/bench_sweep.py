@@ -15,8 +15,10 @@ the top) and ``OUT/figures/sweep_launcher.png``. Not part of the test suite.
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import shlex
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -24,15 +26,20 @@ from pathlib import Path
 import numpy as np
 from common import REPO, machine_facts
 
+from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM, carried_weight
 from linmstmm.model import load_model
 from linmstmm.sweep import Vary, grid, sweep
+from linmstmm.topology import build_topology
 
 MODEL = REPO / "models" / "mlrs" / "mlrs.toml"
 #: (key, tuned value in the model file); each swept from value/5 to value*5.
 PARAMETERS = (("spring.elevation.k[4]", 2.5e7), ("spring.bearing.k[5]", 3.0e7))
 SPAN = 5.0
-#: The engines measured, the sweep's default first.
+#: The engines measured: what a new process runs a short sweep of the launcher with, then the kernels.
 ENGINES = ("numpy", "compiled")
+#: Steps of the command-line sweeps (one range of ``spring.elevation.k[4]``) timed in new
+#: processes, by each engine and by the default "auto", to show where "auto" takes the kernels.
+COMMAND_STEPS = (20, 45, 100, 400)
 #: (label, sweep options) of the runs of each engine; the cold ones must agree bitwise.
 RUNS = (("serial", {}), ("2 processes", {"workers": 2}),
         ("dask LocalCluster, 2 workers", {"dask": "local", "workers": 2}),
@@ -67,7 +74,9 @@ def main() -> None:
     (out / "figures").mkdir(parents=True, exist_ok=True)
     figure = out / "figures" / "sweep_launcher.png"
     plot(results[0], varies, figure)
-    write_report(out / "sweep.md", command, results[0], runs, (identical, np.nanmax(differences)), varies)
+    commands = command_timings(args.count)
+    write_report(out / "sweep.md", command, results[0], runs, (identical, np.nanmax(differences)), varies,
+                 commands)
     print(f"wrote {out}/sweep.md and {figure}; runs identical: {identical}")
 
 
@@ -77,8 +86,30 @@ def _same(a, b) -> bool:
             and np.array_equal(a.order, b.order))
 
 
-def write_report(path, command, result, runs, agreement, varies) -> None:
-    """The Markdown report: setup, throughput, identity of the runs, what tracking did.
+def command_timings(count: int, rounds: int = 2) -> dict:
+    """(steps, engine) -> (best wall time s of ``rounds``, the engine the sweep reported):
+    ``linmstmm sweep`` of the launcher over COMMAND_STEPS steps of one range, each in a new
+    process (start-up, loading and kernels included), by "auto", "numpy" and "compiled",
+    taken in turn in each round."""
+    timings = {}
+    for _ in range(rounds):
+        for steps in COMMAND_STEPS:
+            low, high = PARAMETERS[0][1] / SPAN, PARAMETERS[0][1] * SPAN
+            for engine in ("auto", *ENGINES):
+                start = time.perf_counter()
+                run = subprocess.run([sys.executable, "-m", "linmstmm", "sweep", str(MODEL), "--vary",
+                                      f"{PARAMETERS[0][0]}={low}:{high}:{steps}:log", "--count", str(count),
+                                      "--engine", engine, "--json"], capture_output=True, text=True, check=True)
+                seconds = time.perf_counter() - start
+                best = min(seconds, timings.get((steps, engine), (np.inf, ""))[0])
+                timings[steps, engine] = (best, json.loads(run.stdout)["engine"])
+                print(f"command, {steps} steps, {engine}: {seconds:.2f} s", flush=True)
+    return timings
+
+
+def write_report(path, command, result, runs, agreement, varies, commands) -> None:
+    """The Markdown report: setup, throughput, identity of the runs, what the default engine
+    picks (``commands``, :func:`command_timings`), what tracking did.
 
     runs : (runner, engine) -> (SweepResult, wall time s); agreement : (whether the runs of
     each engine are bitwise identical, largest relative difference between the engines)."""
@@ -99,10 +130,11 @@ def write_report(path, command, result, runs, agreement, varies) -> None:
         + "; ".join(f"`{v.key}` {v.start:.3g} … {v.stop:.3g}" for v in varies)
         + f". Lowest {result.order.shape[1]} elastic frequencies per step; each step is one "
         "`mode_shapes` solve (its frequencies are those of `natural_frequencies`; its shapes serve "
-        "the MAC tracking), from a cold start. Engines: `numpy` (the default: the bits of "
-        "`linmstmm freqs`) and `compiled` (the numba kernels, loaded in every process that runs "
-        "steps: the time includes that); the last run of each starts every step from its "
-        "neighbour's frequencies (`warm_start=True`).",
+        "the MAC tracking), from a cold start. Engines: `numpy` (the bits of `linmstmm freqs` in a "
+        "new process) and `compiled` (the numba kernels, loaded in every process that runs "
+        "steps: the time includes that; what the default `auto` takes for a sweep this long, "
+        "below); the last run of each starts every step from its neighbour's frequencies "
+        "(`warm_start=True`).",
         "",
         "| run | engine | wall time | solves per second | speed-up over serial numpy |",
         "|---|---|---:|---:|---:|",
@@ -122,6 +154,25 @@ def write_report(path, command, result, runs, agreement, varies) -> None:
          f"and between warm and cold starts, the frequencies differ by at most {difference:.1e} "
          "(relative): rounding. A warm start begins each step's root search at the frequencies of "
          "the step it is tracked from, so a step waits for that one: serial only here."),
+        "",
+        "## What the default engine picks",
+        "",
+        ("`engine=\"auto\"` (the default of `sweep` and of the command) loads the compiled kernels "
+         "where the sweep's steps together carry at least "
+         f"{KERNELS_PAY_FROM:,} elements one at a time, each beam counted {BEAM_WEIGHT} times "
+         "(`linmstmm.determinant.kernels_pay`; the launcher counts "
+         f"{launcher_weight()}, so from {-(-KERNELS_PAY_FROM // launcher_weight())} steps), "
+         "and they are compiled on the machine; else the numpy carry. "
+         "`linmstmm sweep` of the launcher over one range of "
+         f"`{PARAMETERS[0][0]}`, lowest {result.order.shape[1]}, each run a new process "
+         "(start-up, loading and the kernels' start-up included), best of 2; in brackets the "
+         "engine the sweep reported:"),
+        "",
+        "| steps | auto (the default) | numpy | compiled |",
+        "|---:|---:|---:|---:|",
+        *(f"| {steps} | {commands[steps, 'auto'][0]:.2f} s ({commands[steps, 'auto'][1]}) | "
+          f"{commands[steps, 'numpy'][0]:.2f} s | {commands[steps, 'compiled'][0]:.2f} s |"
+          for steps in COMMAND_STEPS),
         "",
         "## What tracking did",
         "",
@@ -148,6 +199,12 @@ def write_report(path, command, result, runs, agreement, varies) -> None:
     lines += ["", "![tracked frequencies over the grid](figures/sweep_launcher.png)", ""]
     with open(path, "w") as stream:
         stream.write("\n".join(lines))
+
+
+def launcher_weight() -> int:
+    """The launcher's elements carried one at a time, each beam BEAM_WEIGHT times, as
+    :func:`linmstmm.determinant.kernels_pay` counts them."""
+    return carried_weight(build_topology(load_model(MODEL)))
 
 
 def plot(result, varies, path) -> None:

@@ -109,6 +109,9 @@ def determinant(deduction: Deduction, engine: str = "auto"):
 #: bodies and springs gain little. At 1,500 the kernels are ahead at the command's ten
 #: frequencies (500 beam elements 1.54 against 2.68 s, 750 unequal bodies 2.04 against
 #: 2.77 s) and within 10 % behind at three (numpy 1.71 and 1.90 s, the kernels 1.87 and 1.97 s).
+#: A sweep counts its steps together (``solves``): ``linmstmm sweep`` of the launcher (34),
+#: five modes per step, numpy against the kernels: 25 steps 1.50/2.02 s, 50 steps 2.14/2.40 s,
+#: 100 steps 3.51/2.97 s (they break even near 60 steps; the rule takes the kernels from 45).
 KERNELS_PAY_FROM = 1500
 #: A beam's weight in that count: the numpy carry's cost of a beam element against a rigid
 #: body's or a spring's, taken low (in one process, first 20, 200 elements: a cantilever
@@ -116,29 +119,38 @@ KERNELS_PAY_FROM = 1500
 BEAM_WEIGHT = 3
 
 
-def kernels_pay(deduction: Deduction) -> bool:
+def kernels_pay(deduction: Deduction, solves: int = 1) -> bool:
     """True where loading the compiled kernels costs less than the numpy carry would take:
-    at least KERNELS_PAY_FROM elements carried one at a time (each beam BEAM_WEIGHT times),
-    the runs of a repeated cell, which the numpy carry powers, left out (they are looked
-    for only where the model has that many elements at all), and the kernels compiled on
-    this machine already (:func:`kernels_compiled`): a first compilation takes about a
-    minute, more than the numpy carry saves on one solve.
+    at least KERNELS_PAY_FROM elements carried one at a time (each beam BEAM_WEIGHT times)
+    over ``solves`` solves of models like this one, the runs of a repeated cell, which the
+    numpy carry powers, left out (they are looked for only where the solves carry that
+    many elements at all), and the kernels compiled on this machine already
+    (:func:`kernels_compiled`): a first compilation takes about a minute, more than the
+    numpy carry saves on one solve.
 
     Parameters
     ----------
     deduction : Deduction
         The model's deduction.
+    solves : int
+        Solves of models of this structure the kernels would serve (a sweep's steps).
 
     Returns
     -------
     bool
     """
-    elements = [deduction.topology.elements[e] for e in deduction.topology.order]
-    weight = sum(BEAM_WEIGHT if element.kind == "beam" else 1 for element in elements)
-    if weight < KERNELS_PAY_FROM:
+    weight = carried_weight(deduction.topology)
+    if weight * solves < KERNELS_PAY_FROM:
         return False
     powered = sum(len(run.cell) * run.repetitions for run in deduction.periodic_runs())  # never beams
-    return weight - powered >= KERNELS_PAY_FROM and kernels_compiled()
+    return (weight - powered) * solves >= KERNELS_PAY_FROM and kernels_compiled()
+
+
+def carried_weight(topology) -> int:
+    """The elements of ``topology`` (:class:`~linmstmm.topology.Topology`) in the carry
+    order, each beam counted BEAM_WEIGHT times: the measure of the numpy carry's work
+    that :func:`kernels_pay` holds against KERNELS_PAY_FROM."""
+    return sum(BEAM_WEIGHT if topology.elements[e].kind == "beam" else 1 for e in topology.order)
 
 
 def kernels_compiled() -> bool:

@@ -234,7 +234,8 @@ def fit(model: Model, measured: Measured, bounds, engine: str = ENGINE) -> FitRe
     bounds : sequence of Bounds
         The fitted keys and their ranges (SI); the model's value of each must lie inside.
     engine : str
-        How det Ū_all is evaluated ("numpy", "compiled" or "auto").
+        How det Ū_all is evaluated ("numpy", "compiled" or "auto": at each solve as
+        :func:`~linmstmm.solve.natural_frequencies` resolves it).
 
     Returns
     -------

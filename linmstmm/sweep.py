@@ -7,14 +7,16 @@ scenes of :mod:`linmstmm.scenes` are another list of steps. Each step is an
 edited copy of the model, solved once by :func:`~linmstmm.modes.mode_shapes`
 (its frequencies are those of :func:`~linmstmm.solve.natural_frequencies` to
 the last digit; its shapes serve the tracking and the sensitivities of
-:mod:`linmstmm.sensitivity`). By default with the numpy engine
-(:data:`ENGINE`) and from a cold start, so that every row is exactly what
-``linmstmm freqs`` gives on the edited model, whatever runs the steps.
+:mod:`linmstmm.sensitivity`). By default from a cold start, with the engine
+"auto" resolved once, in the calling process, for the whole sweep (:data:`ENGINE`):
+every runner then uses that engine, and every row is exactly what
+``natural_frequencies(edited model, engine=result.engine)`` gives, whatever runs
+the steps. A short sweep of a launcher-size model runs on the numpy carry, as
+``linmstmm freqs`` does in a new process; a long one loads the compiled kernels
+(:func:`~linmstmm.determinant.kernels_pay`, counting the steps).
 
-Options that trade those bits (the roots agree to rounding) for speed:
-``engine="compiled"`` evaluates det Ū_all by the compiled kernels in every
-process that runs steps ("auto" is resolved once, in the calling process, so
-every runner uses the same engine); ``warm_start`` starts each step's root
+An option that trades the bits of a cold start (the roots agree to rounding) for
+speed: ``warm_start`` starts each step's root
 search from the frequencies of its neighbour in the grid (below) where they
 are the better starts, else from the step's own coarse predictions
 (:mod:`linmstmm.warm_starts`), so a step waits for its neighbour and the
@@ -48,10 +50,10 @@ from linmstmm.topology import build_topology
 from linmstmm.tracking import SAME_MODE_MAC, length_scale, track
 from linmstmm.warm_starts import largest_difference, prediction_error, warm_starts
 
-#: How every step evaluates det Ū_all unless told: the engine ``linmstmm freqs`` uses in a
-#: new process. Not "auto" (which follows what this process has loaded), so that a step
-#: gives the same bits in this process, in a fresh worker process and on a cluster.
-ENGINE = "numpy"
+#: How every step evaluates det Ū_all unless told: "auto", resolved once in the calling
+#: process (:func:`_step_engine`), so that a step gives the same bits in this process, in a
+#: fresh worker process and on a cluster.
+ENGINE = "auto"
 #: Stations along each beam for the mode shapes of a step: its ends (a step's shapes are
 #: read at the points; the points' displacements do not depend on the stations).
 SHAPE_STATIONS = 2
@@ -379,8 +381,8 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
     engine : str
         How every step evaluates det Ū_all: "numpy", "compiled", or "auto"
         (what this process has loaded, :func:`linmstmm.determinant.resolved_engine`,
-        and the kernels for a model large enough that they pay for their start-up,
-        :func:`linmstmm.determinant.kernels_pay`, as a solve of it would take them;
+        and the kernels where the sweep's steps together carry enough elements that
+        they pay for their start-up, :func:`linmstmm.determinant.kernels_pay`;
         the runners all use that engine).
     warm_start : bool
         Start each step's root search from the frequencies of its neighbour
@@ -405,7 +407,7 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
     steps = list(steps)
     shape = tuple(shape) if shape is not None else (len(steps),)
     _check_steps(steps, shape)
-    engine = _step_engine(model, engine)
+    engine = _step_engine(model, engine, len(steps))
     keys = [parse_key(model, text) for text in steps[0]]
     models = [_edited(model, keys, step) for step in steps]
     names = tuple(key.text for key in keys)
@@ -432,12 +434,13 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
         engine, warm_start)
 
 
-def _step_engine(model: Model, engine: str) -> str:
+def _step_engine(model: Model, engine: str, steps: int) -> str:
     """"numpy" or "compiled": ``engine`` as this process resolves it, "auto" taking the
-    kernels for a model large enough (:func:`linmstmm.determinant.kernels_pay`), as
+    kernels where ``steps`` solves of ``model`` carry elements enough
+    (:func:`linmstmm.determinant.kernels_pay`), as
     :func:`linmstmm.compiled_model.compiled_system` does for one solve."""
     resolved = resolved_engine(engine)
-    if engine == "auto" and resolved == "numpy" and kernels_pay(Deduction(build_topology(model))):
+    if engine == "auto" and resolved == "numpy" and kernels_pay(Deduction(build_topology(model)), steps):
         return "compiled"
     return resolved
 

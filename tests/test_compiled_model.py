@@ -105,6 +105,23 @@ def test_kernels_pay_for_a_large_model_carried_element_by_element():
     assert not pays(unequal_chain(bodies - 1)) and pays(unequal_chain(bodies))
 
 
+def test_kernels_pay_for_a_sweep_of_a_small_model_long_enough():
+    """A sweep's steps count together: the launcher (30 elements, two of them beams) pays
+    for the kernels from the step where its weight times the steps reaches KERNELS_PAY_FROM."""
+    from linmstmm.deduction import Deduction
+    from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM, carried_weight, kernels_pay
+    from linmstmm.topology import build_topology
+
+    natural_frequencies(load_model("models/mlrs/mlrs.toml"), 1, engine="compiled")  # compiled here, cached
+    deduction = Deduction(build_topology(load_model("models/mlrs/mlrs.toml")))
+    weight = carried_weight(deduction.topology)
+    assert weight == 28 + 2 * BEAM_WEIGHT
+    steps = -(-KERNELS_PAY_FROM // weight)
+    assert not kernels_pay(deduction, steps - 1) and kernels_pay(deduction, steps)
+    equal_cells = Deduction(build_topology(spring_chain(3000)))  # powered by the numpy carry, however often
+    assert not kernels_pay(equal_cells, 1000)
+
+
 def test_auto_loads_the_kernels_for_a_large_model_in_a_new_process():
     """In a new process "auto" solves a launcher by the numpy carry and a 500-element
     cantilever by the kernels (compiled on this machine) it loads for it (a sweep's steps
@@ -120,16 +137,18 @@ def test_auto_loads_the_kernels_for_a_large_model_in_a_new_process():
             "from linmstmm.determinant import kernels_loaded\n"
             "from linmstmm.sweep import _step_engine\n"
             "natural_frequencies(load_model('models/mlrs/mlrs.toml'), 10); print(kernels_loaded())\n"
-            "print(_step_engine(load_model('models/mlrs/mlrs.toml'), 'auto'), "
-            "_step_engine(cantilever_of_beams(500), 'auto'))\n"
+            "print(_step_engine(load_model('models/mlrs/mlrs.toml'), 'auto', 1), "
+            "_step_engine(load_model('models/mlrs/mlrs.toml'), 'auto', 1000), "
+            "_step_engine(cantilever_of_beams(500), 'auto', 1))\n"
             "auto = natural_frequencies(cantilever_of_beams(500), 6); print(kernels_loaded())\n"
             "plain = natural_frequencies(cantilever_of_beams(500), 6, engine='numpy')\n"
             "print(np.abs(auto.frequencies_hz / plain.frequencies_hz - 1).max())\n")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr
-    launcher, sweep_launcher, sweep_cantilever, cantilever, difference = run.stdout.split()
+    launcher, sweep_launcher, long_sweep_launcher, sweep_cantilever, cantilever, difference = run.stdout.split()
     assert (launcher, cantilever) == ("False", "True")
-    assert (sweep_launcher, sweep_cantilever) == ("numpy", "compiled")  # a sweep's steps follow the same rule
+    # a sweep's steps follow the same rule, counted together
+    assert (sweep_launcher, long_sweep_launcher, sweep_cantilever) == ("numpy", "compiled", "compiled")
     assert float(difference) < 1e-12
 
 

@@ -79,12 +79,12 @@ def edited_file(path, edits: dict, folder) -> Path:
     return out
 
 
-def reference(path, steps, count, folder) -> np.ndarray:
-    """(steps, count) frequencies of ``natural_frequencies`` on each edited file, with the
-    engine ``linmstmm freqs`` uses in a new process (numpy; "auto" would take the compiled
-    kernels once another test has loaded them, equal to rounding only)."""
+def reference(path, steps, count, folder, engine) -> np.ndarray:
+    """(steps, count) frequencies of ``natural_frequencies`` on each edited file by ``engine``,
+    the one the sweep reports it resolved "auto" to (the compiled kernels once another test
+    has loaded them: the engines agree to rounding only)."""
     return np.array([natural_frequencies(load_model(edited_file(path, step, folder)), count=count,
-                                         engine="numpy").frequencies_hz for step in steps])
+                                         engine=engine).frequencies_hz for step in steps])
 
 
 def run_cli(*argv) -> tuple[int, str, str]:
@@ -173,15 +173,16 @@ def test_ranges_grid_and_zip():
 def test_chain_grid_equals_freqs_on_the_edited_files(tmp_path):
     steps, shape = grid([Vary.parse("rigid.m2.mass=1.5:3:2"), Vary.parse("spring.k3.k[1]=600:1500:2:log")])
     result = sweep(load_model(CHAIN), steps, count=4, shape=shape)
-    np.testing.assert_array_equal(result.frequencies_hz_by_rank, reference(CHAIN, steps, 4, tmp_path))
+    np.testing.assert_array_equal(result.frequencies_hz_by_rank, reference(CHAIN, steps, 4, tmp_path, result.engine))
     assert (np.sort(result.frequencies_hz, axis=1) == result.frequencies_hz_by_rank).all()
 
 
 def test_launcher_equals_freqs_serial_two_processes_and_dask(tmp_path):
-    """With the compiled kernels loaded here (as after other tests), and not in the workers."""
+    """With the compiled kernels loaded here (as after other tests) "auto" resolves to them
+    here, and every runner, in its own processes too, uses them: the same bits."""
     load_kernels()
     steps, _ = grid([Vary.parse("spring.elevation.k[4]=1e7:6e7:3:log"), Vary.parse("beam.tube_aft.E=1.9e11:2.1e11:1")])
-    expected = reference(MLRS, steps, 3, tmp_path)
+    expected = reference(MLRS, steps, 3, tmp_path, "compiled")
     varies = ["--vary", "spring.elevation.k[4]=1e7:6e7:3:log", "--vary", "beam.tube_aft.E=1.9e11:2.1e11:1"]
     outputs = []
     for runner in (["--workers", "1"], ["--workers", "2"], ["--dask", "local"]):
@@ -190,6 +191,7 @@ def test_launcher_equals_freqs_serial_two_processes_and_dask(tmp_path):
         assert "%|" not in err  # no progress bar on a stderr that is not a terminal
         assert err == "" or runner[0] == "--dask", err  # dask may log what the cluster does
         data = json.loads(out)
+        assert data["engine"] == "compiled"
         np.testing.assert_array_equal(data["frequencies_hz_by_rank"], expected)
         assert data["values"] == [list(s.values()) for s in steps]
         outputs.append({k: v for k, v in data.items() if k not in ("seconds", "workers")})
@@ -200,7 +202,7 @@ def test_a_moved_point_carries_its_beam_as_the_edited_file_does(tmp_path):
     """The muzzle raised and lowered: the overhanging tube beam takes the new length and axis."""
     steps, shape = grid([Vary.parse("points.muzzle[2]=3.40:3.55:2")])
     result = sweep(load_model(MLRS), steps, count=3, shape=shape)
-    np.testing.assert_array_equal(result.frequencies_hz_by_rank, reference(MLRS, steps, 3, tmp_path))
+    np.testing.assert_array_equal(result.frequencies_hz_by_rank, reference(MLRS, steps, 3, tmp_path, result.engine))
 
 
 def test_a_dask_client_gives_the_serial_result():
@@ -307,7 +309,7 @@ def test_compiled_engine_and_warm_starts_give_freqs_to_rounding_whoever_runs_the
     assert outputs[0]["engine"] == "compiled" and outputs[0]["warm_start"] is True
     assert {k: v for k, v in outputs[0].items() if k not in ("seconds", "workers")} == \
         {k: v for k, v in outputs[1].items() if k not in ("seconds", "workers")}
-    np.testing.assert_allclose(outputs[0]["frequencies_hz_by_rank"], reference(CHAIN, steps, 4, tmp_path),
+    np.testing.assert_allclose(outputs[0]["frequencies_hz_by_rank"], reference(CHAIN, steps, 4, tmp_path, "numpy"),
                                rtol=1e-12)
     loaded = SweepResult.from_dict(outputs[0])  # how it ran is kept too
     assert (loaded.engine, loaded.warm_start) == ("compiled", True)

@@ -208,6 +208,9 @@ class EvaluationCount:
 class NumpyDeterminant(EvaluationCount):
     """det Ū_all by the numpy carry of ``deduction`` (stable: orthonormalised)."""
 
+    #: The engine this is (:data:`ENGINES`), as results report it.
+    engine = "numpy"
+
     def __init__(self, deduction: Deduction):
         super().__init__()
         self.deduction = deduction
@@ -236,6 +239,9 @@ class CompiledDeterminant(EvaluationCount):
     numba is imported, and the kernels compiled or loaded from their cache, on
     the first evaluation.
     """
+
+    #: The engine this is (:data:`ENGINES`), as results report it.
+    engine = "compiled"
 
     def __init__(self, deduction: Deduction):
         super().__init__()

@@ -94,6 +94,8 @@ class ModalResult(Result):
     without_translation : (n,) bool, the modes without translation (a pure
         rotation); with "max" they are scaled to a largest rotation of 1 rad, so
         their modal mass is a moment of inertia (``modal_mass_units``).
+    engine : "numpy" or "compiled": what evaluated det Ū_all and the Ū_all whose null
+        spaces give the shapes ("auto" resolved).
     """
 
     model: str
@@ -112,6 +114,7 @@ class ModalResult(Result):
     normalization: str
     note: str = ""
     without_translation: np.ndarray | None = None
+    engine: str = "numpy"
 
     kind = "modes"
 
@@ -224,6 +227,7 @@ class ModalResult(Result):
             "omega": self.omega.tolist(),
             "rigid_body_modes": self.rigid_body_modes,
             "normalization": self.normalization,
+            "engine": self.engine,
             **({"note": self.note} if self.note else {}),
             "modal_mass": self.modal_mass.tolist(),
             "modal_stiffness": self.modal_stiffness.tolist(),
@@ -261,7 +265,7 @@ class ModalResult(Result):
                    decode_arrays(data["com_displacements"], ndim=2), fields, data["normalization"],
                    data.get("note", ""),
                    np.array([unit == "kg m^2" for unit in data["modal_mass_units"]], bool)
-                   if "modal_mass_units" in data else None)
+                   if "modal_mass_units" in data else None, data["engine"])
 
     def plot(self, model: Model, mode: int = 0):
         """One mode drawn over the undeformed ``model`` (:func:`linmstmm.plot.mode_shape_figure`).
@@ -405,7 +409,7 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
         {beam.name: BeamField(raw.stations[beam.name], _station_positions(model, beam, raw),
                               fields.station_states[beam.name][..., :6])
          for beam in model.beams},
-        normalization, note, without_translation)
+        normalization, note, without_translation, finder.determinant.engine)
 
 
 def _accuracy_note(omega: np.ndarray, mass: np.ndarray, stiffness: np.ndarray) -> str:

@@ -42,6 +42,8 @@ class FrequencyResult(Result):
     circular frequencies (rad/s) as decimal strings at that precision (mpmath only).
     evaluations : float64 evaluations of det Ū_all (one per frequency) the
     search and its certifying counts took.
+    engine : "numpy" or "compiled": what evaluated det Ū_all in float64 ("auto"
+    resolved; :func:`linmstmm.determinant.determinant`).
     """
 
     model: str
@@ -55,6 +57,7 @@ class FrequencyResult(Result):
     frequencies_text: list | None = None
     omegas_text: list | None = None
     evaluations: int = 0
+    engine: str = "numpy"
 
     kind = "freqs"
 
@@ -65,8 +68,8 @@ class FrequencyResult(Result):
         -------
         dict
             JSON-ready: ``model``, ``frequencies_hz``, ``rigid_body_modes``, ``ubar_order``,
-            ``seconds``, ``precision``, ``method``, ``indeterminate_released``, ``evaluations``
-            and, when set, ``note``, ``frequencies_hz_text``, ``omega_rad_s_text``.
+            ``seconds``, ``precision``, ``method``, ``indeterminate_released``, ``evaluations``,
+            ``engine`` and, when set, ``note``, ``frequencies_hz_text``, ``omega_rad_s_text``.
         """
         return {
             "model": self.model,
@@ -78,6 +81,7 @@ class FrequencyResult(Result):
             "method": "mstmm",
             "indeterminate_released": int(self.indeterminate_released),
             "evaluations": int(self.evaluations),
+            "engine": self.engine,
             **({"note": self.note} if self.note else {}),
             **({"frequencies_hz_text": self.frequencies_text} if self.frequencies_text else {}),
             **({"omega_rad_s_text": self.omegas_text} if self.omegas_text else {}),
@@ -89,7 +93,7 @@ class FrequencyResult(Result):
         return cls(data["model"], decode_array(data["frequencies_hz"]), data["rigid_body_modes"],
                    data["ubar_order"], data["seconds"], data["precision"], data.get("note", ""),
                    data["indeterminate_released"], data.get("frequencies_hz_text"), data.get("omega_rad_s_text"),
-                   data["evaluations"])
+                   data["evaluations"], data["engine"])
 
     def plot(self):
         """Draw the frequencies against their mode number.
@@ -365,7 +369,7 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
                            solution.deduction.full_order, time.perf_counter() - start,
                            precision=solution.precision, note=note, indeterminate_released=solution.released,
                            frequencies_text=solution.frequencies_text, omegas_text=solution.omegas_text,
-                           evaluations=solution.evaluations)
+                           evaluations=solution.evaluations, engine=solution.finder.determinant.engine)
 
 
 def search_note(search: RootSearchResult, found: int, unseparated, count: int | None, fmax: float | None) -> str:

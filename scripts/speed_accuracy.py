@@ -66,9 +66,8 @@ from benchmarks.common import (  # noqa: E402
     spring_chain_reference_hz,
 )
 from linmstmm import deduction as deduction_module  # noqa: E402
-from linmstmm.compiled_model import compiled_system, forget_compiled_models  # noqa: E402
+from linmstmm.compiled_model import forget_compiled_models  # noqa: E402
 from linmstmm.deduction import Deduction  # noqa: E402
-from linmstmm.determinant import CompiledDeterminant  # noqa: E402
 from linmstmm.fe import fe_frequencies  # noqa: E402
 from linmstmm.label_layout import line_samples, place_label  # noqa: E402
 from linmstmm.model import load_model  # noqa: E402
@@ -319,7 +318,7 @@ def scaling(kind: str, sizes, count: int, fe_auto_max: int, quick: bool) -> list
         else:
             row.update(solve=seconds, solve_cpu=cpu, solve_runs=runs,
                        solve_error=max_relative_error(result.frequencies_hz, reference), precision=result.precision,
-                       compiled=isinstance(compiled_system(model).determinant, CompiledDeterminant))
+                       compiled=result.engine == "compiled")
         fe_options = dict(elements_per_beam=1, estimate_error=False) if kind == "beam" else {}
         seconds, result, _, cpu = best_of(lambda: fe_frequencies(model, count, **fe_options), 3, 2.0)
         row.update(fe=seconds, fe_cpu=cpu, fe_error=max_relative_error(result.frequencies_hz, reference))

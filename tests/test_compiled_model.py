@@ -205,3 +205,33 @@ def test_two_threads_solving_one_model_each_report_their_own_work():
     for result in results[0] + results[1]:
         assert result.evaluations == alone.evaluations > 0
         np.testing.assert_array_equal(result.frequencies_hz, alone.frequencies_hz)
+
+
+def test_results_say_which_engine_evaluated():
+    """A frequency and a modal result name the engine that evaluated det Ū_all, and keep
+    it through their dictionaries; the command's JSON and table carry it."""
+    import contextlib
+    import io
+    import json
+
+    from linmstmm.cli import main
+    from linmstmm.modes import ModalResult, mode_shapes
+    from linmstmm.solve import FrequencyResult
+
+    model = load_model("models/cantilever_tip_mass.toml")
+    for engine in ("numpy", "compiled"):
+        frequencies = natural_frequencies(model, 2, engine=engine)
+        modes = mode_shapes(model, 2, engine=engine)
+        assert frequencies.engine == modes.engine == engine
+        assert FrequencyResult.from_dict(frequencies.to_dict()).engine == engine
+        assert ModalResult.from_dict(modes.to_record()).engine == engine
+    for extra in (["--json"], []):
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            assert main(["freqs", "models/cantilever_tip_mass.toml", "--count", "2", "--engine", "compiled",
+                         *extra]) == 0
+        text = out.getvalue()
+        if extra:
+            assert json.loads(text)["engine"] == "compiled"
+        else:
+            assert "solve time" in text and "(compiled engine)" in text

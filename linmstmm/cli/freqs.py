@@ -102,6 +102,7 @@ def print_frequency_table(title: str, data: dict, rtol: float | None = None) -> 
     print(f"  {'mode':>4}  {'f [Hz]':>{width}}  {'omega [rad/s]':>{width}}")
     for index, (f, omega) in enumerate(zip(hz, rad_s), start=1):
         print(f"  {index:>4}  {f:>{width}}  {omega:>{width}}")
-    print(f"  solve time: {data['seconds'] * 1e3:.2f} ms")
+    engine = f" ({data['engine']} engine)" if "engine" in data else ""
+    print(f"  solve time: {data['seconds'] * 1e3:.2f} ms{engine}")
     if data.get("note"):
         print(f"  note: {data['note']}")

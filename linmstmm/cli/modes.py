@@ -80,7 +80,7 @@ def run_modes(args) -> int:
 def modes_summary(result, model) -> dict:
     """The ``modes --json`` object: frequencies, modal masses, orthogonality errors, shapes at points."""
     full = result.to_dict()
-    keys = ("model", "frequencies_hz", "rigid_body_modes", "normalization", "modal_mass",
+    keys = ("model", "frequencies_hz", "rigid_body_modes", "normalization", "engine", "modal_mass",
             "modal_stiffness", "modal_mass_units", "modal_stiffness_units", "mass_orthogonality_error",
             "stiffness_orthogonality_error", "point_displacements")
     return {key: full[key] for key in keys} | {"points": list(model.points)} | (

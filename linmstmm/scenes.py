@@ -394,8 +394,10 @@ def scene_study(base, count: int = 6, tubes=range(1, 19), fired=None, bundle: Bu
         move 40 ppm a scene and every scene starts warm; in a salvo, whose scenes
         move 1-1.4 %, the scenes after the second start from their predictions.
     engine : str
-        How det Ū_all is evaluated (default "auto": the compiled kernels if
-        this process has loaded them, as ``natural_frequencies`` does).
+        How det Ū_all is evaluated (default "auto", resolved once for every scene
+        as :func:`linmstmm.sweep.sweep` resolves it: the compiled kernels if this
+        process has loaded them, or where the scenes are many enough to pay for
+        loading them; else numpy).
     **options
         Passed to :func:`linmstmm.sweep.sweep`: ``workers``, ``dask``,
         ``sensitivity``, ``progress``, ``track_modes``.

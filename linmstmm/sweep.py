@@ -41,7 +41,7 @@ from functools import partial
 import numpy as np
 
 from linmstmm.deduction import Deduction
-from linmstmm.determinant import kernels_pay, resolved_engine
+from linmstmm.determinant import kernels_pay, repeated_cells_dominate, resolved_engine
 from linmstmm.model import Model, ModelError
 from linmstmm.parameters import get_value, parse_key, with_values
 from linmstmm.results import Result, decode_array, decode_arrays
@@ -379,11 +379,13 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
     progress : bool
         A tqdm bar on stderr (only when stderr is a terminal).
     engine : str
-        How every step evaluates det Ū_all: "numpy", "compiled", or "auto"
-        (what this process has loaded, :func:`linmstmm.determinant.resolved_engine`,
-        and the kernels where the sweep's steps together carry enough elements that
-        they pay for their start-up, :func:`linmstmm.determinant.kernels_pay`;
-        the runners all use that engine).
+        How every step evaluates det Ū_all: "numpy", "compiled", or "auto": what a
+        solve of ``model`` in this process would take
+        (:func:`linmstmm.determinant.determinant`), and the kernels where the steps
+        each process runs (``workers`` share them, a dask cluster is taken for
+        ``max(workers, 2)``) carry elements enough that they pay for the kernels'
+        start-up, once the kernels are compiled on this machine
+        (:func:`linmstmm.determinant.kernels_pay`); the runners all use that engine.
     warm_start : bool
         Start each step's root search from the frequencies of its neighbour
         (:func:`neighbours`; found, then certified by a count as from a cold start),
@@ -407,7 +409,8 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
     steps = list(steps)
     shape = tuple(shape) if shape is not None else (len(steps),)
     _check_steps(steps, shape)
-    engine = _step_engine(model, engine, len(steps))
+    processes = max(workers, 2) if dask is not None else workers  # each loads the kernels for itself
+    engine = _step_engine(model, engine, -(-len(steps) // processes))
     keys = [parse_key(model, text) for text in steps[0]]
     models = [_edited(model, keys, step) for step in steps]
     names = tuple(key.text for key in keys)
@@ -435,14 +438,18 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
 
 
 def _step_engine(model: Model, engine: str, steps: int) -> str:
-    """"numpy" or "compiled": ``engine`` as this process resolves it, "auto" taking the
-    kernels where ``steps`` solves of ``model`` carry elements enough
-    (:func:`linmstmm.determinant.kernels_pay`), as
-    :func:`linmstmm.compiled_model.compiled_system` does for one solve."""
+    """"numpy" or "compiled": ``engine`` as this process resolves it; "auto" as a solve of
+    ``model`` here would resolve it (:func:`linmstmm.determinant.determinant`: numpy for a
+    model mostly of repeated cells even with the kernels loaded), and taking the kernels
+    where the ``steps`` solves each process runs carry elements enough
+    (:func:`linmstmm.determinant.kernels_pay`)."""
     resolved = resolved_engine(engine)
-    if engine == "auto" and resolved == "numpy" and kernels_pay(Deduction(build_topology(model)), steps):
-        return "compiled"
-    return resolved
+    if engine != "auto":
+        return resolved
+    deduction = Deduction(build_topology(model))
+    if resolved == "compiled":
+        return "numpy" if repeated_cells_dominate(deduction) else "compiled"
+    return "compiled" if kernels_pay(deduction, steps) else "numpy"
 
 
 def _check_steps(steps: list, shape: tuple) -> None:

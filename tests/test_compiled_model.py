@@ -235,3 +235,25 @@ def test_results_say_which_engine_evaluated():
             assert json.loads(text)["engine"] == "compiled"
         else:
             assert "solve time" in text and "(compiled engine)" in text
+
+
+def test_a_sweeps_auto_follows_a_solves_auto_and_counts_steps_per_process(monkeypatch):
+    """With the kernels loaded here a sweep's "auto" is what a solve's would be: the kernels
+    for the launcher, numpy for a chain of equal cells (which the numpy carry powers); and
+    the steps it counts are those each process runs."""
+    import linmstmm.sweep as sweep_module
+    from linmstmm.sweep import Vary, grid
+
+    natural_frequencies(load_model("models/mlrs/mlrs.toml"), 1, engine="compiled")  # loaded here
+    assert sweep_module._step_engine(load_model("models/mlrs/mlrs.toml"), "auto", 1) == "compiled"
+    assert sweep_module._step_engine(spring_chain(3000), "auto", 1) == "numpy"
+    assert sweep_module._step_engine(spring_chain(3000), "compiled", 1) == "compiled"
+
+    asked = []
+    monkeypatch.setattr(sweep_module, "_step_engine",
+                        lambda model, engine, steps: asked.append(steps) or "numpy")
+    steps, shape = grid([Vary.parse("spring.k2.k[0]=500:2000:5:log")])
+    for workers in (1, 2):
+        sweep_module.sweep(load_model("models/spring_mass_chain.toml"), steps, count=2, shape=shape,
+                           workers=workers, track_modes=False)
+    assert asked == [5, 3]

@@ -1,9 +1,9 @@
 """One line on stderr when numba compiles a kernel of this package, once per process.
 
 The kernels are compiled on their first use on a machine (``@njit(cache=True)``)
-and loaded from numba's cache after: about half a minute of CPU once per
+and loaded from numba's cache after: up to about a minute of CPU once per
 install, 0.3-0.7 s to load in each new process. A first run would otherwise sit
-silent for that half minute. numba announces a compilation (its
+silent for that long. numba announces a compilation (its
 ``numba:compile`` event) only where its cache has no kernel for the call, so
 a run that loads every kernel from the cache prints nothing.
 
@@ -18,7 +18,7 @@ from numba.core import event
 
 #: What a first run on a machine prints, once, before its first compilation.
 NOTICE = ("linmstmm: compiling the numba kernels for this machine (once per install, "
-          "about half a minute; later runs load them from numba's cache)")
+          "up to about a minute; later runs load them from numba's cache)")
 
 _installed = False
 

@@ -1,4 +1,4 @@
-"""``linmstmm fit MODEL MEASURED.csv --vary KEY=START:STOP ...``: model updating.
+"""``linmstmm fit MODEL MEASURED.csv|MEASURED.uff --vary KEY=START:STOP ...``: model updating.
 
 The fit is :func:`linmstmm.fit.fit`; the JSON is
 :meth:`linmstmm.fit.FitResult.to_dict` (keys in ``docs/cli.md``). A malformed
@@ -26,7 +26,8 @@ def add_fit_command(subparsers) -> None:
                                                 "(least squares, analytic sensitivities)")
     add_model_argument(command)
     command.add_argument("measured", help="CSV: a column 'frequency [Hz]', one row per measured mode, "
-                                          "optionally shape columns POINT.DIR (DIR x, y, z, rx, ry, rz)")
+                                          "optionally shape columns POINT.DIR (DIR x, y, z, rx, ry, rz); "
+                                          "or a universal file (.uff, .unv) of dataset-55 modes")
     command.add_argument("--vary", type=parsed_by(Bounds.parse), action="append", required=True,
                          metavar="KEY=START:STOP",
                          help="a value of the model to fit (e.g. spring.k1.k[2], rigid.m2.mass), "

@@ -37,8 +37,9 @@ def add_freqs_command(subparsers) -> None:
     freqs.add_argument("--root", default=None, help="boundary point to use as the root")
     freqs.add_argument("--engine", choices=("auto", "numpy", "compiled"), default="auto",
                        help="how det Ū_all is evaluated: the numpy carry, or numba-compiled kernels "
-                            "(about 5x cheaper per evaluation, 0.5-1.5 s to start in a new process); "
-                            "auto: numpy in a new process")
+                            "(about 5x cheaper per evaluation in a batch, 0.5-1.5 s to start in a new "
+                            "process); auto: numpy in a new process, the kernels for a model of 1,500 "
+                            "elements or more (a beam counting three) once they are compiled here")
     add_damped_option(freqs)
     freqs.set_defaults(run=run_freqs)
 

@@ -89,18 +89,18 @@ def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
-    a : numpy.ndarray of float, shape (n, 3)
+    a : numpy.ndarray of float, shape (..., 3)
         The vectors on the left.
-    b : numpy.ndarray of float, shape (3,)
-        The vector on the right.
+    b : numpy.ndarray of float, shape (3,) or broadcasting with ``a``
+        The vector(s) on the right.
 
     Returns
     -------
-    numpy.ndarray of float64, shape (n, 3)
+    numpy.ndarray of float64, shape (..., 3)
         a × b row by row: per component a product minus a product, as :func:`cross3`.
     """
-    return np.stack([a[:, 1] * b[2] - a[:, 2] * b[1], a[:, 2] * b[0] - a[:, 0] * b[2],
-                     a[:, 0] * b[1] - a[:, 1] * b[0]], axis=1)
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
 
 
 def local_axes(x: np.ndarray, y_axis=None) -> np.ndarray:

@@ -21,6 +21,37 @@ from linmstmm.model import Model
 EXTRA_QUADRATURE_POINTS = 20
 
 
+@dataclass(frozen=True)
+class _Bodies:
+    """The rigid bodies of a topology as arrays, in element order (R of them).
+
+    names : (R,). elements : (R,) their transfer element indices. mass : (R,) kg.
+    inertia : (R, 3, 3) kg m² about the mass centre, inertial axes. arms : (R, 3) m,
+    mass centre less the first port's position.
+    """
+
+    names: tuple
+    elements: np.ndarray
+    mass: np.ndarray
+    inertia: np.ndarray
+    arms: np.ndarray
+
+
+@dataclass(frozen=True)
+class _Springs:
+    """The springs of a topology as arrays, in element order (S of them).
+
+    elements : (S,) transfer element indices. ends : (S, 2) the port of ends[0] and
+    of ends[1]. axes : (S, 3, 3) rows the spring's local axes. k : (S, 6) N/m and
+    N m/rad, 0 where infinite (a rigid direction stores no strain energy).
+    """
+
+    elements: np.ndarray
+    ends: np.ndarray
+    axes: np.ndarray
+    k: np.ndarray
+
+
 @dataclass(frozen=True, eq=False)
 class _Fields:
     """Everything linear in z̄ for a set of modes; ``apply`` recombines modes.
@@ -82,7 +113,7 @@ class _Fields:
     @property
     def com_displacements(self) -> dict[str, np.ndarray]:
         """rigid body -> (n, 6) translation and rotation of its mass centre."""
-        return {el.name: self._com(el.record) for el in self.topology.elements if el.kind == "rigid"}
+        return dict(zip(self._bodies.names, self._coms()))
 
     def displacement_samples(self) -> np.ndarray:
         """(n, s, 6) displacements at every point and beam quadrature node."""
@@ -93,21 +124,20 @@ class _Fields:
     # -- the body operators ---------------------------------------------------
     def mass_gram(self, axis_weights=np.ones(3)) -> np.ndarray:
         """(n, n) ⟨M V^k, V^p⟩; ``axis_weights`` (3,) scale the translational mass along x, y, z."""
-        return _gram(self._mass_measures(np.asarray(axis_weights, float)), self.zbar.shape[0])
+        axis_weights = np.asarray(axis_weights, float)
+        bodies, coms = self._bodies, self._coms()  # every rigid body at once: (R, n, 6)
+        translation, rotation = coms[..., :3], coms[..., 3:]
+        gram = (np.einsum("rka,rpa,ra->kp", translation, translation, np.outer(bodies.mass, axis_weights))
+                + np.einsum("rka,rab,rpb->kp", rotation, bodies.inertia, rotation))
+        return gram + _gram(self._beam_mass_measures(axis_weights), self.zbar.shape[0])
 
     def stiffness_gram(self) -> np.ndarray:
         """(n, n) ⟨K V^k, V^p⟩ from the strain energy of springs and beams."""
-        return _gram(self._stiffness_measures(), self.zbar.shape[0])
+        stretch = self._spring_motions()  # every spring at once: (S, n, 6)
+        gram = np.einsum("rka,rpa,ra->kp", stretch, stretch, self._springs.k)
+        return gram + _gram(self._beam_strain_measures(), self.zbar.shape[0])
 
-    def _mass_measures(self, axis_weights):
-        for element in self.topology.elements:
-            if element.kind != "rigid":
-                continue
-            rigid = element.record
-            com = self._com(rigid)
-            principal, axes = np.linalg.eigh(np.asarray(rigid.inertia, float))
-            yield com[:, :3], rigid.mass * axis_weights
-            yield com[:, 3:] @ axes, principal
+    def _beam_mass_measures(self, axis_weights):
         for beam, (nodes, weights) in self._beams():
             states = self.quadrature_states[beam.name]
             yield (states[..., :3].reshape(len(states), -1),
@@ -115,18 +145,7 @@ class _Fields:
             torsion = states[..., 3:6] @ np.asarray(beam.axes, float)[0]
             yield torsion, beam.rho * beam.Ip * weights
 
-    def _stiffness_measures(self):
-        for e, element in enumerate(self.topology.elements):
-            if element.kind != "spring":
-                continue
-            spring = element.record
-            ends = [next(p for p, port in enumerate(element.ports) if port.point == end)
-                    for end in spring.ends]
-            delta = self.element_states[e][:, ends[1], :6] - self.element_states[e][:, ends[0], :6]
-            axes = np.asarray(spring.axes, float)
-            local = np.concatenate([delta[:, :3] @ axes.T, delta[:, 3:] @ axes.T], axis=1)
-            finite = np.isfinite(spring.k)
-            yield local[:, finite], np.asarray(spring.k, float)[finite]
+    def _beam_strain_measures(self):
         for beam, (nodes, weights) in self._beams():
             states = self.quadrature_states[beam.name]
             axes = np.asarray(beam.axes, float)
@@ -140,19 +159,48 @@ class _Fields:
             for values, rigidity in terms:
                 yield values, weights / rigidity
 
-    def _com(self, rigid) -> np.ndarray:
-        """(n, 6) mass-centre displacement u_c = u_p + θ × (c − p) from the body's first port."""
-        e = self._element_index[rigid.name]
-        element = self.topology.elements[e]
-        port = self.element_states[e][:, 0]
-        arm = np.asarray(rigid.com, float) - np.asarray(element.ports[0].position, float)
-        return np.concatenate([port[:, :3] + cross_rows(port[:, 3:6], arm), port[:, 3:6]], axis=1)
+    def _coms(self) -> np.ndarray:
+        """(R, n, 6) mass-centre displacement u_c = u_p + θ × (c − p) of each rigid body, from
+        its first port."""
+        bodies = self._bodies
+        ports = self._gathered(bodies.elements, np.zeros(bodies.elements.size, int))
+        theta = ports[..., 3:6]
+        return np.concatenate([ports[..., :3] + cross_rows(theta, bodies.arms[:, None, :]), theta], axis=2)
+
+    def _spring_motions(self) -> np.ndarray:
+        """(S, n, 6) each spring's relative motion, its ends[1] less its ends[0], in its own axes."""
+        springs = self._springs
+        first, second = (self._gathered(springs.elements, springs.ends[:, end]) for end in (0, 1))
+        delta = second - first
+        return np.concatenate([np.einsum("rab,rkb->rka", springs.axes, delta[..., :3]),
+                               np.einsum("rab,rkb->rka", springs.axes, delta[..., 3:])], axis=2)
+
+    def _gathered(self, elements: np.ndarray, ports: np.ndarray) -> np.ndarray:
+        """(m, n, 6) displacement and rotation at port ``ports[i]`` of element ``elements[i]``."""
+        if not elements.size:
+            return np.zeros((0, self.zbar.shape[0], 6))
+        return np.stack([self.element_states[e][:, p, :6] for e, p in zip(elements.tolist(), ports.tolist())])
 
     @functools.cached_property
-    def _element_index(self) -> dict[str, int]:
-        """Transfer element name -> its index in :attr:`names` (a search of the names for each
-        body made a 20,000-body chain's shapes quadratic in its length)."""
-        return {name: e for e, name in enumerate(self.names)}
+    def _bodies(self) -> _Bodies:
+        """The rigid bodies' arrays (:class:`_Bodies`), made once."""
+        found = [(e, element) for e, element in enumerate(self.topology.elements) if element.kind == "rigid"]
+        return _Bodies(tuple(element.name for _, element in found), np.array([e for e, _ in found], int),
+                       np.array([element.record.mass for _, element in found], float).reshape(-1),
+                       np.array([element.record.inertia for _, element in found], float).reshape(-1, 3, 3),
+                       np.array([np.asarray(element.record.com, float) - element.ports[0].position
+                                 for _, element in found], float).reshape(-1, 3))
+
+    @functools.cached_property
+    def _springs(self) -> _Springs:
+        """The springs' arrays (:class:`_Springs`), made once."""
+        found = [(e, element) for e, element in enumerate(self.topology.elements) if element.kind == "spring"]
+        ends = [[next(p for p, port in enumerate(element.ports) if port.point == end) for end in element.record.ends]
+                for _, element in found]
+        stiffness = np.array([element.record.k for _, element in found], float).reshape(-1, 6)
+        return _Springs(np.array([e for e, _ in found], int), np.array(ends, int).reshape(-1, 2),
+                        np.array([element.record.axes for _, element in found], float).reshape(-1, 3, 3),
+                        np.where(np.isfinite(stiffness), stiffness, 0.0))  # a rigid direction stores no energy
 
     def _beams(self):
         for element in self.topology.elements:

@@ -370,13 +370,13 @@ LARGE_CANTILEVER = 1000
 def large_model_rows() -> list[str]:
     """Rows of the new-process table: the first 20 frequencies of a cantilever of
     LARGE_CANTILEVER beam elements (a model file written for it), by the default engine,
-    which loads the kernels for a model that large (linmstmm.determinant.kernels_pay),
+    which loads the kernels for a request that large (linmstmm.determinant.kernels_pay),
     and by the numpy carry; median of three processes each."""
     with tempfile.TemporaryDirectory() as folder:
         path = beam_chain_file(LARGE_CANTILEVER, Path(folder))
         command = [sys.executable, "-m", "linmstmm", "freqs", str(path), "--count", "20", "--quiet"]
         return [f"| `linmstmm freqs` on a cantilever of {LARGE_CANTILEVER:,} beam elements (a model file), "
-                f"first 20 (engine auto: the kernels loaded for a model that large) | {startup(command, 2):.2f} s |",
+                f"first 20 (engine auto: the kernels loaded for a request that large) | {startup(command, 2):.2f} s |",
                 f"| the same with `--engine numpy` | {startup(command + ['--engine', 'numpy'], 2):.2f} s |"]
 
 

@@ -39,7 +39,7 @@ SPAN = 5.0
 ENGINES = ("numpy", "compiled")
 #: Steps of the command-line sweeps (one range of ``spring.elevation.k[4]``) timed in new
 #: processes, by each engine and by the default "auto", to show where "auto" takes the kernels.
-COMMAND_STEPS = (20, 45, 100, 400)
+COMMAND_STEPS = (20, 53, 100, 400)
 #: (label, sweep options) of the runs of each engine; the cold ones must agree bitwise.
 RUNS = (("serial", {}), ("2 processes", {"workers": 2}),
         ("dask LocalCluster, 2 workers", {"dask": "local", "workers": 2}),
@@ -158,10 +158,11 @@ def write_report(path, command, result, runs, agreement, varies, commands) -> No
         "## What the default engine picks",
         "",
         ("`engine=\"auto\"` (the default of `sweep` and of the command) loads the compiled kernels "
-         "where the sweep's steps together carry at least "
-         f"{KERNELS_PAY_FROM:,} elements one at a time, each beam counted {BEAM_WEIGHT} times "
+         "where the steps times the frequencies per step times the elements carried one at a time, "
+         f"each beam counted {BEAM_WEIGHT} times, reach {KERNELS_PAY_FROM:,} "
          "(`linmstmm.determinant.kernels_pay`; the launcher counts "
-         f"{launcher_weight()}, so from {-(-KERNELS_PAY_FROM // launcher_weight())} steps), "
+         f"{launcher_weight()}, so at {result.order.shape[1]} frequencies a step from "
+         f"{-(-KERNELS_PAY_FROM // (launcher_weight() * result.order.shape[1]))} steps), "
          "and they are compiled on the machine; else the numpy carry. "
          "`linmstmm sweep` of the launcher over one range of "
          f"`{PARAMETERS[0][0]}`, lowest {result.order.shape[1]}, each run a new process "

@@ -24,7 +24,16 @@ from linmstmm.coarse_prediction import coarse_pencil
 from linmstmm.collector import collector_paused
 from linmstmm.counting import count_in_disc
 from linmstmm.deduction import Deduction
-from linmstmm.determinant import determinant, kernels_loaded, kernels_pay, load_kernels, resolved_engine
+from linmstmm.determinant import (
+    FREQUENCIES_ASSUMED,
+    KERNELS_PAY_FROM,
+    determinant,
+    kernels_loaded,
+    kernels_pay,
+    load_kernels,
+    resolved_engine,
+    weight_at_most,
+)
 from linmstmm.model import Model
 from linmstmm.model_structure import MODELS_KEPT, forget_structures
 from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
@@ -68,7 +77,8 @@ class CompiledSystem:
     counter: ModeCounter | None
 
 
-def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: str = "auto") -> CompiledSystem:
+def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: str = "auto",
+                    frequencies: int = FREQUENCIES_ASSUMED) -> CompiledSystem:
     """The :class:`CompiledSystem` of ``model``: made on the first call for this model
     object (and root, cuts, engine), the same object after.
 
@@ -81,17 +91,29 @@ def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: st
     engine : str
         "auto", "numpy" or "compiled" (:func:`linmstmm.determinant.determinant`; a
         system made for "auto" before the kernels were loaded is not taken for one
-        made after). For a model large enough that the numpy carry would take longer
-        than the kernels' start-up (:func:`~linmstmm.determinant.kernels_pay`), "auto"
-        loads them first, and a later call for the same model, finding them loaded,
-        makes its system once more.
+        made after). Where the numpy carry would take longer than the kernels'
+        start-up to find ``frequencies`` of ``model``
+        (:func:`~linmstmm.determinant.kernels_pay`), "auto" loads them first, and a
+        later call for the same model, finding them loaded, makes its system once more.
+    frequencies : int
+        Natural frequencies the solve asks for (what the kernels would save grows with them).
 
     Returns
     -------
     CompiledSystem
     """
     resolved_engine(engine)  # an unknown engine is refused before anything is built
+    if engine == "auto" and not kernels_loaded() and _kernels_pay_for(model, root, tuple(cut_at), frequencies):
+        load_kernels()  # a large request: the kernels' start-up costs less than the numpy carry's solve
     return _compiled(model, root, tuple(cut_at), engine, kernels_loaded())
+
+
+def _kernels_pay_for(model: Model, root: str | None, cut_at: tuple, frequencies: int) -> bool:
+    """:func:`~linmstmm.determinant.kernels_pay` for ``frequencies`` of ``model``, its
+    topology built only where the model's size alone does not rule them out."""
+    if weight_at_most(model) * frequencies < KERNELS_PAY_FROM:
+        return False
+    return kernels_pay(Deduction(build_topology(model, root=root, cut_at=cut_at)), frequencies)
 
 
 @functools.lru_cache(maxsize=MODELS_KEPT)
@@ -105,8 +127,6 @@ def _compiled(model: Model, root: str | None, cut_at: tuple, engine: str, loaded
 def _compiled_now(model: Model, root: str | None, cut_at: tuple, engine: str) -> CompiledSystem:
     """The :class:`CompiledSystem` of ``model``, built."""
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
-    if engine == "auto" and not kernels_loaded() and kernels_pay(deduction):
-        load_kernels()  # a large model: the kernels' start-up costs less than the numpy carry's solve
     evaluator = determinant(deduction, engine)  # compiled first: its plain Ū_all screens the probes
     scales = characteristic_frequencies(deduction.topology)  # of the elements alone: a release keeps them
     released = release_indeterminate(deduction, screen=evaluator.plain_matrix, scales=scales)

@@ -98,33 +98,40 @@ def determinant(deduction: Deduction, engine: str = "auto"):
     return CompiledDeterminant(deduction) if chosen == "compiled" else NumpyDeterminant(deduction)
 
 
-#: Elements the numpy carry takes one at a time, each beam counted BEAM_WEIGHT times, from
-#: which ``engine="auto"`` loads the kernels in a process that has not (:func:`kernels_pay`).
-#: Measured end to end, ``linmstmm freqs FILE`` in new processes, numpy against the kernels
-#: (cached), best of 5 to 11: cantilevers of 134, 300, 1,000 beam elements, first 10:
-#: 0.86/1.19, 1.75/1.56, 5.2/1.9 s; first 20: 1.73/1.41, 3.43/1.71, 7.2/2.0 s; first 3,
-#: 134 elements: 0.80/1.27 s; chains of 200, 250, 400 unequal bodies, first 20: 1.3/1.5,
-#: 1.5/1.4 s, and 1.13-1.17 times faster at 400. The kernels' start-up (0.5-1.1 s) outweighs
-#: the saving below a few hundred beams, the more so for few frequencies, and chains of
-#: bodies and springs gain little. At 1,500 the kernels are ahead at the command's ten
-#: frequencies (500 beam elements 1.54 against 2.68 s, 750 unequal bodies 2.04 against
-#: 2.77 s) and within 10 % behind at three (numpy 1.71 and 1.90 s, the kernels 1.87 and 1.97 s).
-#: A sweep counts its steps together (``solves``): ``linmstmm sweep`` of the launcher (34),
-#: five modes per step, numpy against the kernels: 25 steps 1.50/2.02 s, 50 steps 2.14/2.40 s,
-#: 100 steps 3.51/2.97 s (they break even near 60 steps; the rule takes the kernels from 45).
-KERNELS_PAY_FROM = 1500
+#: Frequencies asked for times the elements the numpy carry takes one at a time (each beam
+#: counted BEAM_WEIGHT times), over all the solves the kernels would serve, from which
+#: ``engine="auto"`` loads the kernels in a process that has not (:func:`kernels_pay`): the
+#: numpy carry's work grows with both, the kernels' start-up (0.5-1.1 s) does not. Measured
+#: end to end, ``linmstmm freqs FILE --count C`` in new processes, numpy against the kernels
+#: (cached), best of 2: cantilevers of 100 beam elements, C = 5, 10, 20, 40: 0.82/1.36,
+#: 0.70/1.20, 0.81/1.27, 1.23/1.51 s; of 200: 0.85/1.12, 0.99/1.10, 1.81/1.32, 3.26/1.65 s;
+#: of 300: 1.15/1.23, 1.57/1.15, 2.44/1.37, 17.7/1.75 s (the numpy carry's 6,677 evaluations
+#: of a scan above the predictions' reach); earlier, best of 5 to 11: 500 beam elements
+#: C = 3 1.71/1.87 s, 10 2.68/1.54 s; 1,000, C = 10 5.2/1.9 s; chains of 200, 250, 400 unequal
+#: bodies, C = 20: 1.3/1.5, 1.5/1.4 s, the kernels 1.13-1.17 times faster at 400; 750 bodies,
+#: C = 3 1.90/1.97 s, C = 10 2.77/2.04 s. The kernels break even between 4,500 (300 beams,
+#: C = 5) and 9,000 (300 beams, C = 10; 200 beams, C = 20 at 12,000); below, at most 10 %
+#: is lost where numpy is chosen above the line (500 beams, C = 3) and a small model's many
+#: frequencies (100 beams, C = 40: 12,000) take the kernels 0.3 s too early. A sweep counts
+#: its steps (``solves``): ``linmstmm sweep`` of the launcher (34), five modes per step:
+#: 25 steps 1.50/2.02 s, 50 steps 2.14/2.40 s, 100 steps 3.51/2.97 s (even near 60 steps,
+#: 10,200; the rule takes the kernels from 53).
+KERNELS_PAY_FROM = 9000
+#: Frequencies a request is taken to ask for where it names no count (a range up to fmax)
+#: and its beams' clamped modes do not promise more: the commands' default count.
+FREQUENCIES_ASSUMED = 10
 #: A beam's weight in that count: the numpy carry's cost of a beam element against a rigid
 #: body's or a spring's, taken low (in one process, first 20, 200 elements: a cantilever
 #: 2.18 s, a chain of 100 unequal bodies 0.41 s).
 BEAM_WEIGHT = 3
 
 
-def kernels_pay(deduction: Deduction, solves: int = 1) -> bool:
+def kernels_pay(deduction: Deduction, frequencies: int, solves: int = 1) -> bool:
     """True where loading the compiled kernels costs less than the numpy carry would take:
-    at least KERNELS_PAY_FROM elements carried one at a time (each beam BEAM_WEIGHT times)
-    over ``solves`` solves of models like this one, the runs of a repeated cell, which the
-    numpy carry powers, left out (they are looked for only where the solves carry that
-    many elements at all), and the kernels compiled on this machine already
+    the elements carried one at a time (each beam BEAM_WEIGHT times) times the
+    ``frequencies`` asked for times the ``solves`` at least KERNELS_PAY_FROM, the runs of a
+    repeated cell, which the numpy carry powers, left out (they are looked for only where
+    the product reaches that at all), and the kernels compiled on this machine already
     (:func:`kernels_compiled`): a first compilation takes about a minute, more than the
     numpy carry saves on one solve.
 
@@ -132,6 +139,8 @@ def kernels_pay(deduction: Deduction, solves: int = 1) -> bool:
     ----------
     deduction : Deduction
         The model's deduction.
+    frequencies : int
+        Natural frequencies each solve asks for.
     solves : int
         Solves of models of this structure the kernels would serve (a sweep's steps).
 
@@ -139,11 +148,18 @@ def kernels_pay(deduction: Deduction, solves: int = 1) -> bool:
     -------
     bool
     """
+    work = frequencies * solves
     weight = carried_weight(deduction.topology)
-    if weight * solves < KERNELS_PAY_FROM:
+    if weight * work < KERNELS_PAY_FROM:
         return False
     powered = sum(len(run.cell) * run.repetitions for run in deduction.periodic_runs())  # never beams
-    return (weight - powered) * solves >= KERNELS_PAY_FROM and kernels_compiled()
+    return (weight - powered) * work >= KERNELS_PAY_FROM and kernels_compiled()
+
+
+def weight_at_most(model) -> int:
+    """An upper bound of :func:`carried_weight` of any topology of ``model``: its elements
+    (each beam BEAM_WEIGHT times) and a junction at every point, read off the model alone."""
+    return len(model.rigids) + len(model.springs) + BEAM_WEIGHT * len(model.beams) + len(model.points)
 
 
 def carried_weight(topology) -> int:

@@ -10,7 +10,8 @@ import numpy as np
 from linmstmm.coarse_prediction import predicted_modes
 from linmstmm.compiled_model import compiled_system
 from linmstmm.deduction import Deduction
-from linmstmm.mode_bound import check_range_request
+from linmstmm.determinant import FREQUENCIES_ASSUMED
+from linmstmm.mode_bound import check_range_request, clamped_modes_below
 from linmstmm.model import Model
 from linmstmm.results import Result, decode_array
 from linmstmm.roots import CERTIFIED_STEP, MAX_XTOL, RootFinder, RootSearchResult
@@ -109,7 +110,8 @@ class FrequencyResult(Result):
         return frequency_figure(self.frequencies_hz, self.rigid_body_modes, title=title)
 
 
-def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: str = "auto", **options):
+def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: str = "auto",
+                     frequencies: int = FREQUENCIES_ASSUMED, **options):
     """The deduced system of ``model`` and a new root finder on its stable determinant.
 
     The system is compiled once per model object (:func:`~linmstmm.compiled_model.compiled_system`:
@@ -119,6 +121,7 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     (:func:`linmstmm.determinant.determinant`; kept as ``finder.determinant``
     with its count of evaluations); the deduction's own numpy carry serves
     mode shapes and the mpmath refinement either way.
+    frequencies : how many the search is to find (for "auto", :func:`~linmstmm.compiled_model.compiled_system`).
     root, cut_at : see :func:`linmstmm.topology.build_topology`. options go to
     :class:`linmstmm.roots.RootFinder` (xtol, points_per_octave, points_per_root, rtol).
     The finder knows the rigid-body modes (counted from the model's kinematics)
@@ -133,7 +136,7 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     depends on the units the model is written in.
     Returns (deduction, finder, number of indeterminate unknowns released).
     """
-    system = compiled_system(model, root, cut_at, engine)
+    system = compiled_system(model, root, cut_at, engine, frequencies)
     evaluator = system.determinant
     finder = RootFinder(evaluator.log_det, lambda omega: evaluator.matrix(omega)[0],
                         rigid_body_modes=system.rigid_body_modes,
@@ -263,7 +266,9 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
     report("deducing Ubar_all")
     accuracy = {} if rtol is None else {"rtol": rtol, "xtol": min(max(XTOL_PER_RTOL * rtol, 1e-14), MAX_XTOL),
                                         "unpolished": True}
-    deduction, finder, released = frequency_finder(model, root, engine=engine, **accuracy)
+    frequencies = count if count is not None else max(clamped_modes_below(model, 2 * np.pi * fmax),
+                                                      FREQUENCIES_ASSUMED)  # a range: at least its clamped modes
+    deduction, finder, released = frequency_finder(model, root, engine=engine, frequencies=frequencies, **accuracy)
     report("finding roots")
     abandoned = 0  # evaluations of a search made again at the default accuracy
     try:
@@ -277,7 +282,7 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
         # count by the argument principle), the search is made again at the default accuracy.
         report("searching again at the default accuracy")
         abandoned = finder.determinant.evaluations
-        deduction, finder, released = frequency_finder(model, root, engine=engine)
+        deduction, finder, released = frequency_finder(model, root, engine=engine, frequencies=frequencies)
         search = _searched(finder, count, fmax, guess_hz)
     omegas, unseparated = search.roots, dict(search.unseparated)
     # (a root no Newton step reached has a NaN step: it is in unseparated)

@@ -410,7 +410,7 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
     shape = tuple(shape) if shape is not None else (len(steps),)
     _check_steps(steps, shape)
     processes = max(workers, 2) if dask is not None else workers  # each loads the kernels for itself
-    engine = _step_engine(model, engine, -(-len(steps) // processes))
+    engine = _step_engine(model, engine, count, -(-len(steps) // processes))
     keys = [parse_key(model, text) for text in steps[0]]
     models = [_edited(model, keys, step) for step in steps]
     names = tuple(key.text for key in keys)
@@ -437,19 +437,19 @@ def sweep(model: Model, steps, count: int = 5, shape=None, sensitivity: bool = F
         engine, warm_start)
 
 
-def _step_engine(model: Model, engine: str, steps: int) -> str:
+def _step_engine(model: Model, engine: str, count: int, steps: int) -> str:
     """"numpy" or "compiled": ``engine`` as this process resolves it; "auto" as a solve of
     ``model`` here would resolve it (:func:`linmstmm.determinant.determinant`: numpy for a
     model mostly of repeated cells even with the kernels loaded), and taking the kernels
-    where the ``steps`` solves each process runs carry elements enough
-    (:func:`linmstmm.determinant.kernels_pay`)."""
+    where the ``steps`` solves of ``count`` frequencies each process runs carry elements
+    enough (:func:`linmstmm.determinant.kernels_pay`)."""
     resolved = resolved_engine(engine)
     if engine != "auto":
         return resolved
     deduction = Deduction(build_topology(model))
     if resolved == "compiled":
         return "numpy" if repeated_cells_dominate(deduction) else "compiled"
-    return "compiled" if kernels_pay(deduction, steps) else "numpy"
+    return "compiled" if kernels_pay(deduction, count, steps) else "numpy"
 
 
 def _check_steps(steps: list, shape: tuple) -> None:

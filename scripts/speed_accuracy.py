@@ -68,6 +68,7 @@ from benchmarks.common import (  # noqa: E402
 from linmstmm import deduction as deduction_module  # noqa: E402
 from linmstmm.compiled_model import forget_compiled_models  # noqa: E402
 from linmstmm.deduction import Deduction  # noqa: E402
+from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM  # noqa: E402
 from linmstmm.fe import fe_frequencies  # noqa: E402
 from linmstmm.label_layout import line_samples, place_label  # noqa: E402
 from linmstmm.model import load_model  # noqa: E402
@@ -972,10 +973,10 @@ def write_report(args, command, facts, loads, elapsed, beam_model, beam_referenc
       "time (best of up to 9 runs), less disturbed by the other users' load than wall time (the fits give "
       "both: keys ending in `_cpu` are CPU time). Full solve = "
       "`natural_frequencies(model, 20)` including the topology build, by the numpy carry unless marked "
-      "*compiled*: with `engine=\"auto\"`, the default, a model of 1,500 or more elements carried one at a time "
-      "(each beam counted three times; `linmstmm.determinant.kernels_pay`) has the compiled kernels loaded for "
-      "it, so from the first such beam chain on this process solves by them, as a new process would solve that "
-      "chain. FE = `fe_frequencies(model, 20)`: exact "
+      "*compiled*: with `engine=\"auto\"`, the default, a request whose elements carried one at a time "
+      f"(each beam counted {BEAM_WEIGHT} times) times the frequencies asked for reach {KERNELS_PAY_FROM:,} "
+      "(`linmstmm.determinant.kernels_pay`) has the compiled kernels loaded for it, so from the first such "
+      "beam chain on this process solves by them, as a new process would solve that chain. FE = `fe_frequencies(model, 20)`: exact "
       "for springs; for beam chains one element per beam (the same element count, but a coarse "
       f"discretisation: see its error), and the automatic refinement up to N = {args.fe_auto_max}.")
     w("")

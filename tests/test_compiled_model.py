@@ -81,11 +81,12 @@ def test_auto_leaves_a_long_chain_to_the_numpy_carry_that_powers_its_cells():
     assert np.allclose(2 * np.pi * result.frequencies_hz, lowest, rtol=1e-9)
 
 
-def test_kernels_pay_for_a_large_model_carried_element_by_element():
-    """"auto" loads the kernels (compiled here already) for a model of KERNELS_PAY_FROM
-    elements carried one at a time (a beam weighs BEAM_WEIGHT): not for the launchers, nor
-    for a long chain of equal cells (powered by the numpy carry), but for a long cantilever
-    and a chain of unequal bodies."""
+def test_kernels_pay_for_a_large_request_carried_element_by_element():
+    """"auto" loads the kernels (compiled here already) where the elements carried one at a
+    time (a beam weighs BEAM_WEIGHT) times the frequencies asked for reach KERNELS_PAY_FROM:
+    not for the launchers' ten lowest, nor for a long chain of equal cells (powered by the
+    numpy carry) however many, but for a cantilever and a chain of unequal bodies, the
+    sooner the more frequencies are asked for."""
     from builders import cantilever_of_beams, unequal_chain
     from linmstmm.deduction import Deduction
     from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM, kernels_compiled, kernels_pay
@@ -94,20 +95,23 @@ def test_kernels_pay_for_a_large_model_carried_element_by_element():
     natural_frequencies(load_model("models/mlrs/mlrs.toml"), 1, engine="compiled")  # compiled here, cached
     assert kernels_compiled()
 
-    def pays(model):
-        return kernels_pay(Deduction(build_topology(model)))
+    def pays(model, frequencies):
+        return kernels_pay(Deduction(build_topology(model)), frequencies)
 
-    beams = -(-KERNELS_PAY_FROM // BEAM_WEIGHT)  # the fewest beams that weigh that much
-    assert not pays(load_model("models/mlrs/mlrs.toml")) and not pays(load_model("models/launcher2/launcher2.toml"))
-    assert not pays(spring_chain(3000))  # equal cells: the numpy carry powers them
-    assert not pays(cantilever_of_beams(beams - 1)) and pays(cantilever_of_beams(beams))
-    bodies = KERNELS_PAY_FROM // 2  # a body and a spring each
-    assert not pays(unequal_chain(bodies - 1)) and pays(unequal_chain(bodies))
+    for launcher in ("models/mlrs/mlrs.toml", "models/launcher2/launcher2.toml"):
+        assert not pays(load_model(launcher), 10) and not pays(load_model(launcher), 100)
+    assert not pays(spring_chain(3000), 100)  # equal cells: the numpy carry powers them
+    for frequencies in (10, 20, 40):
+        beams = -(-KERNELS_PAY_FROM // (BEAM_WEIGHT * frequencies))  # the fewest beams that weigh that much
+        assert not pays(cantilever_of_beams(beams - 1), frequencies) and pays(cantilever_of_beams(beams), frequencies)
+        bodies = -(-KERNELS_PAY_FROM // (2 * frequencies))  # a body and a spring each
+        assert not pays(unequal_chain(bodies - 1), frequencies) and pays(unequal_chain(bodies), frequencies)
 
 
 def test_kernels_pay_for_a_sweep_of_a_small_model_long_enough():
     """A sweep's steps count together: the launcher (30 elements, two of them beams) pays
-    for the kernels from the step where its weight times the steps reaches KERNELS_PAY_FROM."""
+    for the kernels from the step where its weight times the frequencies times the steps
+    reaches KERNELS_PAY_FROM."""
     from linmstmm.deduction import Deduction
     from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM, carried_weight, kernels_pay
     from linmstmm.topology import build_topology
@@ -116,16 +120,16 @@ def test_kernels_pay_for_a_sweep_of_a_small_model_long_enough():
     deduction = Deduction(build_topology(load_model("models/mlrs/mlrs.toml")))
     weight = carried_weight(deduction.topology)
     assert weight == 28 + 2 * BEAM_WEIGHT
-    steps = -(-KERNELS_PAY_FROM // weight)
-    assert not kernels_pay(deduction, steps - 1) and kernels_pay(deduction, steps)
+    steps = -(-KERNELS_PAY_FROM // (weight * 5))
+    assert not kernels_pay(deduction, 5, steps - 1) and kernels_pay(deduction, 5, steps)
     equal_cells = Deduction(build_topology(spring_chain(3000)))  # powered by the numpy carry, however often
-    assert not kernels_pay(equal_cells, 1000)
+    assert not kernels_pay(equal_cells, 5, 1000)
 
 
 def test_auto_loads_the_kernels_for_a_large_model_in_a_new_process():
     """In a new process "auto" solves a launcher by the numpy carry and a 500-element
-    cantilever by the kernels (compiled on this machine) it loads for it (a sweep's steps
-    likewise); the frequencies are numpy's to rounding."""
+    cantilever's six lowest by the kernels (compiled on this machine) it loads for them, but
+    not its lowest (a sweep's steps likewise); the frequencies are numpy's to rounding."""
     import subprocess
     import sys
 
@@ -136,10 +140,11 @@ def test_auto_loads_the_kernels_for_a_large_model_in_a_new_process():
             "from linmstmm import load_model, natural_frequencies\n"
             "from linmstmm.determinant import kernels_loaded\n"
             "from linmstmm.sweep import _step_engine\n"
-            "natural_frequencies(load_model('models/mlrs/mlrs.toml'), 10); print(kernels_loaded())\n"
-            "print(_step_engine(load_model('models/mlrs/mlrs.toml'), 'auto', 1), "
-            "_step_engine(load_model('models/mlrs/mlrs.toml'), 'auto', 1000), "
-            "_step_engine(cantilever_of_beams(500), 'auto', 1))\n"
+            "natural_frequencies(load_model('models/mlrs/mlrs.toml'), 10)\n"
+            "natural_frequencies(cantilever_of_beams(500), 1); print(kernels_loaded())\n"
+            "print(_step_engine(load_model('models/mlrs/mlrs.toml'), 'auto', 5, 1), "
+            "_step_engine(load_model('models/mlrs/mlrs.toml'), 'auto', 5, 1000), "
+            "_step_engine(cantilever_of_beams(500), 'auto', 6, 1))\n"
             "auto = natural_frequencies(cantilever_of_beams(500), 6); print(kernels_loaded())\n"
             "plain = natural_frequencies(cantilever_of_beams(500), 6, engine='numpy')\n"
             "print(np.abs(auto.frequencies_hz / plain.frequencies_hz - 1).max())\n")
@@ -245,13 +250,13 @@ def test_a_sweeps_auto_follows_a_solves_auto_and_counts_steps_per_process(monkey
     from linmstmm.sweep import Vary, grid
 
     natural_frequencies(load_model("models/mlrs/mlrs.toml"), 1, engine="compiled")  # loaded here
-    assert sweep_module._step_engine(load_model("models/mlrs/mlrs.toml"), "auto", 1) == "compiled"
-    assert sweep_module._step_engine(spring_chain(3000), "auto", 1) == "numpy"
-    assert sweep_module._step_engine(spring_chain(3000), "compiled", 1) == "compiled"
+    assert sweep_module._step_engine(load_model("models/mlrs/mlrs.toml"), "auto", 5, 1) == "compiled"
+    assert sweep_module._step_engine(spring_chain(3000), "auto", 5, 1) == "numpy"
+    assert sweep_module._step_engine(spring_chain(3000), "compiled", 5, 1) == "compiled"
 
     asked = []
     monkeypatch.setattr(sweep_module, "_step_engine",
-                        lambda model, engine, steps: asked.append(steps) or "numpy")
+                        lambda model, engine, count, steps: asked.append(steps) or "numpy")
     steps, shape = grid([Vary.parse("spring.k2.k[0]=500:2000:5:log")])
     for workers in (1, 2):
         sweep_module.sweep(load_model("models/spring_mass_chain.toml"), steps, count=2, shape=shape,

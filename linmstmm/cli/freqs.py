@@ -20,6 +20,7 @@ from linmstmm.cli.common import (
     request,
     stages,
 )
+from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM
 from linmstmm.roots import MAX_RTOL, MIN_RTOL
 
 
@@ -38,8 +39,9 @@ def add_freqs_command(subparsers) -> None:
     freqs.add_argument("--engine", choices=("auto", "numpy", "compiled"), default="auto",
                        help="how det Ū_all is evaluated: the numpy carry, or numba-compiled kernels "
                             "(about 5x cheaper per evaluation in a batch, 0.5-1.5 s to start in a new "
-                            "process); auto: numpy in a new process, the kernels for a model of 1,500 "
-                            "elements or more (a beam counting three) once they are compiled here")
+                            "process); auto: numpy in a new process, the kernels where the elements (a "
+                            f"beam counting {BEAM_WEIGHT}) times the frequencies asked for reach "
+                            f"{KERNELS_PAY_FROM:,}, once they are compiled here")
     add_damped_option(freqs)
     freqs.set_defaults(run=run_freqs)
 

@@ -49,9 +49,10 @@ def add_sweep_command(subparsers) -> None:
                          help="run the steps on a dask.distributed scheduler; 'local' starts a LocalCluster")
     command.add_argument("--engine", choices=ENGINES, default=ENGINE,
                          help=f"how every step evaluates det Ubar_all (default {ENGINE}: numpy, as "
-                              "'linmstmm freqs' in a new process, unless the steps together carry elements "
-                              "enough to pay for loading the numba kernels; compiled: the kernels in every "
-                              "process, faster on long sweeps and large models)")
+                              "'linmstmm freqs' in a new process, unless the steps each process runs, times "
+                              "--count, times the model's elements make work enough to pay for loading the "
+                              "numba kernels; compiled: the kernels in every process, faster on long sweeps "
+                              "and large models)")
     command.add_argument("--warm-start", action="store_true",
                          help="start each step's root search from its neighbouring step's frequencies")
     add_output_options(command, csv_layout="one row per step (values, tracked frequencies, ranks, sensitivities)")

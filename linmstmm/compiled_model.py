@@ -29,10 +29,10 @@ from linmstmm.determinant import (
     KERNELS_PAY_FROM,
     determinant,
     kernels_loaded,
-    kernels_pay,
     load_kernels,
     resolved_engine,
     weight_at_most,
+    work_to_pay,
 )
 from linmstmm.model import Model
 from linmstmm.model_structure import MODELS_KEPT, forget_structures
@@ -103,17 +103,28 @@ def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: st
     CompiledSystem
     """
     resolved_engine(engine)  # an unknown engine is refused before anything is built
-    if engine == "auto" and not kernels_loaded() and _kernels_pay_for(model, root, tuple(cut_at), frequencies):
-        load_kernels()  # a large request: the kernels' start-up costs less than the numpy carry's solve
-    return _compiled(model, root, tuple(cut_at), engine, kernels_loaded())
+    key = (model, root, tuple(cut_at))
+    try:
+        if (engine == "auto" and not kernels_loaded() and weight_at_most(model) * frequencies >= KERNELS_PAY_FROM
+                and frequencies >= _work_to_pay(*key)):
+            load_kernels()  # a large request: the kernels' start-up costs less than the numpy carry's solve
+        return _compiled(*key, engine, kernels_loaded())
+    finally:
+        _HANDED.pop(key, None)  # not taken where the system was kept already
 
 
-def _kernels_pay_for(model: Model, root: str | None, cut_at: tuple, frequencies: int) -> bool:
-    """:func:`~linmstmm.determinant.kernels_pay` for ``frequencies`` of ``model``, its
-    topology built only where the model's size alone does not rule them out."""
-    if weight_at_most(model) * frequencies < KERNELS_PAY_FROM:
-        return False
-    return kernels_pay(Deduction(build_topology(model, root=root, cut_at=cut_at)), frequencies)
+#: (model, root, cut_at) -> a Deduction built to decide the engine (:func:`_work_to_pay`),
+#: which the build of the system that follows takes instead of building its own.
+_HANDED: dict = {}
+
+
+@functools.lru_cache(maxsize=MODELS_KEPT)
+def _work_to_pay(model: Model, root: str | None, cut_at: tuple) -> float:
+    """:func:`~linmstmm.determinant.work_to_pay` of ``model``, decided once per model object;
+    the deduction it is decided on is handed to the system's build (:data:`_HANDED`)."""
+    deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
+    _HANDED[model, root, cut_at] = deduction
+    return work_to_pay(deduction)
 
 
 @functools.lru_cache(maxsize=MODELS_KEPT)
@@ -125,8 +136,11 @@ def _compiled(model: Model, root: str | None, cut_at: tuple, engine: str, loaded
 
 
 def _compiled_now(model: Model, root: str | None, cut_at: tuple, engine: str) -> CompiledSystem:
-    """The :class:`CompiledSystem` of ``model``, built."""
-    deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
+    """The :class:`CompiledSystem` of ``model``, built (on the deduction the engine was
+    decided on, where one was built for that)."""
+    deduction = _HANDED.pop((model, root, cut_at), None)
+    if deduction is None:
+        deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
     evaluator = determinant(deduction, engine)  # compiled first: its plain Ū_all screens the probes
     scales = characteristic_frequencies(deduction.topology)  # of the elements alone: a release keeps them
     released = release_indeterminate(deduction, screen=evaluator.plain_matrix, scales=scales)
@@ -144,5 +158,6 @@ def forget_compiled_models() -> None:
     structure (:mod:`linmstmm.model_structure`) so far: the next solve of any model
     compiles it anew, as in a new process (the benchmarks time first solves so)."""
     _compiled.cache_clear()
+    _work_to_pay.cache_clear()
     coarse_pencil.cache_clear()
     forget_structures()  # the program walks, count plans and all else kept by structure

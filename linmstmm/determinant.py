@@ -31,6 +31,7 @@ kernels' start-up has them loaded for it (:func:`kernels_pay`, asked by
 """
 from __future__ import annotations
 
+import math
 import os
 import sys
 import threading
@@ -149,11 +150,19 @@ def kernels_pay(deduction: Deduction, frequencies: int, solves: int = 1) -> bool
     bool
     """
     work = frequencies * solves
-    weight = carried_weight(deduction.topology)
-    if weight * work < KERNELS_PAY_FROM:
+    if carried_weight(deduction.topology) * work < KERNELS_PAY_FROM:
         return False
+    return work >= work_to_pay(deduction)
+
+
+def work_to_pay(deduction: Deduction) -> float:
+    """The fewest frequencies (over all solves) from which :func:`kernels_pay` holds for
+    ``deduction``'s model: KERNELS_PAY_FROM over the elements it carries one at a time
+    (each beam BEAM_WEIGHT times) outside runs of a repeated cell, which the numpy carry
+    powers; inf where none are left or the kernels are not compiled on this machine."""
     powered = sum(len(run.cell) * run.repetitions for run in deduction.periodic_runs())  # never beams
-    return (weight - powered) * work >= KERNELS_PAY_FROM and kernels_compiled()
+    carried = carried_weight(deduction.topology) - powered
+    return math.ceil(KERNELS_PAY_FROM / carried) if carried > 0 and kernels_compiled() else math.inf
 
 
 def weight_at_most(model) -> int:

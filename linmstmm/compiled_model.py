@@ -123,8 +123,9 @@ def _work_to_pay(model: Model, root: str | None, cut_at: tuple) -> float:
     """:func:`~linmstmm.determinant.work_to_pay` of ``model``, decided once per model object;
     the deduction it is decided on is handed to the system's build (:data:`_HANDED`)."""
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
+    work = work_to_pay(deduction)
     _HANDED[model, root, cut_at] = deduction
-    return work_to_pay(deduction)
+    return work
 
 
 @functools.lru_cache(maxsize=MODELS_KEPT)

@@ -25,9 +25,11 @@ unknowns it was compiled for, so after a release it is compiled anew.
 where they are already loaded in this process (a long session, a parameter
 study: :func:`load_kernels`), the numpy carry otherwise, and for a model
 made mostly of one repeated cell (a long chain), whose runs the numpy carry
-powers. A model large enough that its numpy solve would cost more than the
-kernels' start-up has them loaded for it (:func:`kernels_pay`, asked by
-:func:`linmstmm.compiled_model.compiled_system`).
+powers. A request large enough that its numpy solve would cost more than the
+kernels' start-up (the model's elements times the frequencies asked for, times a
+sweep's steps: :func:`kernels_pay`, asked by
+:func:`linmstmm.compiled_model.compiled_system` and :func:`linmstmm.sweep.sweep`)
+has them loaded for it.
 """
 from __future__ import annotations
 

@@ -39,7 +39,7 @@ from linmstmm.eigenspaces import _group, _whole_last_eigenspace, null_bases
 from linmstmm.mode_fields import _Fields, _station_positions
 from linmstmm.model import Model, ModelError
 from linmstmm.results import Result, decode_array, decode_arrays, encode_array
-from linmstmm.solve import search_note, solve_roots
+from linmstmm.solve import UNRECORDED_ENGINE, search_note, solve_roots
 from linmstmm.stages import report
 from linmstmm.threads import single_blas_thread
 
@@ -95,7 +95,8 @@ class ModalResult(Result):
         rotation); with "max" they are scaled to a largest rotation of 1 rad, so
         their modal mass is a moment of inertia (``modal_mass_units``).
     engine : "numpy" or "compiled": what evaluated det Ū_all and the Ū_all whose null
-        spaces give the shapes ("auto" resolved).
+        spaces give the shapes ("auto" resolved; :data:`linmstmm.solve.UNRECORDED_ENGINE`
+        for a result saved before results recorded it).
     """
 
     model: str
@@ -265,7 +266,7 @@ class ModalResult(Result):
                    decode_arrays(data["com_displacements"], ndim=2), fields, data["normalization"],
                    data.get("note", ""),
                    np.array([unit == "kg m^2" for unit in data["modal_mass_units"]], bool)
-                   if "modal_mass_units" in data else None, data["engine"])
+                   if "modal_mass_units" in data else None, data.get("engine", UNRECORDED_ENGINE))
 
     def plot(self, model: Model, mode: int = 0):
         """One mode drawn over the undeformed ``model`` (:func:`linmstmm.plot.mode_shape_figure`).

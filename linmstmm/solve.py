@@ -27,6 +27,8 @@ ESCALATION_DIGITS = 20
 #: (within float64's reach, and no looser than MAX_XTOL): a superlinear step that
 #: small leaves an error far below rtol, which the count across the root confirms.
 XTOL_PER_RTOL = 1e-2
+#: The engine a result loaded from a file saved before results recorded theirs reports.
+UNRECORDED_ENGINE = "unrecorded"
 
 
 @dataclass(frozen=True)
@@ -44,7 +46,8 @@ class FrequencyResult(Result):
     evaluations : float64 evaluations of det Ū_all (one per frequency) the
     search and its certifying counts took.
     engine : "numpy" or "compiled": what evaluated det Ū_all in float64 ("auto"
-    resolved; :func:`linmstmm.determinant.determinant`).
+    resolved; :func:`linmstmm.determinant.determinant`); UNRECORDED_ENGINE for a
+    result saved before results recorded it.
     """
 
     model: str
@@ -94,7 +97,7 @@ class FrequencyResult(Result):
         return cls(data["model"], decode_array(data["frequencies_hz"]), data["rigid_body_modes"],
                    data["ubar_order"], data["seconds"], data["precision"], data.get("note", ""),
                    data["indeterminate_released"], data.get("frequencies_hz_text"), data.get("omega_rad_s_text"),
-                   data["evaluations"], data["engine"])
+                   data["evaluations"], data.get("engine", UNRECORDED_ENGINE))
 
     def plot(self):
         """Draw the frequencies against their mode number.
@@ -340,8 +343,11 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         used with ``count`` only, and checked by a root count either way.
     engine : str
         How det Ū_all is evaluated: "numpy", "compiled" (numba), or "auto"
-        (compiled where the kernels are already loaded in this process; see
-        :mod:`linmstmm.determinant`). The roots agree to rounding either way.
+        (compiled where the kernels are already loaded in this process, or where
+        the model's elements times ``count`` make the numpy carry slower than
+        loading them, :func:`linmstmm.determinant.kernels_pay`; see
+        :mod:`linmstmm.determinant`). The roots agree to rounding either way, and
+        ``result.engine`` says which ran.
     rtol : float or None
         Relative accuracy every frequency is certified to, MIN_RTOL to MAX_RTOL
         (1e-12 to 1e-4). None: certified to 1e-9 and every root polished to rounding.

@@ -280,3 +280,17 @@ def test_deciding_the_engine_builds_a_large_models_topology_once(monkeypatch):
     for count in (10, 20, 40):
         natural_frequencies(chain, count, engine="auto")
     assert len(built) == 1
+
+
+def test_a_result_saved_before_results_recorded_their_engine_still_loads():
+    """A frequency or modal result written before the engine was recorded loads, and says
+    its engine is unrecorded rather than guessing one."""
+    from linmstmm.modes import ModalResult, mode_shapes
+    from linmstmm.solve import UNRECORDED_ENGINE, FrequencyResult
+
+    model = load_model("models/cantilever_tip_mass.toml")
+    frequencies = natural_frequencies(model, 2).to_dict()
+    modes = mode_shapes(model, 2).to_record()
+    del frequencies["engine"], modes["engine"]
+    assert FrequencyResult.from_dict(frequencies).engine == UNRECORDED_ENGINE
+    assert ModalResult.from_dict(modes).engine == UNRECORDED_ENGINE

@@ -272,6 +272,7 @@ def test_deciding_the_engine_builds_a_large_models_topology_once(monkeypatch):
     import linmstmm.compiled_model as compiled_model_module
 
     forget_compiled_models()
+    monkeypatch.setattr(compiled_model_module, "kernels_loaded", lambda: False)  # as in a new process
     built = []
     original = compiled_model_module.build_topology
     monkeypatch.setattr(compiled_model_module, "build_topology",

@@ -95,10 +95,18 @@ def determinant(deduction: Deduction, engine: str = "auto"):
     (:func:`repeated_cells_dominate`), which only the numpy carry takes by powers
     of the cell's matrix.
     """
+    chosen = engine_for(deduction, engine)
+    return CompiledDeterminant(deduction) if chosen == "compiled" else NumpyDeterminant(deduction)
+
+
+def engine_for(deduction: Deduction, engine: str) -> str:
+    """"numpy" or "compiled": what :func:`determinant` evaluates ``deduction`` by for
+    ``engine`` in this process now (:func:`resolved_engine`; "auto" keeps the numpy carry for
+    a model made mostly of a repeated cell, :func:`repeated_cells_dominate`)."""
     chosen = resolved_engine(engine)
     if chosen == "compiled" and engine == "auto" and repeated_cells_dominate(deduction):
-        chosen = "numpy"
-    return CompiledDeterminant(deduction) if chosen == "compiled" else NumpyDeterminant(deduction)
+        return "numpy"
+    return chosen
 
 
 #: Frequencies asked for times the elements the numpy carry takes one at a time (each beam
@@ -162,8 +170,7 @@ def work_to_pay(deduction: Deduction) -> float:
     ``deduction``'s model: KERNELS_PAY_FROM over the elements it carries one at a time
     (each beam BEAM_WEIGHT times) outside runs of a repeated cell, which the numpy carry
     powers; inf where none are left or the kernels are not compiled on this machine."""
-    powered = sum(len(run.cell) * run.repetitions for run in deduction.periodic_runs())  # never beams
-    carried = carried_weight(deduction.topology) - powered
+    carried = carried_weight(deduction.topology) - powered_elements(deduction)  # runs hold no beams
     return math.ceil(KERNELS_PAY_FROM / carried) if carried > 0 and kernels_compiled() else math.inf
 
 
@@ -206,8 +213,13 @@ def repeated_cells_dominate(deduction: Deduction) -> bool:
     elements = len(deduction.topology.order)
     if elements < REPEATED_CELLS_FROM:
         return False
-    repeated = sum(len(run.cell) * run.repetitions for run in deduction.periodic_runs())
-    return repeated > elements / 2
+    return powered_elements(deduction) > elements / 2
+
+
+def powered_elements(deduction: Deduction) -> int:
+    """The transfer elements of ``deduction`` in runs of a repeated cell, which the numpy
+    carry multiplies by powers of the cell's matrix (:meth:`Deduction.periodic_runs`)."""
+    return sum(len(run.cell) * run.repetitions for run in deduction.periodic_runs())
 
 
 class EvaluationCount:

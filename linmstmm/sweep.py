@@ -41,7 +41,7 @@ from functools import partial
 import numpy as np
 
 from linmstmm.deduction import Deduction
-from linmstmm.determinant import kernels_pay, repeated_cells_dominate, resolved_engine
+from linmstmm.determinant import engine_for, kernels_loaded, kernels_pay, resolved_engine
 from linmstmm.model import Model, ModelError
 from linmstmm.parameters import get_value, parse_key, with_values
 from linmstmm.results import Result, decode_array, decode_arrays
@@ -443,12 +443,11 @@ def _step_engine(model: Model, engine: str, count: int, steps: int) -> str:
     model mostly of repeated cells even with the kernels loaded), and taking the kernels
     where the ``steps`` solves of ``count`` frequencies each process runs carry elements
     enough (:func:`linmstmm.determinant.kernels_pay`)."""
-    resolved = resolved_engine(engine)
     if engine != "auto":
-        return resolved
+        return resolved_engine(engine)
     deduction = Deduction(build_topology(model))
-    if resolved == "compiled":
-        return "numpy" if repeated_cells_dominate(deduction) else "compiled"
+    if kernels_loaded():
+        return engine_for(deduction, engine)
     return "compiled" if kernels_pay(deduction, count, steps) else "numpy"
 
 

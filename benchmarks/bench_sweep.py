@@ -117,6 +117,7 @@ def write_report(path, command, result, runs, agreement, varies, commands) -> No
     steps = len(result.values)
     swapped = int(np.sum(np.any(result.order != np.arange(result.order.shape[1]), axis=1)))
     facts = machine_facts()
+    weight = launcher_weight()
     load = ", ".join(f"{v:.1f}" for v in os.getloadavg())
     lines = [
         "# Parameter sweep of the launcher",
@@ -161,8 +162,8 @@ def write_report(path, command, result, runs, agreement, varies, commands) -> No
          "where the steps times the frequencies per step times the elements carried one at a time, "
          f"each beam counted {BEAM_WEIGHT} times, reach {KERNELS_PAY_FROM:,} "
          "(`linmstmm.determinant.kernels_pay`; the launcher counts "
-         f"{launcher_weight()}, so at {result.order.shape[1]} frequencies a step from "
-         f"{-(-KERNELS_PAY_FROM // (launcher_weight() * result.order.shape[1]))} steps), "
+         f"{weight}, so at {result.order.shape[1]} frequencies a step from "
+         f"{-(-KERNELS_PAY_FROM // (weight * result.order.shape[1]))} steps), "
          "and they are compiled on the machine; else the numpy carry. "
          "`linmstmm sweep` of the launcher over one range of "
          f"`{PARAMETERS[0][0]}`, lowest {result.order.shape[1]}, each run a new process "

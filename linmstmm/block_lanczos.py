@@ -42,6 +42,12 @@ PRECISION = 1e-8
 #: launchers' predicting meshes needed 1.5 (90 wanted) to 1.7 (68 wanted); each
 #: check costs a dense eigensolve of the Rayleigh quotient (2 ms at 180).
 FIRST_CHECK = 1.7
+#: The subspace's largest size, per wanted eigenvalue (and at least FEWEST_MOST), beyond
+#: which there is no answer: its basis is allocated at that size (n of them on a pencil
+#: of n unknowns took n² floats, 3.2 GB on 20,000), and the launchers' meshes converge
+#: by 1.7 per wanted.
+MOST_PER_WANTED = 8
+FEWEST_MOST = 64
 #: Between checks the subspace grows by this fraction of itself (at least a block).
 GROWTH = 0.125
 #: A new block whose M-norms' Cholesky factor has a diagonal ratio below this is
@@ -68,8 +74,8 @@ def lowest_eigenvalues(K, M, count: int, shift: float, seed: int = 0) -> np.ndar
     Returns
     -------
     numpy.ndarray, shape (count,), ascending; or None where the subspace would
-    outgrow the pencil before converging, K + shift M is singular, or the basis
-    becomes numerically dependent.
+    outgrow the pencil (or MOST_PER_WANTED vectors per wanted eigenvalue) before
+    converging, K + shift M is singular, or the basis becomes numerically dependent.
     """
     converged = _converged(K, M, count, shift, seed)
     return None if converged is None else np.sort(1.0 / converged[0] - shift)
@@ -100,7 +106,7 @@ def _converged(K, M, count: int, shift: float, seed: int):
     from scipy.sparse.linalg import splu  # imported where used: the command line starts without it
 
     n = K.shape[0]
-    capacity = n - n % BLOCK
+    capacity = min(n - n % BLOCK, max(MOST_PER_WANTED * count, FEWEST_MOST) // BLOCK * BLOCK)
     check = max(int(FIRST_CHECK * count), count + BLOCK)
     if check > capacity:
         return None

@@ -32,6 +32,12 @@ WAVE_PER_ELEMENT = 1.0
 #: scan-based search runs): its dense eigenproblem grows as their cube, and a chain
 #: of 1000 bodies took 3.5 s to predict what the search finds in 0.1 s.
 MAX_UNKNOWNS = 1500
+#: Unknowns beyond MAX_UNKNOWNS up to which the sparse route alone predicts (block
+#: shift-invert Lanczos, one element per beam: :func:`_predicted_modes`): a cantilever of
+#: 300 beams (1,806 unknowns) its 25 lowest in 27 ms, from which its 20 lowest took 130
+#: evaluations of det Ū_all, where the scan took 597; of 3,000 beams (18,006) 0.74 s
+#: in all, against 2.5 s.
+MAX_SPARSE_UNKNOWNS = 20000
 #: A direction of the coarse (K, M) whose images are both below this fraction of
 #: their largest entries moves neither stiffness nor mass (:func:`_regular_pencil`).
 SINGULAR_PENCIL = 1e-12
@@ -60,12 +66,16 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
     −shift (:mod:`linmstmm.block_lanczos`, to the prediction's accuracy: on the
     second launcher's 1284 unknowns its 112 lowest in 19 ms, against 54 ms by
     ARPACK to machine precision and far more dense, whose Cholesky route's lowest
-    eigenvalue was 2.8e-3 off there).
+    eigenvalue was 2.8e-3 off there); about 0 without a shift where the mesh has more
+    than DENSE_PREDICTION unknowns and no rigid-body mode (a cantilever of 100 beams,
+    1,200 unknowns: its 25 lowest in 12 ms, 8e-9 from the closed form, against 0.42 s
+    dense, 2.3e-5 off).
     The lowest as many as the FE model has rigid-body modes are theirs, and dropped
     (a threshold relative to the largest would drop a soft strip's first bending
     modes with them).
-    Returns (m,) ascending, m <= count (fewer if the model has fewer); none for
-    a model of more than MAX_UNKNOWNS unknowns.
+    Returns (m,) ascending, m <= count (fewer if the model has fewer); for a mesh
+    of more than MAX_UNKNOWNS unknowns, only what the sparse route gives (up to
+    MAX_SPARSE_UNKNOWNS; none with a rigid-body mode and no shift).
     """
     return coarse_modes(model, count, elements_per_beam, shift, nodal=False).values
 
@@ -117,17 +127,24 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     (:attr:`~linmstmm.scaled_pencil.CoarsePencil.rounding_level`) is zero, whatever sign
     the eigensolver gave it: no prediction (:func:`linmstmm.roots.floor.usable`).
     """
-    if elements_per_beam > _finest_mesh(model):  # a dense solve would cost more than the search it saves
-        return PredictedModes(np.zeros(0), None)
+    dense = elements_per_beam <= _finest_mesh(model)  # else a dense solve costs more than the search saves
+    if not dense and (_unknowns(model, elements_per_beam) > MAX_SPARSE_UNKNOWNS or not _points_carry_mass(model)):
+        return PredictedModes(np.zeros(0), None)  # (the sparse route's pencil unassembled)
     pencil = coarse_pencil(model, elements_per_beam)
     if pencil.size == 0:  # every point held: no unknown, no mode (LAPACK takes no empty matrix)
         return PredictedModes(np.zeros(0), None)
     rigid = pencil.rigid_body_modes
+    if shift is None and rigid == 0 and pencil.size > DENSE_PREDICTION:
+        shift = 0.0  # K positive definite: the sparse route about 0
+    if not dense and not _sparse_route(pencil, shift):
+        return PredictedModes(np.zeros(0), None)
     wanted = min(count + rigid, pencil.size)
     now = nodal and not (later and _bisected(pencil, wanted, shift))
     loose = accuracy is not None and later and not now  # (λ = ω²: twice ω's accuracy)
     lam, vectors, reduced, bisection = _lowest_eigenvalues(pencil, wanted, shift, now,
-                                                           2.0 * accuracy if loose else None)
+                                                           2.0 * accuracy if loose else None, dense)
+    if lam is None:
+        return PredictedModes(np.zeros(0), None)
     if reduced and pencil.reduced is not None:  # (else QZ, or the sparse route's Ritz values)
         lam = np.where(np.abs(lam) <= pencil.rounding_level, 0.0, lam)  # rounding, whatever its sign
     order = np.argsort(lam)[rigid:rigid + count]
@@ -176,6 +193,23 @@ def _forget_pencils() -> None:
 coarse_pencil.cache_clear = _forget_pencils
 
 
+def _unknowns(model: Model, elements_per_beam: int) -> int:
+    """Unknowns of ``model``'s FE model of ``elements_per_beam``, before its constraints
+    are eliminated: six per point, body and interior beam node."""
+    return 6 * (len(model.points) + len(model.rigids) + (elements_per_beam - 1) * len(model.beams))
+
+
+def _points_carry_mass(model: Model) -> bool:
+    """Whether every point of ``model`` is a beam's end, a rigid body's port or held in
+    all six components: else it is likely an unknown without mass (a point between two
+    springs), which the sparse route cannot take (:func:`_sparse_route`) and whose
+    pencil is then not worth assembling (a chain of 1,000 springs and bodies: 0.13 s)."""
+    carried = {point for beam in model.beams for point in beam.ends}
+    carried.update(point for body in model.rigids for point in body.ports)
+    carried.update(point for point, held in model.boundary.items() if np.all(held))
+    return carried.issuperset(model.points)
+
+
 def _finest_mesh(model: Model) -> int:
     """The most elements per beam whose predicting FE model has at most MAX_UNKNOWNS
     unknowns (6 per point, body and interior beam node); below 1 where even one is too many."""
@@ -203,7 +237,8 @@ def _regular_pencil(K: np.ndarray, M: np.ndarray):
 
 
 def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None, vectors: bool = False,
-                        accuracy: float | None = None) -> tuple[np.ndarray, np.ndarray | None, bool, Bisection | None]:
+                        accuracy: float | None = None,
+                        dense: bool = True) -> tuple[np.ndarray | None, np.ndarray | None, bool, Bisection | None]:
     """(at least the ``count`` lowest eigenvalues of ``pencil`` (K, M), (rad/s)², in
     any order; their eigenvectors (n, m) if ``vectors`` asks and the route gives them,
     else None; whether those are of :attr:`CoarsePencil.reduced` (y), not of the scaled
@@ -214,11 +249,15 @@ def _lowest_eigenvalues(pencil: CoarsePencil, count: int, shift: float | None, v
     mass and there are more than DENSE_PREDICTION; else on the kept standard form
     (:func:`~linmstmm.standard_eigen.lowest_eigenpairs`, y); by QZ where M is singular,
     the infinite eigenvalues dropped, without vectors. ``accuracy``: as
-    :func:`~linmstmm.standard_eigen.lowest_eigenpairs` takes it, of the eigenvalues."""
+    :func:`~linmstmm.standard_eigen.lowest_eigenpairs` takes it, of the eigenvalues.
+    Unless ``dense`` allows the dense routes, (None, None, False, None) where the
+    sparse one gives no answer."""
     if _sparse_route(pencil, shift):
         found = _sparse_lowest(pencil, count, shift, vectors)
         if found is not None:
             return *found, False, None
+    if not dense:
+        return None, None, False, None
     if pencil.reduced is None:  # massless unknowns: QZ, their eigenvalues infinite
         K, M = _regular_pencil(pencil.K, pencil.M)
         lam = scipy.linalg.eigvals(K, M)
@@ -351,18 +390,22 @@ def _predicted_modes(model: Model, count: int, nodal: bool, later: bool = False,
                      accuracy: float | None = None) -> PredictedModes:
     """:func:`predicted_modes` made anew (the modes at the nodes only if ``nodal``, now or
     ``later`` where they can come so): two elements per beam, or as many as the highest
-    frequency's bending waves need. The two-element mesh's frequencies decide; its
+    frequency's bending waves need; one per beam where even two are beyond the dense
+    route (MAX_UNKNOWNS), by the sparse one alone (:func:`coarse_modes`: a model of
+    that many beams has short ones; a chain of 1,000 beams' 25 lowest in 10 ms, against
+    21 ms on two). The first mesh's frequencies decide; its
     modes come with them where bisection finds them (up to BISECTED) and they are
     wanted now, else only where no finer mesh follows. (Where every eigenvalue is
     wanted, syevx's frequencies with the vectors and without differ at rounding,
     1e-13 on a varied model's 24 unknowns, and the finer mesh's shift with them.)"""
-    with_first = nodal and not later and count <= BISECTED
-    predicted = coarse_modes(model, count, 2, nodal=with_first, later=later, accuracy=accuracy)
-    needed = 2
+    first = 2 if _finest_mesh(model) >= 2 else 1  # beyond the dense route's reach the sparse one's, coarsest
+    with_first = nodal and not later and (count <= BISECTED or first == 1)  # (sparse: Ritz vectors)
+    predicted = coarse_modes(model, count, first, nodal=with_first, later=later, accuracy=accuracy)
+    needed = first
     if model.beams and predicted.values.size:
         beta_L = max(bending_wavenumber(beam, predicted.values[-1]) * beam.length for beam in model.beams)
-        needed = min(int(np.ceil(beta_L / WAVE_PER_ELEMENT)), MAX_ELEMENTS, max(_finest_mesh(model), 2))
-    if needed > 2 * 2:
+        needed = min(int(np.ceil(beta_L / WAVE_PER_ELEMENT)), MAX_ELEMENTS, max(_finest_mesh(model), first))
+    if needed > 2 * first:
         return coarse_modes(model, count, needed, shift=0.5 * predicted.values[0] ** 2, nodal=nodal, later=later,
                             accuracy=accuracy)
     if with_first or not nodal or (later and predicted.later is not None):

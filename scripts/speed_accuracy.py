@@ -319,6 +319,7 @@ def scaling(kind: str, sizes, count: int, fe_auto_max: int, quick: bool) -> list
         else:
             row.update(solve=seconds, solve_cpu=cpu, solve_runs=runs,
                        solve_error=max_relative_error(result.frequencies_hz, reference), precision=result.precision,
+                       per_root=result.evaluations / count,
                        compiled=result.engine == "compiled")
         fe_options = dict(elements_per_beam=1, estimate_error=False) if kind == "beam" else {}
         seconds, result, _, cpu = best_of(lambda: fe_frequencies(model, count, **fe_options), 3, 2.0)
@@ -976,7 +977,10 @@ def write_report(args, command, facts, loads, elapsed, beam_model, beam_referenc
       "*compiled*: with `engine=\"auto\"`, the default, a request whose elements carried one at a time "
       f"(each beam counted {BEAM_WEIGHT} times) times the frequencies asked for reach {KERNELS_PAY_FROM:,} "
       "(`linmstmm.determinant.kernels_pay`) has the compiled kernels loaded for it, so from the first such "
-      "beam chain on this process solves by them, as a new process would solve that chain. FE = `fe_frequencies(model, 20)`: exact "
+      "beam chain on this process solves by them, as a new process would solve that chain; its evaluations "
+      "of det Ū_all per root beside it (from the coarse FE predictions where there are any: on the beam chains "
+      "one element per beam by the sparse Lanczos beyond 1,500 unknowns, `linmstmm/coarse_prediction.py`). "
+      "FE = `fe_frequencies(model, 20)`: exact "
       "for springs; for beam chains one element per beam (the same element count, but a coarse "
       f"discretisation: see its error), and the automatic refinement up to N = {args.fe_auto_max}.")
     w("")
@@ -991,8 +995,9 @@ def write_report(args, command, facts, loads, elapsed, beam_model, beam_referenc
         w(f"**{title}**, first 20 frequencies")
         w("")
         w("| N | build (topology + deduction) | det / frequency, batch 64 | det, single | det / freq., plain | "
-          "MSTMM solve (CPU) | error | FE solve | FE error |" + (" FE auto | FE auto error |" if rows is beams else ""))
-        w("|---:|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|---:|" if rows is beams else ""))
+          "MSTMM solve (CPU) | evaluations / root | error | FE solve | FE error |"
+          + (" FE auto | FE auto error |" if rows is beams else ""))
+        w("|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|" + ("---:|---:|" if rows is beams else ""))
         for r in rows:
             extra = ""
             if rows is beams:
@@ -1000,7 +1005,7 @@ def write_report(args, command, facts, loads, elapsed, beam_model, beam_referenc
                          if "fe_auto" in r else " — | — |")
             w(f"| {r['n']:,} | {fmt_time(r['build'])} | {fmt_time(r['det_batch_cpu'])} | {fmt_time(r['det_single_cpu'])}"
               f" | {fmt_time(r['det_batch_plain_cpu'])} | {fmt_time(r['solve'])} ({fmt_time(r['solve_cpu'])})"
-              f"{' compiled' if r.get('compiled') else ''} | "
+              f"{' compiled' if r.get('compiled') else ''} | {r.get('per_root', np.nan):.1f} | "
               f"{fmt_error(r['solve_error'])} | {fmt_time(r['fe'])} | {fmt_error(r['fe_error'])} |" + extra)
         w("")
         two_engines = any(r.get("compiled") for r in rows)  # the solve's rows: no one exponent

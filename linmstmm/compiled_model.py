@@ -20,27 +20,30 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 
-from linmstmm.coarse_prediction import coarse_pencil
+from linmstmm.coarse_prediction import coarse_pencil, predicted_modes
 from linmstmm.collector import collector_paused
 from linmstmm.counting import count_in_disc
 from linmstmm.deduction import Deduction
 from linmstmm.determinant import (
     FREQUENCIES_ASSUMED,
     KERNELS_PAY_FROM,
+    PREDICTED_PAY_FROM,
+    carried_alone,
     determinant,
+    kernels_compiled,
     kernels_loaded,
     load_kernels,
     resolved_engine,
     weight_at_most,
-    work_to_pay,
 )
 from linmstmm.model import Model
 from linmstmm.model_structure import MODELS_KEPT, forget_structures
+from linmstmm.prediction_groups import coinciding
 from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
 from linmstmm.rigid_motion import held_still, rigid_body_mode_count
-from linmstmm.roots.settings import FLOOR_RATIO
+from linmstmm.roots.settings import FLOOR_RATIO, predictions_wanted
 from linmstmm.topology import build_topology
-from linmstmm.wittrick_williams import ModeCounter, mode_counter
+from linmstmm.wittrick_williams import ModeCounter, mode_counter, too_large_to_count
 
 @dataclass(frozen=True, eq=False)
 class CompiledSystem:
@@ -78,7 +81,7 @@ class CompiledSystem:
 
 
 def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: str = "auto",
-                    frequencies: int = FREQUENCIES_ASSUMED) -> CompiledSystem:
+                    frequencies: int = FREQUENCIES_ASSUMED, predicted: bool = False) -> CompiledSystem:
     """The :class:`CompiledSystem` of ``model``: made on the first call for this model
     object (and root, cuts, engine), the same object after.
 
@@ -93,10 +96,15 @@ def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: st
         system made for "auto" before the kernels were loaded is not taken for one
         made after). Where the numpy carry would take longer than the kernels'
         start-up to find ``frequencies`` of ``model``
-        (:func:`~linmstmm.determinant.kernels_pay`), "auto" loads them first, and a
-        later call for the same model, finding them loaded, makes its system once more.
+        (:func:`~linmstmm.determinant.kernels_pay`; PREDICTED_PAY_FROM for a search
+        polishing predictions without a counter, :func:`_kernels_pay`), "auto" loads
+        them first, and a later call for the same model, finding them loaded, makes its
+        system once more.
     frequencies : int
         Natural frequencies the solve asks for (what the kernels would save grows with them).
+    predicted : bool
+        Whether the search is for the lowest ``frequencies`` from the coarse predictions
+        (a count without guesses), not a scan of a range.
 
     Returns
     -------
@@ -106,26 +114,50 @@ def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: st
     key = (model, root, tuple(cut_at))
     try:
         if (engine == "auto" and not kernels_loaded() and weight_at_most(model) * frequencies >= KERNELS_PAY_FROM
-                and frequencies >= _work_to_pay(*key)):
+                and _kernels_pay(key, frequencies, predicted)):
             load_kernels()  # a large request: the kernels' start-up costs less than the numpy carry's solve
         return _compiled(*key, engine, kernels_loaded())
     finally:
         _HANDED.pop(key, None)  # not taken where the system was kept already
 
 
-#: (model, root, cut_at) -> a Deduction built to decide the engine (:func:`_work_to_pay`),
+def _kernels_pay(key: tuple, frequencies: int, predicted: bool) -> bool:
+    """Whether the kernels pay for a solve of the (model, root, cut_at) ``key`` asking for
+    ``frequencies``: where they are compiled on this machine and the elements carried one
+    at a time times ``frequencies`` reach KERNELS_PAY_FROM, or PREDICTED_PAY_FROM where the
+    search (``predicted``) polishes predictions without a Wittrick–Williams counter
+    (:func:`_polished_without_counter`), whose predictions the solve then takes as made here."""
+    work = _carried_alone(*key) * frequencies
+    if work < KERNELS_PAY_FROM or not kernels_compiled():
+        return False
+    return work >= PREDICTED_PAY_FROM or not (predicted and _polished_without_counter(key[0], frequencies))
+
+
+def _polished_without_counter(model: Model, frequencies: int) -> bool:
+    """Whether the search for the lowest ``frequencies`` of ``model`` polishes its coarse
+    predictions (:func:`~linmstmm.coarse_prediction.predicted_modes`, made and kept for the
+    solve) and has no Wittrick–Williams counter for certain
+    (:func:`~linmstmm.wittrick_williams.too_large_to_count`: a model with one counts and
+    refines by the numpy engine too, which the kernels make far cheaper): there are as
+    many predictions and none coincide (:meth:`~linmstmm.roots.RootFinder._separable`)."""
+    if not too_large_to_count(model):
+        return False
+    values = predicted_modes(model, predictions_wanted(frequencies)).values
+    return values.size >= frequencies and not coinciding(values)
+
+
+#: (model, root, cut_at) -> a Deduction built to decide the engine (:func:`_carried_alone`),
 #: which the build of the system that follows takes instead of building its own.
 _HANDED: dict = {}
 
 
 @functools.lru_cache(maxsize=MODELS_KEPT)
-def _work_to_pay(model: Model, root: str | None, cut_at: tuple) -> float:
-    """:func:`~linmstmm.determinant.work_to_pay` of ``model``, decided once per model object;
-    the deduction it is decided on is handed to the system's build (:data:`_HANDED`)."""
+def _carried_alone(model: Model, root: str | None, cut_at: tuple) -> int:
+    """:func:`~linmstmm.determinant.carried_alone` of ``model``, decided once per model
+    object; the deduction it is decided on is handed to the system's build (:data:`_HANDED`)."""
     deduction = Deduction(build_topology(model, root=root, cut_at=cut_at))
-    work = work_to_pay(deduction)
     _HANDED[model, root, cut_at] = deduction
-    return work
+    return carried_alone(deduction)
 
 
 @functools.lru_cache(maxsize=MODELS_KEPT)
@@ -159,6 +191,6 @@ def forget_compiled_models() -> None:
     structure (:mod:`linmstmm.model_structure`) so far: the next solve of any model
     compiles it anew, as in a new process (the benchmarks time first solves so)."""
     _compiled.cache_clear()
-    _work_to_pay.cache_clear()
+    _carried_alone.cache_clear()
     coarse_pencil.cache_clear()
     forget_structures()  # the program walks, count plans and all else kept by structure

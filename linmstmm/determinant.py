@@ -33,7 +33,6 @@ has them loaded for it.
 """
 from __future__ import annotations
 
-import math
 import os
 import sys
 import threading
@@ -114,7 +113,9 @@ def engine_for(deduction: Deduction, engine: str) -> str:
 #: ``engine="auto"`` loads the kernels in a process that has not (:func:`kernels_pay`): the
 #: numpy carry's work grows with both, the kernels' start-up (0.5-1.1 s) does not. Measured
 #: end to end, ``linmstmm freqs FILE --count C`` in new processes, numpy against the kernels
-#: (cached), best of 2: cantilevers of 100 beam elements, C = 5, 10, 20, 40: 0.82/1.36,
+#: (cached), best of 2, while those models were searched by the scan (as a round
+#: cantilever's double roots still are; PREDICTED_PAY_FROM for the searches from
+#: predictions that replaced it): cantilevers of 100 beam elements, C = 5, 10, 20, 40: 0.82/1.36,
 #: 0.70/1.20, 0.81/1.27, 1.23/1.51 s; of 200: 0.85/1.12, 0.99/1.10, 1.81/1.32, 3.26/1.65 s;
 #: of 300: 1.15/1.23, 1.57/1.15, 2.44/1.37, 17.7/1.75 s (the numpy carry's 6,677 evaluations
 #: of a scan above the predictions' reach); earlier, best of 5 to 11: 500 beam elements
@@ -128,6 +129,15 @@ def engine_for(deduction: Deduction, engine: str) -> str:
 #: 25 steps 1.50/2.02 s, 50 steps 2.14/2.40 s, 100 steps 3.51/2.97 s (even near 60 steps,
 #: 10,200; the rule takes the kernels from 53).
 KERNELS_PAY_FROM = 9000
+#: KERNELS_PAY_FROM for a search that polishes its coarse FE predictions without a
+#: Wittrick–Williams counter (a large model: :func:`linmstmm.compiled_model.compiled_system`
+#: looks): it takes 3.5 to 7 evaluations a root, not a scan's 30 to 50, so the numpy carry
+#: stays ahead longer. Measured as above: cantilevers of 100 beams, C = 10, 20, 40:
+#: 0.71/1.07, 0.67/1.22, 1.20/1.47 s; of 300, C = 10, 20, 40, 80: 0.98/1.45, 1.07/1.68,
+#: 1.54/1.59, 2.48/1.79 s; of 1,000, C = 10, 20, 40: 1.38/1.51, 2.02/1.62, 3.21/2.13 s;
+#: of 3,000, C = 10: 3.50/1.87 s. Even at 30,000 (1,000 beams, C = 10) to 36,000 (300
+#: beams, C = 40).
+PREDICTED_PAY_FROM = 30000
 #: Frequencies a request is taken to ask for where it names no count (a range up to fmax)
 #: and its beams' clamped modes do not promise more: the commands' default count.
 FREQUENCIES_ASSUMED = 10
@@ -162,16 +172,14 @@ def kernels_pay(deduction: Deduction, frequencies: int, solves: int = 1) -> bool
     work = frequencies * solves
     if carried_weight(deduction.topology) * work < KERNELS_PAY_FROM:
         return False
-    return work >= work_to_pay(deduction)
+    return carried_alone(deduction) * work >= KERNELS_PAY_FROM and kernels_compiled()
 
 
-def work_to_pay(deduction: Deduction) -> float:
-    """The fewest frequencies (over all solves) from which :func:`kernels_pay` holds for
-    ``deduction``'s model: KERNELS_PAY_FROM over the elements it carries one at a time
-    (each beam BEAM_WEIGHT times) outside runs of a repeated cell, which the numpy carry
-    powers; inf where none are left or the kernels are not compiled on this machine."""
-    carried = carried_weight(deduction.topology) - powered_elements(deduction)  # runs hold no beams
-    return math.ceil(KERNELS_PAY_FROM / carried) if carried > 0 and kernels_compiled() else math.inf
+def carried_alone(deduction: Deduction) -> int:
+    """The elements ``deduction``'s model carries one at a time (each beam BEAM_WEIGHT
+    times) outside runs of a repeated cell, which the numpy carry powers: the weight
+    :func:`kernels_pay` holds against KERNELS_PAY_FROM."""
+    return carried_weight(deduction.topology) - powered_elements(deduction)  # runs hold no beams
 
 
 def weight_at_most(model) -> int:

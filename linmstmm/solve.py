@@ -114,7 +114,7 @@ class FrequencyResult(Result):
 
 
 def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: str = "auto",
-                     frequencies: int = FREQUENCIES_ASSUMED, **options):
+                     frequencies: int = FREQUENCIES_ASSUMED, predicted: bool = False, **options):
     """The deduced system of ``model`` and a new root finder on its stable determinant.
 
     The system is compiled once per model object (:func:`~linmstmm.compiled_model.compiled_system`:
@@ -124,7 +124,8 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     (:func:`linmstmm.determinant.determinant`; kept as ``finder.determinant``
     with its count of evaluations); the deduction's own numpy carry serves
     mode shapes and the mpmath refinement either way.
-    frequencies : how many the search is to find (for "auto", :func:`~linmstmm.compiled_model.compiled_system`).
+    frequencies, predicted : how many the search is to find, and whether it is for the lowest
+    that many from the coarse predictions (for "auto", :func:`~linmstmm.compiled_model.compiled_system`).
     root, cut_at : see :func:`linmstmm.topology.build_topology`. options go to
     :class:`linmstmm.roots.RootFinder` (xtol, points_per_octave, points_per_root, rtol).
     The finder knows the rigid-body modes (counted from the model's kinematics)
@@ -139,7 +140,7 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     depends on the units the model is written in.
     Returns (deduction, finder, number of indeterminate unknowns released).
     """
-    system = compiled_system(model, root, cut_at, engine, frequencies)
+    system = compiled_system(model, root, cut_at, engine, frequencies, predicted)
     evaluator = system.determinant
     finder = RootFinder(evaluator.log_det, lambda omega: evaluator.matrix(omega)[0],
                         rigid_body_modes=system.rigid_body_modes,
@@ -271,7 +272,9 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
                                         "unpolished": True}
     frequencies = count if count is not None else max(clamped_modes_below(model, 2 * np.pi * fmax),
                                                       FREQUENCIES_ASSUMED)  # a range: at least its clamped modes
-    deduction, finder, released = frequency_finder(model, root, engine=engine, frequencies=frequencies, **accuracy)
+    predicted = count is not None and guess_hz is None  # (else a scan, or a search from the guesses)
+    deduction, finder, released = frequency_finder(model, root, engine=engine, frequencies=frequencies,
+                                                   predicted=predicted, **accuracy)
     report("finding roots")
     abandoned = 0  # evaluations of a search made again at the default accuracy
     try:
@@ -285,7 +288,8 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
         # count by the argument principle), the search is made again at the default accuracy.
         report("searching again at the default accuracy")
         abandoned = finder.determinant.evaluations
-        deduction, finder, released = frequency_finder(model, root, engine=engine, frequencies=frequencies)
+        deduction, finder, released = frequency_finder(model, root, engine=engine, frequencies=frequencies,
+                                                       predicted=predicted)
         search = _searched(finder, count, fmax, guess_hz)
     omegas, unseparated = search.roots, dict(search.unseparated)
     # (a root no Newton step reached has a NaN step: it is in unseparated)
@@ -345,8 +349,9 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         How det Ū_all is evaluated: "numpy", "compiled" (numba), or "auto"
         (compiled where the kernels are already loaded in this process, or where
         the model's elements times ``count`` make the numpy carry slower than
-        loading them, :func:`linmstmm.determinant.kernels_pay`; see
-        :mod:`linmstmm.determinant`). The roots agree to rounding either way, and
+        loading them, :func:`linmstmm.determinant.kernels_pay`, later where a large
+        model's search polishes its predictions without a counter,
+        :func:`linmstmm.compiled_model.compiled_system`; see :mod:`linmstmm.determinant`). The roots agree to rounding either way, and
         ``result.engine`` says which ran.
     rtol : float or None
         Relative accuracy every frequency is certified to, MIN_RTOL to MAX_RTOL

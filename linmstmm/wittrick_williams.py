@@ -53,44 +53,40 @@ from linmstmm.model import Model
 from linmstmm.model_structure import KeptByKey
 from linmstmm.spread import spread
 
-#: Largest order of D(ω) counted: its dense factorisation grows as n³ (72 unknowns:
-#: 75 µs, 120: 160 µs compiled), and a count is made twice per root; a longer model
-#: (a chain of 1,000 bodies: 3,000 unknowns, 12.8 s instead of 0.13 s) is counted by
-#: the argument principle, whose evaluations the periodic carry keeps cheap. (The
-#: compiled count is sparse, but leaves the frequencies where its pivots are not
-#: safe to the dense factorisation.)
+#: Largest order of D(ω) counted: its dense factorisation grows as n³ (72 unknowns: 75 µs, 120:
+#: 160 µs compiled), and a count is made twice per root; a longer model (a chain of 1,000 bodies:
+#: 3,000 unknowns, 12.8 s instead of 0.13 s) is counted by the argument principle. (The compiled
+#: count is sparse, but leaves frequencies where its pivots are not safe to the dense one.)
 MAX_ORDER = 150
 
-#: A pivot of the equilibrated D(ω) below this, relative to the largest term that
-#: entered it, is rounding: ω is at a natural frequency to float64's eyes, and the
-#: count is left undecided; D(ω) is also counted shifted by ± this much, and the two
-#: counts must agree. Well above the factorisation's own rounding (order n·eps, 2e-14
-#: for the launcher's 72 unknowns). At 1e-11 the counts ±1e-9 beside 5 of the
-#: launcher's 10 lowest roots were undecided (they were certified at ±1e-8); at 1e-12
-#: all 10 decide. Beside the 8 lowest roots of 77 random and varied models (6,130
-#: counts 1e-9 to 1e-5 from them) 1e-11, 1e-12 and 1e-13 all gave no wrong count,
-#: leaving 2,333, 1,639 and 1,189 undecided.
+#: A pivot of the equilibrated D(ω) below this, relative to the largest term that entered it, is
+#: rounding: ω is at a natural frequency to float64's eyes, and the count is left undecided; D(ω) is
+#: also counted shifted by ± this much, and the two counts must agree. Well above the
+#: factorisation's own rounding (order n·eps, 2e-14 for the launcher's 72 unknowns). At 1e-11 the
+#: counts ±1e-9 beside 5 of the launcher's 10 lowest roots were undecided (they were certified at
+#: ±1e-8); at 1e-12 all 10 decide. Beside the 8 lowest roots of 77 random and varied models (6,130
+#: counts 1e-9 to 1e-5 from them) 1e-11, 1e-12 and 1e-13 all gave no wrong count, leaving 2,333,
+#: 1,639 and 1,189 undecided.
 SINGULAR_PIVOT = 1e-12
 
-#: The compiled count's sparse LDLᵀ without pivoting leaves D(ω) to the dense
-#: Bunch–Kaufman factorisation where an entry of diag(|L| |D| |L|ᵀ) is above this
-#: times the largest equilibrated term. Below it the factorisation's rounding, of
-#: order (entries of a column of L, at most 10 on the launchers) · 1.1e-16 · growth,
-#: about 1e-13 at the bound, stays well below SINGULAR_PIVOT, and a count it
-#: decides is the inertia the dense factorisation finds. Without the bound a 4 × 4 matrix whose first pivot is
-#: 1.2e-11 counts 2 negative eigenvalues where there is 1 (tests/test_sparse_count.py).
+#: The compiled count's sparse LDLᵀ without pivoting leaves D(ω) to the dense Bunch–Kaufman
+#: factorisation where an entry of diag(|L| |D| |L|ᵀ) is above this times the largest equilibrated
+#: term. Below it the factorisation's rounding, of order (entries of a column of L, at most 10 on
+#: the launchers) · 1.1e-16 · growth, about 1e-13 at the bound, stays well below SINGULAR_PIVOT, and
+#: a count it decides is the inertia the dense factorisation finds. Without the bound a 4 × 4 matrix
+#: whose first pivot is 1.2e-11 counts 2 negative eigenvalues where there is 1
+#: (tests/test_sparse_count.py).
 MOST_GROWTH = 1e2
 
-#: Counts below which a batch stays on the calling thread (:func:`linmstmm.spread.spread`):
-#: a compiled count costs about a third of an evaluation of det Ū_all, so handing one to
-#: another thread pays three times later. Measured side by side on the launchers (their
-#: 20 to 23 counts) and the 18 firing scenes (14 a scene): spread from 8 counts, a solve
-#: of the ten lowest took 4.3-4.8 and 6.4-7.0 ms and the scenes 125-128 ms; from 24,
-#: 3.8 and 5.9 ms and 110 ms, as on one thread.
+#: Counts below which a batch stays on the calling thread (:func:`linmstmm.spread.spread`): a
+#: compiled count costs about a third of an evaluation of det Ū_all, so handing one to another
+#: thread pays three times later. Measured side by side on the launchers (their 20 to 23 counts) and
+#: the 18 firing scenes (14 a scene): spread from 8 counts, a solve of the ten lowest took 4.3-4.8
+#: and 6.4-7.0 ms and the scenes 125-128 ms; from 24, 3.8 and 5.9 ms and 110 ms, as on one thread.
 COUNT_BATCH = 24
 
-#: Frequencies whose D(ω) the numpy engine forms at once (:meth:`ModeCounter.prefetch`):
-#: one at a time, forming D(ω) took 176 of the 308 µs of a count on the launcher.
+#: Frequencies whose D(ω) the numpy engine forms at once (:meth:`ModeCounter.prefetch`): one at a
+#: time, forming D(ω) took 176 of the 308 µs of a count on the launcher.
 NUMPY_BATCH = 64
 
 
@@ -103,13 +99,17 @@ def _stiffness_kernels():
 
 
 def mode_counter(model: Model, engine: str = "auto") -> ModeCounter | None:
-    """The :class:`ModeCounter` of ``model``, or None where D(ω) would be larger than
-    MAX_ORDER (decided from the nodes before anything is built, then from the order
-    after the constraints are eliminated)."""
-    if 6 * (len(model.points) + len(model.rigids)) > 4 * MAX_ORDER:
+    """The :class:`ModeCounter` of ``model``, or None where D(ω) would be larger than MAX_ORDER
+    (:func:`too_large_to_count`, else from the order after the constraints are eliminated)."""
+    if too_large_to_count(model):
         return None
     counter = ModeCounter(model, engine)
     return counter if counter.n_dof <= MAX_ORDER else None
+
+
+def too_large_to_count(model: Model) -> bool:
+    """Whether ``model`` has no counter for certain: over 4 MAX_ORDER unknowns before elimination."""
+    return 6 * (len(model.points) + len(model.rigids)) > 4 * MAX_ORDER
 
 
 class ModeCounter:

@@ -127,34 +127,47 @@ def test_kernels_pay_for_a_sweep_of_a_small_model_long_enough():
 
 
 def test_auto_loads_the_kernels_for_a_large_model_in_a_new_process():
-    """In a new process "auto" solves a launcher by the numpy carry and a 500-element
-    cantilever's six lowest by the kernels (compiled on this machine) it loads for them, but
-    not its lowest (a sweep's steps likewise); the frequencies are numpy's to rounding."""
+    """In a new process "auto" solves a launcher by the numpy carry; a 500-element
+    cantilever's six lowest too, polished from predictions without a counter (3 · 500 · 6 =
+    9,000 is below PREDICTED_PAY_FROM), but its twenty lowest (30,000) by the kernels
+    (compiled on this machine) it loads for them, and so the six lowest of a round one,
+    whose double roots the search scans for (KERNELS_PAY_FROM holds there); a sweep's
+    steps follow KERNELS_PAY_FROM; the frequencies are numpy's to rounding."""
     import subprocess
     import sys
 
+    from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM, PREDICTED_PAY_FROM
+
+    assert BEAM_WEIGHT * 500 * 6 == KERNELS_PAY_FROM and BEAM_WEIGHT * 500 * 20 == PREDICTED_PAY_FROM
     natural_frequencies(load_model("models/mlrs/mlrs.toml"), 1, engine="compiled")  # compiled here, cached
 
-    code = (f"import sys, numpy as np; sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
-            "from builders import cantilever_of_beams\n"
-            "from linmstmm import load_model, natural_frequencies\n"
-            "from linmstmm.determinant import kernels_loaded\n"
-            "from linmstmm.sweep import _step_engine\n"
-            "natural_frequencies(load_model('models/mlrs/mlrs.toml'), 10)\n"
-            "natural_frequencies(cantilever_of_beams(500), 1); print(kernels_loaded())\n"
+    prelude = (f"import sys, dataclasses, numpy as np; sys.path.insert(0, {str(Path(__file__).parent)!r})\n"
+               "from builders import cantilever_of_beams\n"
+               "from linmstmm import load_model, natural_frequencies\n"
+               "from linmstmm.determinant import kernels_loaded\n"
+               "from linmstmm.sweep import _step_engine\n"
+               "def rounded(model):\n"
+               "    return dataclasses.replace(model, beams=tuple(dataclasses.replace(b, Iz=b.Iy) for b in model.beams))\n")
+    code = (prelude
+            + "natural_frequencies(load_model('models/mlrs/mlrs.toml'), 10); print(kernels_loaded())\n"
             "print(_step_engine(load_model('models/mlrs/mlrs.toml'), 'auto', 5, 1), "
             "_step_engine(load_model('models/mlrs/mlrs.toml'), 'auto', 5, 1000), "
             "_step_engine(cantilever_of_beams(500), 'auto', 6, 1))\n"
-            "auto = natural_frequencies(cantilever_of_beams(500), 6); print(kernels_loaded())\n"
-            "plain = natural_frequencies(cantilever_of_beams(500), 6, engine='numpy')\n"
+            "six = natural_frequencies(cantilever_of_beams(500), 6); print(six.engine)\n"
+            "auto = natural_frequencies(cantilever_of_beams(500), 20); print(auto.engine)\n"
+            "plain = natural_frequencies(cantilever_of_beams(500), 20, engine='numpy')\n"
             "print(np.abs(auto.frequencies_hz / plain.frequencies_hz - 1).max())\n")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, run.stderr
-    launcher, sweep_launcher, long_sweep_launcher, sweep_cantilever, cantilever, difference = run.stdout.split()
-    assert (launcher, cantilever) == ("False", "True")
-    # a sweep's steps follow the same rule, counted together
+    launcher, sweep_launcher, long_sweep_launcher, sweep_cantilever, six, twenty, difference = run.stdout.split()
+    assert (launcher, six, twenty) == ("False", "numpy", "compiled")
+    # a sweep's steps follow KERNELS_PAY_FROM, counted together
     assert (sweep_launcher, long_sweep_launcher, sweep_cantilever) == ("numpy", "compiled", "compiled")
     assert float(difference) < 1e-12
+    code = prelude + "print(natural_frequencies(rounded(cantilever_of_beams(500)), 6).engine)\n"
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.split() == ["compiled"]
 
 
 def test_a_model_built_in_code_cannot_be_changed_under_its_compiled_solve():

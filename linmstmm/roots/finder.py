@@ -8,6 +8,7 @@ import numpy as np
 
 from linmstmm.counting import deflated
 from linmstmm.predicted import predicted_roots
+from linmstmm.prediction_groups import coinciding
 from linmstmm.rayleigh import AS_PREDICTED_FROM, PREDICTED_TO, refined_predictions
 from linmstmm.roots import brackets, certify, fast_path, floor, pencil, segments
 from linmstmm.roots import clusters as close_roots
@@ -83,14 +84,6 @@ class RootFinder:
     #: Offsets |μ|/ω below this may be a multiple root split by rounding (a count decides);
     #: roots closer than this are reported as one multiple root.
     SPLIT = 1e-4
-    #: Predictions closer than this (relative) may be one multiple root's, as far as a
-    #: prediction can tell: the Lanczos's Ritz values of a double root lay up to 1.7e-8
-    #: apart (a round cantilever of 1,000 beams), the dense route's 7e-9. Without a
-    #: Wittrick–Williams counter the search from them cost twice the scan
-    #: (:meth:`_separable`); the closest distinct pair measured, 5e-5 apart (a
-    #: cantilever of 300 beams' 40 lowest), took 280 evaluations from them, against
-    #: 1,798 by the scan.
-    COINCIDING_PREDICTIONS = 1e-6
     #: An interval this narrow (relative) that a count says holds roots float64 cannot find
     #: is their enclosure: :meth:`_isolate` reports them at its middle, for
     #: ``natural_frequencies`` to separate in mpmath (:attr:`unseparated`).
@@ -229,13 +222,12 @@ class RootFinder:
     def _separable(self, predictions: np.ndarray) -> bool:
         """Whether the search from ``predictions`` (rad/s, ascending) can tell their roots
         apart cheaply: always with a Wittrick–Williams counter; without one (a model too
-        large for it, :data:`~linmstmm.wittrick_williams.MAX_ORDER`) only where no two lie
-        within COINCIDING_PREDICTIONS, as a multiple root's do: from those the search
-        without counts cost more than the scan (a round cantilever of 100 beams, its ten
-        lowest all double: 1,389 evaluations and 0.46 s from its predictions, 675 and
-        0.08 s by the scan)."""
-        gaps = np.diff(predictions)
-        return self.counter is not None or bool(np.all(gaps > self.COINCIDING_PREDICTIONS * predictions[1:]))
+        large for it, :data:`~linmstmm.wittrick_williams.MAX_ORDER`) only where no two
+        coincide as a multiple root's do (:func:`~linmstmm.prediction_groups.coinciding`):
+        from those the search without counts cost more than the scan (a round cantilever
+        of 100 beams, its ten lowest all double: 1,389 evaluations and 0.46 s from its
+        predictions, 675 and 0.08 s by the scan)."""
+        return self.counter is not None or not coinciding(predictions)
 
     def find_near(self, guesses, count: int) -> RootSearchResult:
         """The lowest ``count`` roots, warm-started from ``guesses``.

@@ -176,11 +176,12 @@ def beam_chain(n: int, length: float = 2.0) -> Model:
     return Model(f"beam chain N={n}", points, beams=beams, boundary={"p0": np.ones(6, dtype=bool)})
 
 
-def beam_chain_file(n: int, folder: Path, length: float = 2.0) -> Path:
+def beam_chain_file(n: int, folder: Path, length: float = 2.0, round_section: bool = False) -> Path:
     """:func:`beam_chain` written as a model file ``folder``/beam_chain_<n>.toml, for a new
     process's command to read (the same model, but for the rounding of the beams' lengths,
-    which the loader takes from the points)."""
-    s = BEAM_CHAIN_SECTION
+    which the loader takes from the points); with ``round_section``, Iz = Iy (every bending
+    frequency double), as ``folder``/round_chain_<n>.toml."""
+    s = dict(BEAM_CHAIN_SECTION, Iz=BEAM_CHAIN_SECTION["Iy"]) if round_section else BEAM_CHAIN_SECTION
     lines = [f'name = "beam chain N={n}"', "", "[points]"]
     lines += [f"p{i} = [{length * i / n!r}, 0.0, 0.0]" for i in range(n + 1)]
     for i in range(n):
@@ -188,7 +189,7 @@ def beam_chain_file(n: int, folder: Path, length: float = 2.0) -> Path:
                   *(f"{key} = {value!r}" for key, value in (("E", STEEL["E"]), ("G", STEEL["G"]),
                                                            ("rho", STEEL["rho"]), *s.items()))]
     lines += ["", "[boundary]", 'p0 = "fixed"']
-    path = folder / f"beam_chain_{n}.toml"
+    path = folder / f"{'round' if round_section else 'beam'}_chain_{n}.toml"
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
 

@@ -44,6 +44,11 @@ SINGULAR_PENCIL = 1e-12
 #: Unknowns of the predicting FE model above which its eigenproblem is solved sparse
 #: (see :func:`coarse_predictions`).
 DENSE_PREDICTION = 400
+#: A free model's probe shifts for the sparse route, relative to its median stiffness-to-mass
+#: diagonal ratio, tried in turn (:func:`_free_shift`), and how far above the rigid-body modes'
+#: computed values its lowest elastic eigenvalue must lie to be taken for one.
+FREE_PROBE_SHIFTS = (1e-10, 1e-13)
+ELASTIC_ABOVE = 100.0
 #: Coarse pencils kept (:func:`coarse_pencil`; a model's meshes, least recently used dropped first).
 PENCILS_KEPT = 16
 #: Elements per beam the predicting mesh may take.
@@ -66,16 +71,17 @@ def coarse_predictions(model: Model, count: int, elements_per_beam: int = 2,
     −shift (:mod:`linmstmm.block_lanczos`, to the prediction's accuracy: on the
     second launcher's 1284 unknowns its 112 lowest in 19 ms, against 54 ms by
     ARPACK to machine precision and far more dense, whose Cholesky route's lowest
-    eigenvalue was 2.8e-3 off there); about 0 without a shift where the mesh has more
-    than DENSE_PREDICTION unknowns and no rigid-body mode (a cantilever of 100 beams,
-    1,200 unknowns: its 25 lowest in 12 ms, 8e-9 from the closed form, against 0.42 s
-    dense, 2.3e-5 off).
+    eigenvalue was 2.8e-3 off there); without a shift where the mesh has more than
+    DENSE_PREDICTION unknowns, about 0 where it has no rigid-body mode (a cantilever of
+    100 beams, 1,200 unknowns: its 25 lowest in 12 ms, 8e-9 from the closed form, against
+    0.42 s dense, 2.3e-5 off), else about half its lowest elastic eigenvalue (:func:`_free_shift`).
     The lowest as many as the FE model has rigid-body modes are theirs, and dropped
     (a threshold relative to the largest would drop a soft strip's first bending
     modes with them).
     Returns (m,) ascending, m <= count (fewer if the model has fewer); for a mesh
     of more than MAX_UNKNOWNS unknowns, only what the sparse route gives (up to
-    MAX_SPARSE_UNKNOWNS; none with a rigid-body mode and no shift).
+    MAX_SPARSE_UNKNOWNS; none where it cannot take the mesh: massless unknowns, or rigid-body
+    modes whose shift :func:`_free_shift` cannot find).
     """
     return coarse_modes(model, count, elements_per_beam, shift, nodal=False).values
 
@@ -134,8 +140,8 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     if pencil.size == 0:  # every point held: no unknown, no mode (LAPACK takes no empty matrix)
         return PredictedModes(np.zeros(0), None)
     rigid = pencil.rigid_body_modes
-    if shift is None and rigid == 0 and pencil.size > DENSE_PREDICTION:
-        shift = 0.0  # K positive definite: the sparse route about 0
+    if shift is None and pencil.size > DENSE_PREDICTION:  # the sparse route, where it can turn about a shift
+        shift = 0.0 if rigid == 0 else _free_shift(pencil)  # (rigid == 0: K positive definite)
     if not dense and not _sparse_route(pencil, shift):
         return PredictedModes(np.zeros(0), None)
     wanted = min(count + rigid, pencil.size)
@@ -154,6 +160,30 @@ def coarse_modes(model: Model, count: int, elements_per_beam: int = 2, shift: fl
     later = None if bisection is None else (
         lambda rows=None: pencil.at_nodes(bisection.vectors()[:, order if rows is None else order[rows]], reduced))
     return PredictedModes(values, None, later)
+
+
+def _free_shift(pencil: CoarsePencil) -> float | None:
+    """A shift (rad/s)² for the sparse route on ``pencil``, whose stiffness its rigid-body
+    modes make singular: half its lowest elastic eigenvalue, as a refined mesh takes from a
+    coarser one, found first by the same route asking for one eigenvalue beyond the
+    rigid-body modes, about each of FREE_PROBE_SHIFTS times its median stiffness-to-mass
+    diagonal ratio in turn until one gives an answer (a long flexible model's lowest
+    elastic eigenvalue lies far below that ratio, as the fourth power of its elements'
+    length over its own, and a probe too far above it does not converge); None where none
+    does, or none above ELASTIC_ABOVE times the rigid-body modes' computed values (their
+    rounding about 0). A free rod of 1,000 beams: those within ±0.84 (rad/s)², its lowest
+    elastic 1.67e5 (409.128 rad/s), about the first probe, 1.1e6; of 3,000 beams, the
+    second (the first, 1.1e8, gave no answer)."""
+    rigid = pencil.rigid_body_modes
+    if not _sparse_route(pencil, 1.0):
+        return None
+    ratio = float(np.median(pencil.assembly.K.diagonal() / pencil.assembly.M.diagonal()))
+    for probe in FREE_PROBE_SHIFTS:
+        found = _sparse_lowest(pencil, rigid + 1, probe * ratio, False)
+        if found is not None:
+            lam = np.sort(found[0])
+            return 0.5 * float(lam[rigid]) if lam[rigid] > ELASTIC_ABOVE * np.max(np.abs(lam[:rigid])) else None
+    return None
 
 
 def coarse_pencil(model: Model, elements_per_beam: int) -> CoarsePencil:

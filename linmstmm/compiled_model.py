@@ -38,8 +38,8 @@ from linmstmm.determinant import (
 )
 from linmstmm.model import Model
 from linmstmm.model_structure import MODELS_KEPT, forget_structures
-from linmstmm.prediction_groups import coinciding
 from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
+from linmstmm.prediction_groups import coinciding
 from linmstmm.rigid_motion import held_still, rigid_body_mode_count
 from linmstmm.roots.settings import FLOOR_RATIO, predictions_wanted
 from linmstmm.topology import build_topology

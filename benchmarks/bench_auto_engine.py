@@ -5,8 +5,9 @@
 ``engine="auto"`` decides in each new process whether loading the compiled kernels
 (0.5-1.5 s of start-up) costs less than the numpy carry's solve
 (:func:`linmstmm.compiled_model.compiled_system`): from KERNELS_PAY_FROM elements times
-frequencies for a search that scans, from PREDICTED_PAY_FROM for one polished from its
-coarse predictions without a Wittrick–Williams counter. This times ``linmstmm freqs FILE
+frequencies for a search that scans, from PREDICTED_PAY_FROM elements times (frequencies +
+PREDICTED_FIXED) for one polished from its coarse predictions without a Wittrick–Williams
+counter. This times ``linmstmm freqs FILE
 --count C`` end to end (start-up, loading and kernels included) by ``--engine numpy``,
 ``compiled`` and ``auto``, taken in turn in each round, best of the rounds, on steel
 cantilevers of N beam elements (the two bending planes apart: simple roots, searched from
@@ -28,13 +29,13 @@ from pathlib import Path
 
 from common import REPO, beam_chain_file, machine_facts
 
-from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM, PREDICTED_PAY_FROM
+from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM, PREDICTED_FIXED, PREDICTED_PAY_FROM
 
 #: (elements N, frequencies asked for C, round section) of each row.
 CASES = ((100, 10, False), (100, 20, False), (100, 40, False),
          (300, 10, False), (300, 20, False), (300, 40, False),
-         (1000, 10, False), (1000, 20, False), (1000, 40, False),
-         (300, 10, True), (1000, 10, True))
+         (1000, 5, False), (1000, 10, False), (1000, 20, False), (1000, 40, False),
+         (2000, 4, False), (3000, 1, False), (300, 10, True), (1000, 10, True))
 ENGINES = ("numpy", "compiled", "auto")
 
 
@@ -85,7 +86,8 @@ def write_report(path: Path, command: str, rows: list[dict]) -> None:
         "round (Iz = Iy: every bending root double, which a model this large, without a "
         "Wittrick–Williams counter, scans for). `auto` loads the kernels where the elements carried "
         f"one at a time (a beam counting {BEAM_WEIGHT}) times C reach {KERNELS_PAY_FROM:,}, or "
-        f"{PREDICTED_PAY_FROM:,} where the search polishes predictions without a counter "
+        f"times (C + {PREDICTED_FIXED}) reach {PREDICTED_PAY_FROM:,} where the search polishes predictions "
+        "without a counter, whose numpy carry costs per batch of frequencies, a few a search "
         "(`linmstmm/compiled_model.py`).",
         "",
         "| N | C | section | weight × C | numpy | compiled | auto (took) | evaluations (numpy, compiled) |",

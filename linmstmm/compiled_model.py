@@ -27,6 +27,7 @@ from linmstmm.deduction import Deduction
 from linmstmm.determinant import (
     FREQUENCIES_ASSUMED,
     KERNELS_PAY_FROM,
+    PREDICTED_FIXED,
     PREDICTED_PAY_FROM,
     carried_alone,
     determinant,
@@ -96,8 +97,8 @@ def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: st
         system made for "auto" before the kernels were loaded is not taken for one
         made after). Where the numpy carry would take longer than the kernels'
         start-up to find ``frequencies`` of ``model``
-        (:func:`~linmstmm.determinant.kernels_pay`; PREDICTED_PAY_FROM for a search
-        polishing predictions without a counter, :func:`_kernels_pay`), "auto" loads
+        (:func:`~linmstmm.determinant.kernels_pay`; another line for a search polishing
+        predictions without a counter, :func:`_kernels_pay`), "auto" loads
         them first, and a later call for the same model, finding them loaded, makes its
         system once more.
     frequencies : int
@@ -113,7 +114,8 @@ def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: st
     resolved_engine(engine)  # an unknown engine is refused before anything is built
     key = (model, root, tuple(cut_at))
     try:
-        if (engine == "auto" and not kernels_loaded() and weight_at_most(model) * frequencies >= KERNELS_PAY_FROM
+        if (engine == "auto" and not kernels_loaded()
+                and weight_at_most(model) * (frequencies + PREDICTED_FIXED) >= KERNELS_PAY_FROM  # (either line)
                 and _kernels_pay(key, frequencies, predicted)):
             load_kernels()  # a large request: the kernels' start-up costs less than the numpy carry's solve
         return _compiled(*key, engine, kernels_loaded())
@@ -123,14 +125,21 @@ def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: st
 
 def _kernels_pay(key: tuple, frequencies: int, predicted: bool) -> bool:
     """Whether the kernels pay for a solve of the (model, root, cut_at) ``key`` asking for
-    ``frequencies``: where they are compiled on this machine and the elements carried one
-    at a time times ``frequencies`` reach KERNELS_PAY_FROM, or PREDICTED_PAY_FROM where the
-    search (``predicted``) polishes predictions without a Wittrick–Williams counter
-    (:func:`_polished_without_counter`), whose predictions the solve then takes as made here."""
-    work = _carried_alone(*key) * frequencies
-    if work < KERNELS_PAY_FROM or not kernels_compiled():
+    ``frequencies``, where they are compiled on this machine: the elements carried one at a
+    time times ``frequencies`` reach KERNELS_PAY_FROM, or, where the search (``predicted``)
+    polishes predictions without a Wittrick–Williams counter
+    (:func:`_polished_without_counter`, whose predictions the solve then takes as made
+    here), those elements times (``frequencies`` + PREDICTED_FIXED) reach PREDICTED_PAY_FROM."""
+    if not kernels_compiled():
         return False
-    return work >= PREDICTED_PAY_FROM or not (predicted and _polished_without_counter(key[0], frequencies))
+    model, carried = key[0], _carried_alone(*key)
+    scan_pays = carried * frequencies >= KERNELS_PAY_FROM
+    if not predicted or not too_large_to_count(model):
+        return scan_pays
+    predicted_pays = carried * (frequencies + PREDICTED_FIXED) >= PREDICTED_PAY_FROM
+    if predicted_pays == scan_pays:  # the same either way: no prediction needed to decide
+        return scan_pays
+    return predicted_pays if _polished_without_counter(model, frequencies) else scan_pays
 
 
 def _polished_without_counter(model: Model, frequencies: int) -> bool:

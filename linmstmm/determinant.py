@@ -129,15 +129,18 @@ def engine_for(deduction: Deduction, engine: str) -> str:
 #: 25 steps 1.50/2.02 s, 50 steps 2.14/2.40 s, 100 steps 3.51/2.97 s (even near 60 steps,
 #: 10,200; the rule takes the kernels from 53).
 KERNELS_PAY_FROM = 9000
-#: KERNELS_PAY_FROM for a search that polishes its coarse FE predictions without a
-#: Wittrick–Williams counter (a large model: :func:`linmstmm.compiled_model.compiled_system`
-#: looks): it takes 3.5 to 7 evaluations a root, not a scan's 30 to 50, so the numpy carry
-#: stays ahead longer. Measured as above: cantilevers of 100 beams, C = 10, 20, 40:
-#: 0.71/1.07, 0.67/1.22, 1.20/1.47 s; of 300, C = 10, 20, 40, 80: 0.98/1.45, 1.07/1.68,
-#: 1.54/1.59, 2.48/1.79 s; of 1,000, C = 10, 20, 40: 1.38/1.51, 2.02/1.62, 3.21/2.13 s;
-#: of 3,000, C = 10: 3.50/1.87 s. Even at 30,000 (1,000 beams, C = 10) to 36,000 (300
-#: beams, C = 40).
-PREDICTED_PAY_FROM = 30000
+#: The line for a search that polishes its coarse FE predictions without a Wittrick–Williams
+#: counter (a large model: :func:`linmstmm.compiled_model.compiled_system` looks), held
+#: against the elements carried one at a time times (the frequencies asked for +
+#: PREDICTED_FIXED). Such a search takes 3.5 to 7 evaluations a root, not a scan's 30 to 50,
+#: in few batches, and the numpy carry's cost is per batch (each element once per call, for
+#: all its frequencies): about 3 + 0.3 C calls for C frequencies. Measured as above
+#: (numpy/kernels): cantilevers of 100 beams, C = 40: 1.02/1.30 s; of 300, C = 20, 40:
+#: 0.94/1.35, 1.55/1.49 s; of 1,000, C = 5, 10, 20: 1.31/1.42, 1.32/1.41, 2.02/1.62 s; of
+#: 2,000, C = 4: 2.67/1.56 s; of 3,000, C = 1, 3: 3.27/1.82, 3.32/1.77 s (there a single
+#: frequency costs numpy 0.7 s a call); even near 45,000 (300 beams, C = 40; 1,000, C = 5).
+PREDICTED_PAY_FROM = 40000
+PREDICTED_FIXED = 10
 #: Frequencies a request is taken to ask for where it names no count (a range up to fmax)
 #: and its beams' clamped modes do not promise more: the commands' default count.
 FREQUENCIES_ASSUMED = 10

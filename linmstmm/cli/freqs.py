@@ -20,7 +20,7 @@ from linmstmm.cli.common import (
     request,
     stages,
 )
-from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM, PREDICTED_PAY_FROM
+from linmstmm.determinant import BEAM_WEIGHT, KERNELS_PAY_FROM, PREDICTED_FIXED, PREDICTED_PAY_FROM
 from linmstmm.roots import MAX_RTOL, MIN_RTOL
 
 
@@ -41,8 +41,9 @@ def add_freqs_command(subparsers) -> None:
                             "(about 5x cheaper per evaluation in a batch, 0.5-1.5 s to start in a new "
                             "process); auto: numpy in a new process, the kernels where the elements (a "
                             f"beam counting {BEAM_WEIGHT}) times the frequencies asked for reach "
-                            f"{KERNELS_PAY_FROM:,} ({PREDICTED_PAY_FROM:,} for a large model polished "
-                            "from its predictions), once they are compiled here")
+                            f"{KERNELS_PAY_FROM:,} (for a large model polished from its predictions: "
+                            f"times the frequencies + {PREDICTED_FIXED}, {PREDICTED_PAY_FROM:,}), once "
+                            "they are compiled here")
     add_damped_option(freqs)
     freqs.set_defaults(run=run_freqs)
 

@@ -2,7 +2,7 @@
 block shift-invert Lanczos.
 
 For K x = λ M x (K symmetric positive semi-definite, M positive definite, both
-sparse) and a shift s > 0 below every wanted λ + s, the operator
+sparse) and a shift s >= 0 (0 only where K is positive definite), the operator
 A = (K + s M)⁻¹ M is self-adjoint in the M inner product, and its largest
 eigenvalues θ = 1 / (λ + s) are the pencil's lowest λ. One sparse LU factor of
 K + s M (SuperLU, symmetric mode) serves every step; each step solves for a
@@ -67,7 +67,7 @@ def lowest_eigenvalues(K, M, count: int, shift: float, seed: int = 0) -> np.ndar
     count : int
         Eigenvalues wanted, 1 <= count < n.
     shift : float
-        In the eigenvalues' units, > 0: the operator is (K + shift M)⁻¹ M.
+        In the eigenvalues' units, >= 0: the operator is (K + shift M)⁻¹ M.
     seed : int
         The random start block's seed (the same start, the same answer, every run).
 

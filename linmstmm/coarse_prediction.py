@@ -2,8 +2,9 @@
 
 The first step of :mod:`linmstmm.predicted` (predict, polish, certify): the
 natural frequencies of a coarse mesh of the model, a dense eigenproblem of a
-few hundred unknowns (none above MAX_UNKNOWNS), accurate to about 1e-3 for the
-lowest and 1e-2 by the hundredth. The mesh's assembled, scaled pencil depends
+few hundred unknowns, or a sparse one by block shift-invert Lanczos above
+DENSE_PREDICTION (alone above MAX_UNKNOWNS, up to MAX_SPARSE_UNKNOWNS), accurate to
+about 1e-3 for the lowest and 1e-2 by the hundredth. The mesh's assembled, scaled pencil depends
 on the model alone, so it is kept per model object (:func:`coarse_pencil`).
 Completeness is never taken from these predictions: the root search certifies
 it by counts.
@@ -28,9 +29,10 @@ from linmstmm.standard_eigen import BISECTED, Bisection, bisects, lowest_eigenpa
 #: Radians of a bending wave per element of the predicting mesh: its frequencies are
 #: then high by about 1/720 relative, well inside the secant's reach.
 WAVE_PER_ELEMENT = 1.0
-#: Unknowns of the predicting FE model beyond which there is no prediction (and the
-#: scan-based search runs): its dense eigenproblem grows as their cube, and a chain
-#: of 1000 bodies took 3.5 s to predict what the search finds in 0.1 s.
+#: Unknowns of the predicting FE model beyond which the dense eigensolvers do not predict
+#: (only the sparse route does, else the scan-based search runs): a dense eigenproblem
+#: grows as their cube, and a chain of 1000 bodies took 3.5 s to predict what the search
+#: finds in 0.1 s.
 MAX_UNKNOWNS = 1500
 #: Unknowns beyond MAX_UNKNOWNS up to which the sparse route alone predicts (block
 #: shift-invert Lanczos, one element per beam: :func:`_predicted_modes`): a cantilever of
@@ -230,11 +232,11 @@ def _unknowns(model: Model, elements_per_beam: int) -> int:
 
 
 def _points_carry_mass(model: Model) -> bool:
-    """Whether every point of ``model`` is a beam's end, a rigid body's port or held in
-    all six components: else it is likely an unknown without mass (a point between two
-    springs), which the sparse route cannot take (:func:`_sparse_route`) and whose
-    pencil is then not worth assembling (a chain of 1,000 springs and bodies: 0.13 s)."""
-    carried = {point for beam in model.beams for point in beam.ends}
+    """Whether every point of ``model`` is the end of a beam with mass, a rigid body's port
+    or held in all six components: else it is likely an unknown without mass (a point
+    between two springs), which the sparse route cannot take (:func:`_sparse_route`) and
+    whose pencil is then not worth assembling (a chain of 1,000 springs and bodies: 0.13 s)."""
+    carried = {point for beam in model.beams if beam.rho * beam.A > 0 for point in beam.ends}
     carried.update(point for body in model.rigids for point in body.ports)
     carried.update(point for point, held in model.boundary.items() if np.all(held))
     return carried.issuperset(model.points)
@@ -327,7 +329,7 @@ def _sparse_lowest(pencil: CoarsePencil, count: int, shift: float,
 def predict_frequencies(model: Model, count: int) -> np.ndarray:
     """:func:`coarse_predictions` on a mesh fine enough for the highest of them.
 
-    Two elements per beam first; where the beams' bending waves at the highest
+    Two elements per beam first (one beyond MAX_UNKNOWNS: :func:`_predicted_modes`); where the beams' bending waves at the highest
     prediction need more than twice as many elements for :data:`WAVE_PER_ELEMENT`
     radians each, once more with that many: at most MAX_ELEMENTS per beam, and
     at most as many as keep the model within MAX_UNKNOWNS (the finest that does,

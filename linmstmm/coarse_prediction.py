@@ -329,9 +329,9 @@ def _sparse_lowest(pencil: CoarsePencil, count: int, shift: float,
 def predict_frequencies(model: Model, count: int) -> np.ndarray:
     """:func:`coarse_predictions` on a mesh fine enough for the highest of them.
 
-    Two elements per beam first (one beyond MAX_UNKNOWNS: :func:`_predicted_modes`); where the beams' bending waves at the highest
-    prediction need more than twice as many elements for :data:`WAVE_PER_ELEMENT`
-    radians each, once more with that many: at most MAX_ELEMENTS per beam, and
+    Two elements per beam first (one beyond MAX_UNKNOWNS: :func:`_predicted_modes`);
+    where the beams' bending waves at the highest prediction need more than twice as
+    many elements for :data:`WAVE_PER_ELEMENT` radians each, once more with that many: at most MAX_ELEMENTS per beam, and
     at most as many as keep the model within MAX_UNKNOWNS (the finest that does,
     where more would be needed: without predictions the scan-based search took
     24,708 evaluations for the second launcher's 100 lowest on a mesh of 1,800

@@ -351,8 +351,8 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
         the model's elements times ``count`` make the numpy carry slower than
         loading them, :func:`linmstmm.determinant.kernels_pay`, later where a large
         model's search polishes its predictions without a counter,
-        :func:`linmstmm.compiled_model.compiled_system`; see :mod:`linmstmm.determinant`). The roots agree to rounding either way, and
-        ``result.engine`` says which ran.
+        :func:`linmstmm.compiled_model.compiled_system`; see :mod:`linmstmm.determinant`).
+        The roots agree to rounding either way, and ``result.engine`` says which ran.
     rtol : float or None
         Relative accuracy every frequency is certified to, MIN_RTOL to MAX_RTOL
         (1e-12 to 1e-4). None: certified to 1e-9 and every root polished to rounding.

@@ -11,6 +11,7 @@ import dataclasses
 
 import mpmath as mp
 import numpy as np
+import pytest
 from builders import cantilever_of_beams
 
 from linmstmm import coarse_prediction
@@ -115,3 +116,21 @@ def test_double_roots_of_a_long_round_cantilever_are_scanned_for_not_searched_fr
     reference = cantilever_reference_hz(model.beams[0], 10)  # both planes alike: each bending root twice
     np.testing.assert_allclose(got.frequencies_hz, reference, rtol=1e-12)
     assert got.evaluations < 1000
+
+
+def test_a_double_root_above_the_count_does_not_send_the_search_to_the_scan():
+    """The first torsion frequency tuned onto the fourth bending one (y plane): a double
+    root above the six lowest, whose predictions coincide. Only the predictions the search
+    polishes are asked whether they coincide, so the six lowest are polished from theirs
+    (255 evaluations by the scan when all were asked)."""
+    model = cantilever_of_beams(BEAMS, LENGTH)
+    beam = model.beams[0]
+    lam = mp.findroot(lambda x: mp.cos(x) + mp.sech(x), 7 * mp.pi / 2)  # the fourth clamped-free root
+    bending = float(lam**2 * mp.sqrt(beam.E * beam.Iy / (beam.rho * beam.A * LENGTH**4)) / (2 * mp.pi))
+    J = (4 * LENGTH * bending) ** 2 * beam.rho * beam.Ip / beam.G  # first torsion frequency = bending
+    model = dataclasses.replace(model, beams=tuple(dataclasses.replace(b, J=J) for b in model.beams))
+    reference = cantilever_reference_hz(model.beams[0], 8)
+    assert reference[6] == pytest.approx(reference[7], rel=1e-12)  # the double root, above the six
+    got = natural_frequencies(model, 6)
+    np.testing.assert_allclose(got.frequencies_hz, reference[:6], rtol=1e-12)
+    assert got.evaluations < 10 * 6

@@ -8,7 +8,7 @@ import numpy as np
 
 from linmstmm.counting import deflated
 from linmstmm.predicted import predicted_roots
-from linmstmm.prediction_groups import coinciding
+from linmstmm.prediction_groups import coinciding, polished_up_to
 from linmstmm.rayleigh import AS_PREDICTED_FROM, PREDICTED_TO, refined_predictions
 from linmstmm.roots import brackets, certify, fast_path, floor, pencil, segments
 from linmstmm.roots import clusters as close_roots
@@ -220,8 +220,9 @@ class RootFinder:
         return total if total is not None and 0 <= total < count else None
 
     def _separable(self, predictions: np.ndarray) -> bool:
-        """Whether the search from ``predictions`` (rad/s, ascending) can tell their roots
-        apart cheaply: always with a Wittrick–Williams counter; without one (a model too
+        """Whether the search from ``predictions`` (rad/s, ascending: those it polishes,
+        :func:`~linmstmm.prediction_groups.polished_up_to`; the others only place the
+        certifying count's end) can tell their roots apart cheaply: always with a Wittrick–Williams counter; without one (a model too
         large for it, :data:`~linmstmm.wittrick_williams.MAX_ORDER`) only where no two
         coincide as a multiple root's do (:func:`~linmstmm.prediction_groups.coinciding`):
         from those the search without counts cost more than the scan (a round cantilever
@@ -300,7 +301,8 @@ class RootFinder:
             if wanted == 0:
                 return []
             found = None
-            if wanted is not None and self._usable(predicted.values) and self._separable(predicted.values):
+            if (wanted is not None and self._usable(predicted.values)
+                    and self._separable(predicted.values[:polished_up_to(predicted.values, wanted)])):
                 predictions, spans = refined_predictions(self.counter, predicted, wanted, self.rtol, as_predicted)
                 found = predicted_roots(self, predictions, wanted, spans)
             if found is not None:  # certified up to above the wanted-th: complete below omega_max too

@@ -134,7 +134,7 @@ def _kernels_pay(key: tuple, frequencies: int, predicted: bool) -> bool:
         return False
     model, carried = key[0], _carried_alone(*key)
     scan_pays = carried * frequencies >= KERNELS_PAY_FROM
-    if not predicted or not too_large_to_count(model):
+    if not predicted:
         return scan_pays
     predicted_pays = carried * (frequencies + PREDICTED_FIXED) >= PREDICTED_PAY_FROM
     if predicted_pays == scan_pays:  # the same either way: no prediction needed to decide

@@ -40,7 +40,6 @@ from linmstmm.determinant import (
 from linmstmm.model import Model
 from linmstmm.model_structure import MODELS_KEPT, forget_structures
 from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
-from linmstmm.prediction_groups import coinciding, polished_up_to
 from linmstmm.rigid_motion import held_still, rigid_body_mode_count
 from linmstmm.roots.settings import FLOOR_RATIO, predictions_wanted
 from linmstmm.topology import build_topology
@@ -148,12 +147,10 @@ def _polished_without_counter(model: Model, frequencies: int) -> bool:
     solve) and has no Wittrick–Williams counter for certain
     (:func:`~linmstmm.wittrick_williams.too_large_to_count`: a model with one counts and
     refines by the numpy engine too, which the kernels make far cheaper): there are as
-    many predictions and none the search polishes coincide
-    (:meth:`~linmstmm.roots.RootFinder._separable`)."""
+    many predictions."""
     if not too_large_to_count(model):
         return False
-    values = predicted_modes(model, predictions_wanted(frequencies)).values
-    return values.size >= frequencies and not coinciding(values[:polished_up_to(values, frequencies)])
+    return predicted_modes(model, predictions_wanted(frequencies)).values.size >= frequencies
 
 
 #: (model, root, cut_at) -> a Deduction built to decide the engine (:func:`_carried_alone`),

@@ -40,7 +40,8 @@ import math
 import numpy as np
 
 from linmstmm.counting import deflated
-from linmstmm.prediction_groups import (CLUSTER, Stood, cluster_reach, clustered, gap, gap_above,
+from linmstmm.multiple_predictions import coincident, other_members
+from linmstmm.prediction_groups import (CLUSTER, Stood, cluster_reach, clustered, gap, gap_above, near_any,
                                         intervals_around, polished_up_to, repair_split, standing)
 from linmstmm.secant import secant_roots
 
@@ -57,8 +58,6 @@ NEAR_KNOWN = 1e-5
 #: only places the certifying count's upper end (:func:`_secant_polished`): a tenth of
 #: CLUSTER, the least distance above the roots wanted at which such a value stands.
 PLACING = 1e-4
-#: Predictions this close (relative) are one multiple root's (:func:`_coincident`).
-COINCIDENT = 1e-10
 #: From this rtol up, where the caller asked for one (``RootFinder.unpolished``), each
 #: prediction with no other within CLUSTER is first tried as it stands: where the
 #: Wittrick–Williams counts at ±rtol across it find one natural frequency, it is
@@ -222,14 +221,17 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
                          else ([], np.arange(start, stop)))
     if stood is not None:
         stood.update(standing)
-    leaders, followers = _coincident(predictions, indices)
-    coincident = {*leaders.tolist(), *followers.tolist()}
-    alone = np.array([i for i in indices.tolist() if i not in coincident], dtype=np.int64)
+    leaders, followers = coincident(predictions, indices, finder.counter is not None)
+    grouped = {*leaders.tolist(), *followers.tolist()}
+    alone = np.array([i for i in indices.tolist() if i not in grouped], dtype=np.int64)
     found, unsettled = _secant_polished(finder, predictions, in_cluster, alone, list(roots) + standing, wanted,
                                         spans)
     stood_for = Stood(stood, finder.rtol)
     found, troubled = _pencil_polished(finder, list(roots) + standing + found,
                                        unsettled + [float(p) for p in predictions[leaders]], stood_for)
+    if finder.counter is None:  # no counts to give a multiple root's members: a circle's, else each polished
+        found, followers = other_members(finder, found, predictions, leaders, followers)
+        troubled, followers = troubled + [float(p) for p in predictions[followers]], followers[:0]
     found, troubled = _deflated_polished(finder, found, troubled, predictions, stood_for)
     for lo, hi in intervals_around(troubled + [float(p) for p in predictions[followers]], predictions, found):
         counted = _completed_by_counts(finder, found, lo, hi)
@@ -241,27 +243,6 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
         except RuntimeError:
             return None
     return sorted(found)
-
-
-def _coincident(predictions: np.ndarray, indices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(leaders, followers): of ``indices``, those whose prediction equals (to COINCIDENT)
-    the next one's, first of each such group, and the others of the group.
-
-    A symmetric structure's coarse model predicts its multiple roots as equal values
-    (a steel rod with Iy = Iz: its bending roots to the last digit). The secant on
-    det creeps to a multiple root, where det keeps its sign, and a value that
-    coincides with another prediction never stands (half the gap to it is zero):
-    the secant spent its twelve steps on each member in vain, 24 evaluations a
-    double root. A leader goes to Newton on the pencil, which converges to a
-    multiple root as fast as to a simple one; its followers go to the
-    Wittrick–Williams counts around it, which give its multiplicity."""
-    if indices.size < 2:
-        return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
-    values = predictions[indices]
-    same = np.diff(values) <= COINCIDENT * values[1:]
-    follows = np.r_[False, same]
-    leads = np.r_[same, False] & ~follows
-    return indices[leads], indices[follows]
 
 
 def _counted_predictions(finder, predictions: np.ndarray, in_cluster: list[bool], start: int,
@@ -350,7 +331,7 @@ def _settled(finder, predictions: np.ndarray, in_cluster: list[bool], indices: n
     bounds = [PLACING if loose else finder.xtol if in_cluster[i] else finder.rtol
               for i, loose in zip(indices.tolist(), placing.tolist())]
     settled = [not math.isnan(root) and abs(root - values[i]) <= 0.5 * gap(values, i)
-               and step <= bound and not _known(root, known, same)
+               and step <= bound and not near_any(root, known, same)
                for i, root, step, bound in zip(indices.tolist(), roots, steps.tolist(), bounds)]
     for i in [k for k, stands in enumerate(settled) if stands]:  # two that settled on one root: neither stands
         twins = [k for k, stands in enumerate(settled) if stands and abs(roots[k] - roots[i]) <= same * roots[i]]
@@ -389,7 +370,7 @@ def _pencil_polished(finder, roots: list[float], starts: list[float],
         if root is None:
             return False
         stood_for.absorbed(root, roots)
-        if _known(root, roots, finder.same_root):
+        if near_any(root, roots, finder.same_root):
             return False
         roots.append(root)
         return True
@@ -435,7 +416,7 @@ def _deflated_polished(finder, roots: list[float], starts: list[float], predicti
             if not np.isnan(root):  # converged (NaN otherwise): the root of a value it is within rtol of
                 stood_for.absorbed(float(root), roots)
             if (np.isnan(root) or step > finder.xtol or abs(root - start) > cluster_reach(predictions, start)
-                    or _known(root, roots, NEAR_KNOWN) or _known(root, this_round, finder.same_root)):
+                    or near_any(root, roots, NEAR_KNOWN) or near_any(root, this_round, finder.same_root)):
                 left.append(start)
             else:
                 this_round.append(float(root))
@@ -477,11 +458,6 @@ def _repaired(finder, roots: list[float], lo: float, hi: float, depth: int):
     middle = repair_split(inside, finder.fine_rtol)
     roots = _repaired(finder, roots, lo, middle, depth - 1)
     return None if roots is None else _repaired(finder, roots, middle, hi, depth - 1)
-
-
-def _known(root: float, roots: list[float], same: float) -> bool:
-    """True if ``root`` is within ``same`` (relative) of one of ``roots``."""
-    return any(abs(r - root) <= same * root for r in roots)
 
 
 def _partner(root: float, offsets: np.ndarray, same: float, reach: float) -> float | None:

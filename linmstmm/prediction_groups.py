@@ -15,17 +15,6 @@ import numpy as np
 #: Predictions closer than this (relative) are a cluster: a member's secant result
 #: stands only where it converged to xtol (see :func:`linmstmm.predicted._secant_polished`).
 CLUSTER = 1e-3
-#: Predictions closer than this (relative) may be one multiple root's, as far as a
-#: prediction can tell: the Lanczos's Ritz values of a double root lay up to 1.7e-8
-#: apart (a round cantilever of 1,000 beams), 7.4e-7 on 3,300 beams written in kg and km
-#: (the factorisation's rounding grows as the fourth power of the beams), the dense
-#: route's 7e-9; near-double roots 5e-6 apart were polished from their predictions in
-#: 72-82 evaluations for ten (675 by the scan). Without a
-#: Wittrick–Williams counter the search from such predictions cost twice the scan
-#: (:meth:`linmstmm.roots.RootFinder._separable`); the closest distinct pair measured,
-#: 5e-5 apart (a cantilever of 300 beams' 40 lowest), took 299 evaluations from them,
-#: against 1,798 by the scan.
-COINCIDING = 3e-6
 #: Predictions above the count-th are polished only within this (relative) of it;
 #: the others only place the certifying count's upper end in the gap above it
 #: (the coarse model is within about 1e-2 of every root it predicts).
@@ -44,10 +33,9 @@ def clusters(predictions: np.ndarray) -> list[list[int]]:
     return groups
 
 
-def coinciding(predictions: np.ndarray) -> bool:
-    """Whether two of ``predictions`` (rad/s, ascending) lie within COINCIDING of each
-    other, as a multiple root's do."""
-    return bool(np.any(np.diff(predictions) <= COINCIDING * predictions[1:]))
+def near_any(root: float, roots: list[float], same: float) -> bool:
+    """True if ``root`` is within ``same`` (relative) of one of ``roots``."""
+    return any(abs(r - root) <= same * root for r in roots)
 
 
 def clustered(predictions: np.ndarray) -> list[bool]:

@@ -11,6 +11,10 @@ import numpy as np
 from linmstmm.counting import count_zeros_many
 from linmstmm.roots.settings import CIRCLE_MAX_POINTS, CIRCLE_POINTS
 
+#: How many times smaller than its own circle a multiple root is counted over again
+#: (:func:`tight_counts`): a multiple root keeps its count there, a cluster does not.
+TIGHTER = 100
+
 
 def clusters(finder, starts, confirm: bool = True) -> list[list[float]]:
     """For each start, every root in the cluster around the root nearest it, ascending.
@@ -168,7 +172,7 @@ def separated(finder, roots: list[float]) -> list[float]:
 
     Roots closer than SPLIT are counted as one multiple root (a circle of that
     radius holds them all). Each multiple root is counted again over a circle
-    100 times smaller, by the Wittrick–Williams counts at the two ends of its
+    TIGHTER times smaller (:func:`tight_counts`), by the Wittrick–Williams counts at the two ends of its
     diameter on the real axis, where every natural frequency lies, and by the
     argument principle where they cannot decide (all those in one count; some
     20 evaluations of det each: a symmetric rod's ten lowest spent 104 of their
@@ -194,7 +198,7 @@ def separated(finder, roots: list[float]) -> list[float]:
     if not multiple:
         return roots
     radii = [finder._circle_radius(r, distinct) for r in multiple]
-    tight = _counts_within(finder, multiple, [radius / 100 for radius in radii])
+    tight, _ = tight_counts(finder, multiple, distinct)
     separated = list(roots)
     for r, radius, count in zip(multiple, radii, tight):
         m = finder._counted.get(r, tally[r])  # (``roots`` may end inside a multiple root)
@@ -207,6 +211,21 @@ def separated(finder, roots: list[float]) -> list[float]:
             continue
         separated = [x for x in separated if x != r] + members[:tally[r]]
     return sorted(separated)
+
+
+def tight_counts(finder, centres: list[float], distinct: list[float]) -> tuple[list[int | None], list[float]]:
+    """(the natural frequencies within each tight circle about ``centres`` (rad/s), or
+    None where the count cannot be made; the circles' radii, rad/s): radius
+    :meth:`RootFinder._circle_radius` among the roots ``distinct`` over TIGHTER, where
+    a multiple root keeps its count and a cluster does not (:func:`separated`).
+    Each circle is counted once per search (:func:`_counts_within`, all new ones in
+    one count), however often it is asked for."""
+    radii = [finder._circle_radius(c, distinct) / TIGHTER for c in centres]
+    kept = finder._tight_counts
+    asked = [(c, r) for c, r in zip(centres, radii) if (c, r) not in kept]
+    if asked:
+        kept.update(zip(asked, _counts_within(finder, [c for c, _ in asked], [r for _, r in asked])))
+    return [kept[c, r] for c, r in zip(centres, radii)], radii
 
 
 def beside(finder, polished) -> list[list[float]]:

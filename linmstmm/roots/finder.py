@@ -8,7 +8,6 @@ import numpy as np
 
 from linmstmm.counting import deflated
 from linmstmm.predicted import predicted_roots
-from linmstmm.prediction_groups import coinciding, polished_up_to
 from linmstmm.rayleigh import AS_PREDICTED_FROM, PREDICTED_TO, refined_predictions
 from linmstmm.roots import brackets, certify, fast_path, floor, pencil, segments
 from linmstmm.roots import clusters as close_roots
@@ -172,6 +171,9 @@ class RootFinder:
         #: root -> radius (rad/s) of the circle a count of it was made over (a circle that
         #: reaches out of a segment may hold a root outside it: :meth:`_merge`)
         self._circles: dict[float, float] = {}
+        #: (root, radius rad/s) -> natural frequencies within that tight circle about it, or
+        #: None where the count could not be made (:meth:`tight_counts`)
+        self._tight_counts: dict[tuple[float, float], int | None] = {}
         #: callable omega -> natural frequencies below omega (rad/s), rigid-body modes
         #: included, or None where it cannot decide (a
         #: :class:`~linmstmm.wittrick_williams.ModeCounter`); None: counts by the
@@ -218,17 +220,6 @@ class RootFinder:
         modes there); None where it cannot say so."""
         total = self.stiffness_count([], None, self.ceiling)
         return total if total is not None and 0 <= total < count else None
-
-    def _separable(self, predictions: np.ndarray) -> bool:
-        """Whether the search from ``predictions`` (rad/s, ascending: those it polishes,
-        :func:`~linmstmm.prediction_groups.polished_up_to`; the others only place the
-        certifying count's end) can tell their roots apart cheaply: always with a Wittrick–Williams counter; without one (a model too
-        large for it, :data:`~linmstmm.wittrick_williams.MAX_ORDER`) only where no two
-        coincide as a multiple root's do (:func:`~linmstmm.prediction_groups.coinciding`):
-        from those the search without counts cost more than the scan (a round cantilever
-        of 100 beams, its ten lowest double but one: 1,389 evaluations and 0.46 s from its
-        predictions, 675 and 0.08 s by the scan)."""
-        return self.counter is not None or not coinciding(predictions)
 
     def find_near(self, guesses, count: int) -> RootSearchResult:
         """The lowest ``count`` roots, warm-started from ``guesses``.
@@ -301,8 +292,7 @@ class RootFinder:
             if wanted == 0:
                 return []
             found = None
-            if (wanted is not None and self._usable(predicted.values)
-                    and self._separable(predicted.values[:polished_up_to(predicted.values, wanted)])):
+            if wanted is not None and self._usable(predicted.values):
                 predictions, spans = refined_predictions(self.counter, predicted, wanted, self.rtol, as_predicted)
                 found = predicted_roots(self, predictions, wanted, spans)
             if found is not None:  # certified up to above the wanted-th: complete below omega_max too
@@ -337,6 +327,8 @@ class RootFinder:
     _as_counted = close_roots.as_counted
     _circle_radius = close_roots.circle_radius
     multiplicities = close_roots.multiplicities
+    tight_counts = close_roots.tight_counts
+    beside = close_roots.beside
     unseparated_among = close_roots.unseparated_among
     multiplicity = close_roots.multiplicity
     _separated = close_roots.separated

@@ -7,7 +7,7 @@ the test oracle (tests/test_wittrick_williams.py compares them):
 * :func:`assembled` — :func:`linmstmm.dynamic_stiffness.clamped_counts` and
   :meth:`linmstmm.wittrick_williams.ModeCounter.matrices` (at one ω): J₀(ω) and the reduced
   exact dynamic stiffness D(ω) with the scale of its terms;
-* :func:`block_inertia` — :func:`linmstmm.wittrick_williams._block_inertia`;
+* :func:`block_inertia` — :func:`linmstmm.dense_inertia.block_inertia`;
 * :func:`count` — :meth:`linmstmm.wittrick_williams.ModeCounter._numpy_at`: the
   whole count J(ω) in one call (J₀, D(ω), its equilibration, and LDLᵀ
   factorisations by LAPACK's ``dsytrf`` of it shifted up and down), compiled
@@ -317,10 +317,10 @@ def count(omega, beams, maps, columns, static, mass, singular_pivot, matrix, mag
 
     The arguments of :func:`assembled`, and singular_pivot: a pivot below this
     fraction of the largest equilibrated term is rounding
-    (:data:`linmstmm.wittrick_williams.SINGULAR_PIVOT`); work : (n · WORK_PER_UNKNOWN,)
+    (:data:`linmstmm.dense_inertia.SINGULAR_PIVOT`); work : (n · WORK_PER_UNKNOWN,)
     float64. D(ω) is equilibrated by the diagonal of |D|(ω), shifted by ± the rounding
     level and factorised both ways, whose counts must agree
-    (:func:`linmstmm.wittrick_williams._negative_eigenvalues`, the same numbers in
+    (:func:`linmstmm.dense_inertia.negative_eigenvalues`, the same numbers in
     the same order of operations).
     """
     clamped = assembled(omega, beams, maps, columns, static, mass, matrix, magnitude)

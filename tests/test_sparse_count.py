@@ -32,7 +32,8 @@ from linmstmm.fe import fe_frequencies
 from linmstmm.model import load_model
 from linmstmm._ordering_kernels import count_patterns, minimum_degree, pattern_with_beams, slot_terms
 from linmstmm.ordered_ldlt import elimination_plan
-from linmstmm.wittrick_williams import MOST_GROWTH, SINGULAR_PIVOT, ModeCounter, _block_inertia, _plan_of
+from linmstmm.dense_inertia import block_inertia
+from linmstmm.wittrick_williams import MOST_GROWTH, SINGULAR_PIVOT, ModeCounter, _plan_of
 from random_models import KINDS, random_model
 
 LAUNCHERS = ("models/mlrs/mlrs.toml", "models/launcher2/launcher2.toml")
@@ -249,7 +250,7 @@ def test_growth_is_refused_where_it_would_give_a_wrong_count():
     assert counted(1e300) == [2, 2]
     assert counted(MOST_GROWTH * np.abs(matrix).max()) == [-1, -1]
     factor, pivots, info = la.lapack.dsytrf(matrix, lower=1)
-    assert info == 0 and _block_inertia(factor, pivots, singular) == 1
+    assert info == 0 and block_inertia(factor, pivots, singular) == 1
 
 
 def test_the_plan_eliminates_the_launcher_with_little_fill():

@@ -23,7 +23,8 @@ from linmstmm.fe import assemble, fe_frequencies
 from linmstmm.fe.elements import beam_element
 from linmstmm.model import Model, load_model
 from linmstmm.solve import natural_frequencies
-from linmstmm.wittrick_williams import MAX_ORDER, ModeCounter, _block_inertia, mode_counter
+from linmstmm.dense_inertia import block_inertia
+from linmstmm.wittrick_williams import MAX_ORDER, ModeCounter, mode_counter
 from random_models import KINDS, random_model
 from test_sparse_count import dense_count
 from varied_models import in_units, varied_model
@@ -185,11 +186,11 @@ def test_block_inertia_kernel_mirrors_the_reference():
             factor, pivots, info = la.lapack.dsytrf(matrix, lower=1)
             assert info == 0
             blocks += int(np.sum(pivots < 0)) // 2
-            reference = _block_inertia(factor, pivots, 1e-11)
+            reference = block_inertia(factor, pivots, 1e-11)
             assert kernels.block_inertia(factor, pivots, 1e-11) == reference == int(np.sum(la.eigvalsh(matrix) < 0))
             # a threshold above the smallest pivot or block eigenvalue: undecided in both
             threshold = 1.01 * min(_pivot_sizes(factor, pivots))
-            assert _block_inertia(factor, pivots, threshold) is None
+            assert block_inertia(factor, pivots, threshold) is None
             assert kernels.block_inertia(factor, pivots, threshold) == -1
     assert blocks > 20  # 2 × 2 blocks were exercised
 

@@ -172,11 +172,12 @@ def separated(finder, roots: list[float]) -> list[float]:
 
     Roots closer than SPLIT are counted as one multiple root (a circle of that
     radius holds them all). Each multiple root is counted again over a circle
-    TIGHTER times smaller (:func:`tight_counts`), by the Wittrick–Williams counts at the two ends of its
-    diameter on the real axis, where every natural frequency lies, and by the
-    argument principle where they cannot decide (all those in one count; some
-    20 evaluations of det each: a symmetric rod's ten lowest spent 104 of their
-    138 on them): a multiple root keeps its count, a cluster does not, and its
+    TIGHTER times smaller (:func:`tight_counts`), by the Wittrick–Williams counts
+    at the two ends of its diameter on the real axis, where every natural
+    frequency lies, and by the argument principle where they cannot decide (all
+    those in one count; some 20 evaluations of det each: a symmetric rod's ten
+    lowest spent 104 of their 138 on them): a multiple root keeps its count, a
+    cluster does not, and its
     members are then isolated by bisection on the count within the first
     circle (:meth:`_isolate`). A random loop's double root and the simple one
     1.9e-5 above it had come back as one triple root.

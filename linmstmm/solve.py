@@ -142,7 +142,7 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     """
     system = compiled_system(model, root, cut_at, engine, frequencies, predicted)
     evaluator = system.determinant
-    finder = RootFinder(evaluator.log_det, evaluator.matrix,
+    finder = RootFinder(evaluator.log_det, lambda omega: evaluator.matrix(omega)[0],
                         rigid_body_modes=system.rigid_body_modes,
                         predictor=functools.partial(predicted_modes, model), scale=system.scale, **options)
     finder.determinant = evaluator

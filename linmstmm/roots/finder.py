@@ -30,8 +30,7 @@ class RootFinder:
     """Finds the natural frequencies of a deduced model.
 
     log_det : callable omega (n,) -> (sign (n,), log|det| (n,)).
-    matrix : callable omega (n,) -> (Ū_all stack (n, N, N), log_scale (n,)), det Ū_all =
-    det(matrix) · exp(log_scale) (:meth:`~linmstmm.determinant.CompiledDeterminant.matrix`).
+    matrix : callable omega (n,) -> Ū_all stack (n, N, N).
     xtol : Newton's relative tolerance. points_per_octave : scan density, at
     least POINTS_PER_OCTAVE (a denser scan leaves fewer close roots to the
     repairs; a coarser one is refused, see MIN_POINTS_PER_OCTAVE).

@@ -10,33 +10,11 @@ import scipy.linalg
 from linmstmm.nullspace import equilibration
 
 
-#: A change of log_scale (the log of det Ū_all the stack's orthonormalisations took out of
-#: the matrix, :meth:`~linmstmm.determinant.CompiledDeterminant.matrix`) between ω and
-#: ω (1 + step) beyond this: the pair is evaluated again on its own (:func:`pencil`).
-SCALE_JUMP = 1e-3
-
-
 def pencil(finder, omegas, step: float = 1e-7):
-    """(Ū(ω), dŪ/dω), the derivative a forward difference of ``matrix``, all ω and
-    their neighbours ω (1 + step) in one stack, whose orthonormalisations take the
-    same decisions throughout.
-
-    A decision taken for the stack's other frequencies can orthonormalise a block that
-    is nearly singular at ω, where det Ū_all moves fast: its R then holds the root, the
-    matrix keeps only Q, and log_scale takes the difference between ω and its
-    neighbour (3.3 at a free star's double root, where they are 1e-7 apart; 1e-6 alone),
-    so the pencil no longer sees the root. A pair whose log_scale differs by more than
-    SCALE_JUMP is evaluated again on its own, with decisions of its own: the numpy
-    carry's Newton had given up on three double roots in a batch of eight, and the
-    segment search took 8,000 evaluations for them.
-    """
-    n, steps = omegas.size, step * omegas
-    stack, log_scale = finder.matrix(np.concatenate([omegas, omegas + steps]))
-    if n > 1:
-        for i in np.flatnonzero(np.abs(log_scale[n:] - log_scale[:n]) > SCALE_JUMP):
-            alone, _ = finder.matrix(np.array([omegas[i], omegas[i] + steps[i]]))
-            stack[i], stack[n + i] = alone
-    return stack[:n], (stack[n:] - stack[:n]) / steps[:, None, None]
+    """(Ū(ω), dŪ/dω), the derivative a forward difference of ``matrix``."""
+    steps = step * omegas
+    stack = finder.matrix(np.concatenate([omegas, omegas + steps]))
+    return stack[:omegas.size], (stack[omegas.size:] - stack[:omegas.size]) / steps[:, None, None]
 
 
 def offsets(finder, omegas, full=True) -> list[np.ndarray]:

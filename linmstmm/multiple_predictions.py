@@ -57,12 +57,11 @@ def other_members(finder, roots: list[float], predictions: np.ndarray, leaders: 
     often as the count over its tight circle finds more roots there
     (:meth:`RootFinder.tight_counts`, all circles in one count; the count
     :meth:`RootFinder._separated` asks of every multiple root anyway), where that
-    accounts for all its followers. A group this does not settle is left to the scan
-    (:func:`~linmstmm.predicted._polished` returns None): the segment search about it
-    took a round cantilever of 100 beams' double roots 560 of the 790 evaluations its
-    ten lowest cost from their predictions, where the scan took 635; pairs 1e-6 to 3e-6
-    apart 8,000 to 44,000; an octahedral star's clusters of three roots 5e-8 apart
-    18,613 for ten, the scan 1,562. A circle count is
+    accounts for all its followers. The followers of a group this does not settle are
+    polished one by one, as a close pair's members are (:func:`~linmstmm.predicted._deflated_polished`). In
+    the segment search a round cantilever of 100 beams' double roots took 560 of the
+    790 evaluations its ten lowest cost from their predictions, where the scan took
+    635; pairs 1e-6 to 3e-6 apart took it 8,000 to 44,000. A circle count is
     independent of the certifying count over the whole range, in which a root divided
     out once too often would cancel one missed elsewhere."""
     if not followers.size:

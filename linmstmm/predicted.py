@@ -213,10 +213,8 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
     stand where counts certify them to a loose rtol (unless ``stood`` is None; those added
     to ``stood``), else by the secant (from
     their brackets' ends where ``spans`` has one), then the pencil, then the segment search
-    around those both left troubled. None where a count of that search cannot be made, or,
-    without a counter, where a group of coinciding predictions is not settled
-    (:func:`~linmstmm.multiple_predictions.other_members`): the full search decides. A
-    root the pencil or the deflated secant finds within rtol of
+    around those both left troubled. None where a count of that search cannot be made (the
+    full search decides). A root the pencil or the deflated secant finds within rtol of
     a value that stood is that value's root (:class:`Stood`)."""
     in_cluster = clustered(predictions)  # the same for the counts and the secant
     standing, indices = (_counted_predictions(finder, predictions, in_cluster, start, stop) if stood is not None

@@ -229,10 +229,9 @@ def _polished(finder, predictions: np.ndarray, roots: list[float], start: int, s
     stood_for = Stood(stood, finder.rtol)
     found, troubled = _pencil_polished(finder, list(roots) + standing + found,
                                        unsettled + [float(p) for p in predictions[leaders]], stood_for)
-    if finder.counter is None:  # no counts to give a multiple root's members: the pencil's or a circle's
+    if finder.counter is None:  # no counts to give a multiple root's members: a circle's, else each polished
         found, followers = other_members(finder, found, predictions, leaders, followers)
-        if followers.size:  # a cluster neither tells apart: the scan does (the segment search here cost 12 times more)
-            return None
+        troubled, followers = troubled + [float(p) for p in predictions[followers]], followers[:0]
     found, troubled = _deflated_polished(finder, found, troubled, predictions, stood_for)
     for lo, hi in intervals_around(troubled + [float(p) for p in predictions[followers]], predictions, found):
         counted = _completed_by_counts(finder, found, lo, hi)

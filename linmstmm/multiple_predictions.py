@@ -80,9 +80,8 @@ def other_members(finder, roots: list[float], predictions: np.ndarray, leaders: 
     centres = [c for c in centres if c not in shared]
     if not centres:
         return roots, followers
-    unknown = [c for c in centres if finder.offsets_at.get(c, np.zeros(0)).size == 0]
-    offsets = dict(zip(unknown, finder._offsets(np.array(unknown)) if unknown else []))
-    partners = finder.beside([(c, offsets.get(c, finder.offsets_at.get(c))) for c in centres])
+    offsets = finder.offsets_of(centres, [1] * len(centres))
+    partners = finder.beside([(c, offsets[c]) for c in centres])
     roots, settled, alone = list(roots), set(), []
     for centre, members, beside in zip(centres, groups, partners):
         beside = [r for r in beside if not near_any(r, roots, finder.same_root)]

@@ -258,6 +258,15 @@ def beside(finder, polished) -> list[list[float]]:
     return near
 
 
+def offsets_of(finder, roots: list[float], least: list[int]) -> dict[float, np.ndarray]:
+    """root (rad/s) -> the pencil's offsets there: those its polish kept
+    (:attr:`RootFinder.offsets_at`) where they hold at least ``least`` (one per root)
+    values, else found now, all those in one call (:meth:`RootFinder._offsets`)."""
+    missing = [r for r, n in zip(roots, least) if finder.offsets_at.get(r, np.zeros(0)).size < n]
+    found = dict(zip(missing, finder._offsets(np.array(missing)) if missing else []))
+    return {r: found[r] if r in found else finder.offsets_at[r] for r in roots}
+
+
 def _apart_by_offsets(finder, roots: list[float], copies: dict[float, int]) -> list[float]:
     """``roots`` with each multiple one whose pencil shows a distinct root beside it
     (:func:`beside`) split: that root takes one of its copies, unless a count across
@@ -266,10 +275,7 @@ def _apart_by_offsets(finder, roots: list[float], copies: dict[float, int]) -> l
     counts of :func:`separated` only say how many roots a circle holds. ``copies``:
     each multiple root of ``roots`` (:func:`_multiple`) -> how many roots sit there."""
     multiple = sorted(copies)
-    known = [r for r in multiple if finder.offsets_at.get(r, np.zeros(0)).size >= copies[r]]
-    missing = [r for r in multiple if r not in known]
-    offsets = dict(zip(missing, finder._offsets(np.array(missing)) if missing else []))
-    offsets.update((r, finder.offsets_at[r]) for r in known)
+    offsets = offsets_of(finder, multiple, [copies[r] for r in multiple])
     split = list(roots)
     for r, near in zip(multiple, beside(finder, [(r, offsets[r]) for r in multiple])):
         near = [member for member in near if not any(abs(member - other) <= finder.rtol * other for other in split)]

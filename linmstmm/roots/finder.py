@@ -329,6 +329,7 @@ class RootFinder:
     multiplicities = close_roots.multiplicities
     tight_counts = close_roots.tight_counts
     beside = close_roots.beside
+    offsets_of = close_roots.offsets_of
     unseparated_among = close_roots.unseparated_among
     multiplicity = close_roots.multiplicity
     _separated = close_roots.separated

@@ -11,7 +11,7 @@ import pytest
 import linmstmm.roots.segments as segments
 from linmstmm import fe_frequencies, load_model, natural_frequencies
 from linmstmm.roots import certify
-from linmstmm.roots.counted_search import counted_segment
+from linmstmm.roots.counted_search import _split, counted_segment
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -29,6 +29,10 @@ class KnownRoots:
         (relative) of them."""
         self.roots, self.undecided, self.blind = np.sort(roots), undecided, blind
         self.last_step, self.evaluations = {}, 0
+        self._counted, self._circles = {}, {}  # multiplicities as the finder records them
+
+    def counter_for_stretch(self):
+        return self.counter
 
     @property
     def fine_rtol(self):
@@ -96,6 +100,34 @@ def test_an_undecided_count_or_an_unresolved_cluster_hands_the_segment_back():
     unresolved = KnownRoots([4.0, 9.0, 9.0])
     unresolved.cluster = lambda omega: []  # the pencil finds nothing there
     assert counted_segment(unresolved, 1.0, 20.0) is None
+
+
+def test_a_double_root_the_pencil_sees_too_often_is_taken_as_the_counts_bound_it():
+    """An octahedral star's pencil saw one double root of a cluster six times, and the count
+    cannot decide within 1e-9 of it, so its piece cannot be halved: the counts within ±rtol
+    of it, and over that and the piece together, find its two, which it then holds."""
+    double = 9.0 * (1 + 5e-8)
+    finder = KnownRoots([4.0, 9.0, double, double, 15.0], undecided=(double,), blind=1e-9)
+    finder.cluster = lambda omega: [double] * 6 if abs(omega - double) < 1e-4 * 9.0 else []
+    found = counted_segment(finder, 1.0, 20.0)
+    assert found == pytest.approx([4.0, 9.0, double, double, 15.0], rel=1e-13)
+    assert finder._counted[found[2]] == 2  # the counts' multiplicity, for the later checks
+    # a value held by fewer than the piece holds within ±rtol: not taken
+    lone = KnownRoots([4.0, 9.0, double, double * (1 + 3e-9), 15.0], undecided=(double,), blind=1e-8)
+    lone.cluster = lambda omega: [double] * 6 if abs(omega - double) < 1e-4 * 9.0 else []
+    assert counted_segment(lone, 1.0, 20.0) is None
+
+
+def test_a_piece_whose_middle_the_count_cannot_decide_is_split_between_the_pencils_roots():
+    """Two double roots 5e-8 apart whose piece's middle the count cannot decide (an
+    octahedral star's, bending planes 1e-7 apart): the piece is split halfway between
+    the pencil's two roots instead, where the count decides; where none decides, the
+    middle is given back undecided."""
+    lower, upper = 9.0 * (1 - 1e-8), 9.0 * (1 + 4e-8)
+    lo, hi = 9.0 * (1 - 6e-8), 9.0 * (1 + 6e-8)
+    finder = KnownRoots([4.0, lower, lower, upper, upper, 15.0], undecided=(0.5 * (lo + hi),))
+    assert _split(finder, lo, hi, [lower, upper]) == (0.5 * (lower + upper), 3)
+    assert _split(finder, lo, hi, [lower]) == (0.5 * (lo + hi), None)
 
 
 def test_the_launchers_first_100_agree_with_the_fe_route(monkeypatch):

@@ -56,19 +56,34 @@ def counted_segment(finder, lo: float, hi: float) -> list[float] | None:
     Wittrick–Williams counts and det Ū_all; None without a counter, or where a count
     cannot decide or a piece cannot be resolved (the caller then runs the
     argument-principle segment search)."""
-    if finder.counter is None:
+    if finder.counter_for_stretch() is None:
         return None
     outward = 1 if finder.fine_rtol else 0
     (start, below), (stop, above) = _decided_end(finder, lo, -outward), _decided_end(finder, hi, outward)
     if below is None or above is None:
         return None
     found = _pieces(finder, start, stop, below, above, 0)
-    if found is None or (start, stop) == (lo, hi):
+    if found is None:
+        return None
+    _record_multiplicities(finder, found)
+    if (start, stop) == (lo, hi):
         return found
     if _crowded(found, lo, start) or _crowded(found, hi, stop):
         return None
     same = finder.same_root  # lo found again stays out, hi found again is in; no other beyond them
     return [root for root in found if lo * (1 + same) < root <= hi * (1 + same)]
+
+
+def _record_multiplicities(finder, found: list[float]) -> None:
+    """Record how often each root of ``found`` (rad/s) is repeated as its multiplicity
+    (:attr:`RootFinder._counted`), in place of a circle count of it made before: the
+    counts of the pieces bound these. A circle drawn about a double root before its
+    neighbour 5e-8 above was found passed through that neighbour and counted 3 (an
+    octahedral star, bending planes 1e-7 apart), and the check of multiplicities
+    (:meth:`RootFinder._separated`) then failed to part the double root in float64."""
+    for root in set(found):
+        finder._counted[root] = found.count(root)
+        finder._circles.pop(root, None)
 
 
 def _decided_end(finder, omega: float, outward: int) -> tuple[float, int | None]:
@@ -107,17 +122,52 @@ def _pieces(finder, lo: float, hi: float, below: int, above: int, depth: int) ->
             return [root]
     elif hi - lo < finder.CERTIFIED_WIDTH * hi:
         return None  # float64 cannot tell them apart: the segment search reports them together
-    elif hi - lo < CLUSTER_WIDTH * hi:
+    members = []
+    if expected > 1 and hi - lo < CLUSTER_WIDTH * hi:
         members = sorted(r for r in finder.cluster(0.5 * (lo + hi)) if lo < r <= hi)
         if len(members) == expected and not _split_across(finder, members):
             return members
-    middle = 0.5 * (lo + hi)
-    at_middle = finder.counter(middle)
+        held = _held_by_one(finder, members, lo, hi, expected)
+        if held is not None:
+            return held
+    middle, at_middle = _split(finder, lo, hi, sorted(set(members)))
     if at_middle is None:
         return None
     lower = _pieces(finder, lo, middle, below, at_middle, depth + 1)
     upper = None if lower is None else _pieces(finder, middle, hi, at_middle, above, depth + 1)
     return None if upper is None else lower + upper
+
+
+def _split(finder, lo: float, hi: float, distinct: list[float]) -> tuple[float, int | None]:
+    """(a point inside (lo, hi), J there; None where no count there decides): the middle,
+    else the points halfway between neighbours of ``distinct`` (rad/s, ascending: the
+    pencil's roots inside), the farthest from them. Within a cluster the count cannot
+    decide near its roots: an octahedral star's two double roots 5e-8 apart (bending
+    planes 1e-7 apart) left the middle of their piece 1.2e-7 wide undecided."""
+    for point in [0.5 * (lo + hi)] + [0.5 * (a + b) for a, b in zip(distinct, distinct[1:])]:
+        count = finder.counter(point)
+        if count is not None:
+            return point, count
+    return 0.5 * (lo + hi), None
+
+
+def _held_by_one(finder, members: list[float], lo: float, hi: float, expected: int) -> list[float] | None:
+    """[root] * ``expected`` where the pencil's ``members`` (rad/s) in the piece (lo, hi]
+    are one root it took with another multiplicity, and the counts find the piece's
+    ``expected`` roots all within the finder's rtol of it: J over (root (1 − rtol), root
+    (1 + rtol)] is ``expected``, and so is J over the union of that with the piece, so
+    the two hold the same roots. None otherwise.
+
+    The pencil of a cluster can see one double root of it six times (an octahedral star
+    with bending planes 1e-6 apart, double roots 2.5e-7 apart): the piece around it
+    cannot be halved where the count cannot decide, 1e-9 from the root."""
+    if len(set(members)) != 1:
+        return None
+    root = members[0]
+    near_lo, near_hi = root * (1 - finder.rtol), root * (1 + finder.rtol)
+    around = finder.stiffness_count([], near_lo, near_hi)
+    union = finder.stiffness_count([], min(lo, near_lo), max(hi, near_hi))
+    return [root] * expected if around == expected and union == expected else None
 
 
 def _split_across(finder, members: list[float]) -> bool:

@@ -18,6 +18,7 @@ pencil that predicts the roots is kept the same way
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from linmstmm.coarse_prediction import coarse_pencil, predicted_modes
@@ -43,7 +44,7 @@ from linmstmm.nullspace import characteristic_frequencies, release_indeterminate
 from linmstmm.rigid_motion import held_still, rigid_body_mode_count
 from linmstmm.roots.settings import FLOOR_RATIO, predictions_wanted
 from linmstmm.topology import build_topology
-from linmstmm.wittrick_williams import ModeCounter, mode_counter, too_large_to_count
+from linmstmm.wittrick_williams import ModeCounter, late_counter, mode_counter, too_large_to_count
 
 @dataclass(frozen=True, eq=False)
 class CompiledSystem:
@@ -69,6 +70,9 @@ class CompiledSystem:
         :func:`~linmstmm.nullspace.characteristic_frequencies`).
     counter : ModeCounter or None
         The Wittrick–Williams counter (:func:`~linmstmm.wittrick_williams.mode_counter`).
+    late_counter : callable or None
+        For a model with no ``counter``: () -> its counter up to a larger order, made
+        on the first call, or None (:func:`~linmstmm.wittrick_williams.late_counter`).
     """
 
     deduction: Deduction
@@ -78,6 +82,7 @@ class CompiledSystem:
     rigid_zeros_confirmed: bool
     scale: float
     counter: ModeCounter | None
+    late_counter: Callable[[], ModeCounter | None] | None
 
 
 def compiled_system(model: Model, root: str | None = None, cut_at=(), engine: str = "auto",
@@ -189,7 +194,9 @@ def _compiled_now(model: Model, root: str | None, cut_at: tuple, engine: str) ->
     rigid = 0 if held_still(deduction) else rigid_body_mode_count(model)
     scale = min(scales)
     confirmed = bool(rigid) and count_in_disc(evaluator.log_det, FLOOR_RATIO * scale) == 2 * rigid
-    return CompiledSystem(deduction, evaluator, released, rigid, confirmed, scale, mode_counter(model, engine))
+    counter = mode_counter(model, engine)
+    late = None if counter is not None else late_counter(model, engine)
+    return CompiledSystem(deduction, evaluator, released, rigid, confirmed, scale, counter, late)
 
 
 def forget_compiled_models() -> None:

@@ -149,6 +149,7 @@ def frequency_finder(model: Model, root: str | None = None, cut_at=(), engine: s
     finder._evaluations_reported = evaluator.evaluations  # this finder's search counts from here
     if system.counter is not None:
         finder.counter = system.counter.fresh()
+    finder.late_counter = system.late_counter
     if system.rigid_zeros_confirmed:
         finder.divide_out_rigid_body_zeros()
     return system.deduction, finder, system.released

@@ -179,6 +179,9 @@ class RootFinder:
         #: :class:`~linmstmm.wittrick_williams.ModeCounter`); None: counts by the
         #: argument principle only (see :func:`linmstmm.roots.certify.other_zeros`)
         self.counter = None
+        #: for a model too large to count at every root: callable () -> its counter or
+        #: None, made only where a stretch must be searched (:meth:`counter_for_stretch`)
+        self.late_counter = None
 
     def divide_out_rigid_body_zeros(self) -> None:
         """Count and scan det Ū_all / ω^2r instead of det Ū_all.
@@ -193,6 +196,20 @@ class RootFinder:
         """
         self.log_det = deflated(self.log_det, np.zeros(self._rigid))
         self._divided = True
+
+    def counter_for_stretch(self):
+        """The counter a stretch of roots is searched with (:mod:`~linmstmm.roots.counted_search`):
+        :attr:`counter`, made now from :attr:`late_counter` where there is none yet, and
+        kept for the rest of the search. A model too large to count at every root
+        (:data:`~linmstmm.wittrick_williams.MAX_ORDER`) comes here only where its
+        predictions' polish leaves a stretch unsettled: roots closer than det Ū_all and its
+        pencil can part, which the counts bisect (each count a factorisation of D(ω),
+        10 ms at 690 unknowns, against the hundreds of evaluations of det the
+        argument-principle search of such a stretch takes a root). None without either."""
+        if self.counter is None and self.late_counter is not None:
+            made, self.late_counter = self.late_counter(), None
+            self.counter = None if made is None else made.fresh()
+        return self.counter
 
     def rigid_body_modes(self) -> int:
         """Number of zero-frequency (rigid-body) modes, as given at construction."""

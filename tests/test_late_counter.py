@@ -13,33 +13,14 @@ import numpy as np
 import pytest
 
 from linmstmm import fe_frequencies
-from linmstmm.builders import fixed, make_beam
-from linmstmm.model import Model
+from linmstmm.builders import beam_star
 from linmstmm.solve import natural_frequencies
 from linmstmm.wittrick_williams import CLUSTER_ORDER, MAX_ORDER, late_counter, mode_counter
-
-AXES = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]
-
-
-def octahedral_star(beams_per_arm: int, gap: float) -> Model:
-    """Six 1 m steel arms along ±x, ±y, ±z from a free centre, each of ``beams_per_arm``
-    beams (A 1e-3 m², Iy 2e-7 m⁴, Iz = Iy (1 + ``gap``)²), their far ends clamped."""
-    points, beams, boundary = {"c": np.zeros(3)}, [], {}
-    for arm, axis in enumerate(AXES):
-        previous = "c"
-        for k in range(1, beams_per_arm + 1):
-            name = f"a{arm}_{k}"
-            points[name] = np.asarray(axis, float) * k / beams_per_arm
-            beams.append(make_beam(f"b{arm}_{k}", previous, name, points, Iy=2e-7, Iz=2e-7 * (1 + gap) ** 2,
-                                   J=4e-7, Ip=4e-7))
-            previous = name
-        boundary[previous] = fixed()
-    return Model("octahedral star", points, beams=tuple(beams), boundary=boundary)
 
 
 def test_the_star_has_a_counter_only_late():
     """Twenty beams an arm: 690 unknowns, no counter at every root, one made late."""
-    star = octahedral_star(20, 1e-5)
+    star = beam_star(20, 1e-5)
     assert mode_counter(star) is None
     made = late_counter(star)()
     assert MAX_ORDER < made.n_dof <= CLUSTER_ORDER
@@ -49,13 +30,13 @@ def test_a_count_that_ends_on_a_double_root_keeps_both_its_copies():
     """The 20 lowest end on a double root with two more 5e-6 and 1e-5 above it. Its circle,
     drawn among the roots found, held all six; the pencil showed the highest beside it, which
     took one of its two copies: the 20th came back 1e-5 high, with no note."""
-    star = octahedral_star(20, 1e-5)
+    star = beam_star(20, 1e-5)
     got = natural_frequencies(star, 20)
-    fe = fe_frequencies(octahedral_star(20, 1e-5), 20, elements_per_beam=8).frequencies_hz
+    fe = fe_frequencies(beam_star(20, 1e-5), 20, elements_per_beam=8).frequencies_hz
     np.testing.assert_allclose(got.frequencies_hz, fe, rtol=1e-7)  # FE's mesh error: 3e-8
     assert got.frequencies_hz[-1] == pytest.approx(got.frequencies_hz[-2], rel=1e-12)
     assert got.precision == "float64" and got.note == ""
-    counted = natural_frequencies(octahedral_star(1, 1e-5), 20)  # a counter at every root
+    counted = natural_frequencies(beam_star(1, 1e-5), 20)  # a counter at every root
     np.testing.assert_allclose(got.frequencies_hz, counted.frequencies_hz, rtol=1e-11)
 
 
@@ -64,11 +45,11 @@ def test_clusters_are_parted_by_the_late_counts(gap):
     """Roots gap / 2 apart in clusters of three, and double roots. The argument-principle
     search of their stretches took some 2,000 evaluations of det Ū_all a root (100 to 190 s
     at twenty beams an arm); the late counts bisect them in a few hundred."""
-    star = octahedral_star(6, gap)
+    star = beam_star(6, gap)
     got = natural_frequencies(star, 10)
-    fe = fe_frequencies(octahedral_star(6, gap), 10, elements_per_beam=8).frequencies_hz
+    fe = fe_frequencies(beam_star(6, gap), 10, elements_per_beam=8).frequencies_hz
     np.testing.assert_allclose(got.frequencies_hz, fe, rtol=1e-7)
-    counted = natural_frequencies(octahedral_star(1, gap), 10)
+    counted = natural_frequencies(beam_star(1, gap), 10)
     # (at gap 1e-6 the 9th and 10th are 1.3e-11 apart, FE at 128 elements a beam: each
     # search reports them as a double root, within the default rtol of 1e-9, at one or the other)
     np.testing.assert_allclose(got.frequencies_hz, counted.frequencies_hz, rtol=1e-10)

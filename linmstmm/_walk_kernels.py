@@ -95,7 +95,7 @@ def walk(kinds, elements, input_start, links, joints, set_columns, set_start, ro
     element_count, cut_count : int
         Elements and cuts of the topology.
     final_carries : int
-        :data:`linmstmm.program.FINAL_CARRIES`.
+        :data:`linmstmm.godunov.FINAL_CARRIES`.
     room : int
         Slots and records of each table the record has room for; place entries, PLACES_A_RECORD times as many.
 
@@ -455,7 +455,7 @@ def _laid(r, src, columns, rows, kind, forces):
 @njit
 def _leave_final_orthos_to_the_lu(r, final_carries):
     """Mark the orthonormalisations after which at most ``final_carries`` carries and no
-    beam remain as layout only (:data:`linmstmm.program.FINAL_CARRIES`)."""
+    beam remain as layout only (:data:`linmstmm.godunov.FINAL_CARRIES`)."""
     carries = 0
     operations = _table(r, _OPERATIONS)
     orthos = _table(r, _ORTHOS)

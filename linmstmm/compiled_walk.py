@@ -30,7 +30,7 @@ def compiled_walk(deduction, final_carries: int) -> tuple[dict, Constants, tuple
     deduction : Deduction
         The deduced system, any indeterminate unknowns released.
     final_carries : int
-        :data:`linmstmm.program.FINAL_CARRIES`.
+        :data:`linmstmm.godunov.FINAL_CARRIES`.
 
     Returns
     -------

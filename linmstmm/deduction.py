@@ -38,7 +38,7 @@ import numpy as np
 from linmstmm.elements.beam import beam_transfer, bending_wavenumber
 from linmstmm.elements.rigid import force_extraction, position_incidence, rigid_transfer_parts
 from linmstmm.elements.spring import joint_force, joint_jump, spring_constant_transfer
-from linmstmm.godunov import PortState, _Orthonormaliser, _row_kinds
+from linmstmm.godunov import PortState, _Orthonormaliser, _row_kinds, left_to_the_lu
 from linmstmm.load_jumps import _Loads
 from linmstmm.numeric import constant_times, frequencies, is_mp, numbers, zeros_like_stack
 from linmstmm.periodic import carry_run, find_runs
@@ -319,12 +319,12 @@ class Deduction:
     def _carry(self, omega, stable: bool, loads=None):
         """Carry states from the tips to the root.
 
-        stable : orthonormalise columns on the way (:class:`_Orthonormaliser`)
-        and split beams into pieces of βL <= _BEAM_PIECE_BETA_L.
+        stable : orthonormalise columns on the way (:class:`_Orthonormaliser`; the last few
+        to the final LU, :func:`~linmstmm.godunov.left_to_the_lu`), beams in pieces of βL <= _BEAM_PIECE_BETA_L.
         loads : the point loads and probes of :meth:`forced` (:class:`_Loads`), or None.
 
-        rows[0] is the main equation's known side, ``−Z_root`` (12 rows); the
-        geometric rows follow (6 each). For a boundary-less model Z_root is the
+        rows[0] is the main equation's known side, ``−Z_root`` (12 rows); the geometric
+        rows follow (6 each). For a boundary-less model Z_root is the
         closing cut's own unknowns, so that row is orthonormalised with the
         state carried round the loop: Ū_all = T_loop − I is never formed, whose
         I would be lost under T_loop's growing solutions.
@@ -339,7 +339,7 @@ class Deduction:
         open_states: dict[int, PortState] = {}
         given = self.root_given(n)
         rows = [["root", given.columns, -given.matrix]]
-        normaliser = _Orthonormaliser(omega) if stable else None
+        normaliser, left = (_Orthonormaliser(omega), left_to_the_lu(self.topology)) if stable else (None, ())
         order = self.topology.order
         runs = {run.start: run for run in self.periodic_runs()} if stable and not loads.active else {}
         loads.watch_tips(open_states)
@@ -381,7 +381,7 @@ class Deduction:
                                                              (state.columns, constant_times(incidence, state.matrix))])])
             state = PortState(*self._combined((e,), terms), reference=_largest([state.reference for state in inputs]))
             state = loads.jumped((e, element.output), state, rows)
-            if stable:
+            if stable and e not in left:
                 state = normaliser.apply(state, rows, open_states)
             outputs[e] = open_states[e] = state
             loads.watch((e, element.output), state, open_states)

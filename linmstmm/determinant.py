@@ -362,7 +362,7 @@ class CompiledDeterminant(EvaluationCount):
         evaluations.
 
         The program with every orthonormalisation only laid out (the flag of those the
-        final LU takes over, :data:`linmstmm.program.FINAL_CARRIES`), one frequency at a
+        final LU takes over, :data:`linmstmm.godunov.FINAL_CARRIES`), one frequency at a
         time. A beam's pieces of βL ≤ 4 are multiplied through, the same transfer as the
         numpy carry's one piece; at the probes of
         :func:`~linmstmm.nullspace.release_indeterminate`, below every beam's own scale,

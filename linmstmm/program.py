@@ -29,24 +29,12 @@ import numpy as np
 from linmstmm.compiled_walk import compiled_walk
 from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import _state_rotation
+from linmstmm.godunov import FINAL_CARRIES
 from linmstmm.model_structure import KeptByKey
 from linmstmm.program_constants import Constants
 from linmstmm.program_record import (BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, ROW_BLOCK, STATE_BLOCK, TIP,
                                      Program)
 
-#: An orthonormalisation after which at most this many element carries, and no
-#: beam, remain is left to the final LU: a change of unknowns (every block that
-#: holds its columns is in it) commutes with the carries that follow (they
-#: multiply rows), and the LU factorises the same matrix. On the launcher these
-#: were the four largest (60 rows, 54 columns) and cost more than half of an
-#: evaluation at 1000 rad/s and above (224 → 88 µs); log|det| against mpmath at
-#: 12 frequencies from 10 to 3e4 rad/s kept its accuracy on both launcher models
-#: (largest error 2e-11 below 1e4 rad/s and 4e-8 above, as before, against 5e-11
-#: and 6e-8 of the numpy carry). Not for a model without boundary, whose
-#: closing equation T_loop − I must be orthonormalised with the state carried
-#: round the loop (every block holds the closing cut's unknowns there), lest the I
-#: be lost under T_loop's growth (a ring at 1.3e5 rad/s lost 3e-9 in log|det|).
-FINAL_CARRIES = 4
 
 
 class _Planner:
@@ -481,7 +469,8 @@ def _joint(plan: _Planner, deduction: Deduction, e: int, state: int, rows: list)
 
 
 def _leave_final_orthos_to_the_lu(plan: _Planner) -> None:
-    """Mark the orthonormalisations :data:`FINAL_CARRIES` describes as layout only."""
+    """Mark the orthonormalisations :data:`~linmstmm.godunov.FINAL_CARRIES` describes as layout
+    only (those :func:`~linmstmm.godunov.left_to_the_lu` leaves in the numpy carry)."""
     carries = 0
     for code, index, *_ in reversed(plan.operations):
         if code == BEAM:

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from linmstmm import compiled_walk, program
+from linmstmm import compiled_walk, godunov, program
 from linmstmm.deduction import Deduction
 from linmstmm.model import load_model
 from linmstmm.nullspace import release_indeterminate
@@ -72,8 +72,8 @@ def test_the_compiled_walk_writes_the_python_walks_program_on_random_models(kind
 def test_a_walk_that_outgrows_its_room_walks_again_with_more():
     deduction = _deduced(load_model(MODELS / "launcher2/launcher2.toml"))
     arrays, _ = compiled_walk._walk_input(deduction)
-    roomy = compiled_walk._walked(arrays, program.FINAL_CARRIES, 1000 * arrays[3].shape[0])
-    cramped = compiled_walk._walked(arrays, program.FINAL_CARRIES, 1)  # grown four times over and over
+    roomy = compiled_walk._walked(arrays, godunov.FINAL_CARRIES, 1000 * arrays[3].shape[0])
+    cramped = compiled_walk._walked(arrays, godunov.FINAL_CARRIES, 1)  # grown four times over and over
     assert len(roomy) == len(cramped)
     for a, b in zip(roomy, cramped):
         assert np.asarray(a).tobytes() == np.asarray(b).tobytes()

@@ -159,7 +159,7 @@ def _held_by_one(finder, members: list[float], lo: float, hi: float, expected: i
     the two hold the same roots. None otherwise.
 
     The pencil of a cluster can see one double root of it six times (an octahedral star
-    with bending planes 1e-6 apart, double roots 2.5e-7 apart): the piece around it
+    with bending planes 1e-6 apart, double roots 5e-7 apart): the piece around it
     cannot be halved where the count cannot decide, 1e-9 from the root."""
     if len(set(members)) != 1:
         return None

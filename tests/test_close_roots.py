@@ -218,3 +218,23 @@ def test_mode_shapes_of_a_turned_strut():
     np.testing.assert_allclose(modes.frequencies_hz[elastic], upright.frequencies_hz, rtol=1e-12)
     np.testing.assert_allclose(modes.modal_mass[elastic], 1.0, rtol=1e-9)
     assert modes.mass_orthogonality_error < 1e-8
+
+
+def test_a_copy_taken_from_a_multiple_root_leaves_it_the_others(monkeypatch):
+    """A root listed six times (three double roots 5e-9 apart that the list held as one)
+    whose pencil shows the highest beside it gives that root one copy and keeps five: its
+    multiplicity is recorded as five. Where no count had recorded one it was recorded as
+    one, and the later check of multiplicities took it for a simple root: an octahedral
+    star's 20 lowest (bending planes 1e-8 apart) came back with the highest double root
+    in place of the lowest one's second copy, 1e-8 high and without a note."""
+    from types import SimpleNamespace
+
+    from linmstmm.roots import clusters
+
+    root, beside = 10.0, 10.0 * (1 + 1e-8)
+    monkeypatch.setattr(clusters, "offsets_of", lambda finder, roots, copies: dict.fromkeys(roots))
+    monkeypatch.setattr(clusters, "beside", lambda finder, polished: [[beside] for _ in polished])
+    monkeypatch.setattr(clusters, "_holds_its_copies", lambda *arguments: False)  # the count beside it finds fewer
+    finder = SimpleNamespace(_counted={}, rtol=1e-9)
+    assert clusters._apart_by_offsets(finder, [root] * 6, {root: 6}) == [root] * 5 + [beside]
+    assert finder._counted[root] == 5

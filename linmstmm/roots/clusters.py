@@ -284,7 +284,7 @@ def _apart_by_offsets(finder, roots: list[float], copies: dict[float, int]) -> l
         for member in near:  # (each not a root found already)
             if split.count(r) > 1:
                 split.remove(r)
-            finder._counted[r] = max(finder._counted.get(r, 1) - 1, 1)
+            finder._counted[r] = max(finder._counted.get(r, copies[r]) - 1, 1)  # one copy fewer than it had
             split.append(member)
     return sorted(split)
 

@@ -29,16 +29,19 @@ FINAL_CARRIES = 4
 
 
 def left_to_the_lu(topology) -> frozenset:
-    """The elements (indices) whose orthonormalisation the stable carry leaves to the final
-    LU (:data:`FINAL_CARRIES`): the last ones of ``topology.order`` after its last beam, up
-    to FINAL_CARRIES + 1 of them; none for a model without boundary."""
+    """The elements (indices) whose orthonormalisation, made once an element is carried,
+    the stable carry leaves to the final LU (:data:`FINAL_CARRIES`): the last ones of
+    ``topology.order``, up to FINAL_CARRIES + 1 of them, back to the last beam (included:
+    its pieces are orthonormalised on the way, the one after them is not); none for a
+    model without boundary. The compiled program (:func:`linmstmm.program._walked`) and
+    the numpy carry (:meth:`linmstmm.deduction.Deduction._carry`) both take these."""
     if topology.root[0] != "boundary":
         return frozenset()
     left: set[int] = set()
     for e in reversed(topology.order):
+        left.add(e)
         if topology.elements[e].kind == "beam" or len(left) > FINAL_CARRIES:
             break
-        left.add(e)
     return frozenset(left)
 
 

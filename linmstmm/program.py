@@ -29,12 +29,11 @@ import numpy as np
 from linmstmm.compiled_walk import compiled_walk
 from linmstmm.deduction import Deduction
 from linmstmm.elements.beam import _state_rotation
-from linmstmm.godunov import FINAL_CARRIES
+from linmstmm.godunov import FINAL_CARRIES, left_to_the_lu
 from linmstmm.model_structure import KeptByKey
 from linmstmm.program_constants import Constants
 from linmstmm.program_record import (BEAM, CARRY, COMBINE, GEOMETRIC, JOINT, ORTHO, ROW_BLOCK, STATE_BLOCK, TIP,
                                      Program)
-
 
 
 class _Planner:
@@ -234,6 +233,7 @@ def _walked(plan: _Planner) -> tuple[list, int]:
     topology = deduction.topology
     elements = topology.elements
     root_given = topology.root if topology.root[0] == "boundary" else ("cut", topology.root[1], 0)
+    left = left_to_the_lu(topology)  # their orthonormalisations: layout only, the final LU does the rest
     # Blocks, each [slot, rows, forces, kind] (see Program.ortho_blocks), its slot rewritten when
     # an orthonormalisation widens it: the rows of Ū_all, the root's known side first; the
     # open states by element; the cut sides waiting to enter by (cut, side).
@@ -324,11 +324,11 @@ def _walked(plan: _Planner) -> tuple[list, int]:
             plan.place(plan.columns(other), union)
             rows.append([row, 6, -1, ROW_BLOCK])
         state = terms[0][0] if len(terms) == 1 else plan.combined(terms)
+        recorded = len(plan.orthos)
         open_states[e] = _state_block(orthonormalise(state))
-    root = open_states[topology.order[-1]][0]
-    if topology.root[0] == "boundary":
-        _leave_final_orthos_to_the_lu(plan)
-    return rows, root
+        if e in left and len(plan.orthos) > recorded:
+            plan.orthos[-1] = plan.orthos[-1][:4] + (1,)
+    return rows, open_states[topology.order[-1]][0]
 
 
 def _assembled(plan: _Planner, rows: list, root: int) -> Program:
@@ -466,18 +466,3 @@ def _joint(plan: _Planner, deduction: Deduction, e: int, state: int, rows: list)
     slot = plan.slot(12, deduction.jump_selection(e)[0])
     plan.emit(TIP, slot, jump)
     return slot
-
-
-def _leave_final_orthos_to_the_lu(plan: _Planner) -> None:
-    """Mark the orthonormalisations :data:`~linmstmm.godunov.FINAL_CARRIES` describes as layout
-    only (those :func:`~linmstmm.godunov.left_to_the_lu` leaves in the numpy carry)."""
-    carries = 0
-    for code, index, *_ in reversed(plan.operations):
-        if code == BEAM:
-            return
-        if code == CARRY:
-            carries += 1
-            if carries > FINAL_CARRIES:
-                return
-        if code == ORTHO:
-            plan.orthos[index] = plan.orthos[index][:4] + (1,)

@@ -48,7 +48,7 @@ from linmstmm.results import Result, decode_array, decode_arrays
 from linmstmm.sweep_runners import run_steps
 from linmstmm.topology import build_topology
 from linmstmm.tracking import SAME_MODE_MAC, length_scale, track
-from linmstmm.warm_starts import largest_difference, prediction_error, warm_starts
+from linmstmm.warm_starts import largest_difference, prediction_error, trend, warm_starts
 
 #: How every step evaluates det Ū_all unless told: "auto", resolved once in the calling
 #: process (:func:`_step_engine`), so that a step gives the same bits in this process, in a
@@ -177,7 +177,10 @@ class StepSolution:
     (m/√kg, rad/√kg). sensitivities : key -> (m,) ∂f/∂value, Hz per SI unit.
     note : what the solve had to say ("" if nothing).
     moved : largest relative change of the frequencies from those of the step it
-    started from (nan without one). prediction_error : largest relative error of the
+    started from (nan without one). previous_hz : (m',) the frequencies of that step
+    (None without one). trend_miss : largest relative difference of the frequencies
+    from those the step it started from extrapolated (:func:`~linmstmm.warm_starts.trend`;
+    nan where it could not). prediction_error : largest relative error of the
     coarse predictions (:func:`~linmstmm.coarse_prediction.predict_frequencies`) at
     the frequencies of the first step of its chain of warm starts (nan where not
     measured). The next step chooses its starts by both
@@ -190,6 +193,8 @@ class StepSolution:
     sensitivities: dict = field(default_factory=dict)
     note: str = ""
     moved: float = math.nan
+    previous_hz: np.ndarray | None = None
+    trend_miss: float = math.nan
     prediction_error: float = math.nan
 
 
@@ -230,7 +235,10 @@ def solve_step(model: Model, count: int, sensitivity_keys=(), engine: str = ENGI
     solution = _solved_step(model, count, sensitivity_keys, engine, warm_starts(start), with_shapes)
     found = solution.frequencies_hz
     if start is not None:
+        extrapolated = trend(start)
+        missed = math.nan if extrapolated is None else largest_difference(extrapolated, found)
         return replace(solution, moved=largest_difference(start.frequencies_hz, found),
+                       previous_hz=start.frequencies_hz, trend_miss=missed,
                        prediction_error=start.prediction_error)
     return replace(solution, prediction_error=prediction_error(model, count, found)) if chained else solution
 

@@ -363,3 +363,28 @@ def test_a_step_starts_from_its_neighbour_unless_the_last_move_outran_the_predic
         assert warm_starts(neighbour(moved, error)) is roots
     assert warm_starts(neighbour(1.1e-3, 1e-6)) is None
     assert warm_starts(neighbour(1e-2, 1e-3)) is roots and warm_starts(neighbour(4e-2, 1e-3)) is None
+
+
+def test_a_step_starts_from_its_neighbours_trend_where_that_missed_less_than_the_roots_moved():
+    """Where the neighbour's own start is known, its roots extrapolated along their last
+    move (2 f - f_before, rank by rank) start the step, provided the same extrapolation
+    missed the neighbour's roots by less than they moved and by no more than the square
+    root of the predictions' error, and the move is smaller than the closest relative
+    gap between the neighbour's roots (a veering pair may swap ranks within one move)."""
+    from linmstmm.sweep import StepSolution
+    from linmstmm.warm_starts import trend, warm_starts
+
+    roots, before = np.array([3.0, 4.0]), np.array([2.97, 3.96])
+
+    def neighbour(moved, missed, error=1e-6, found=roots):
+        return StepSolution(found, 0, np.zeros((2, 0, 6)), moved=moved, previous_hz=before,
+                            trend_miss=missed, prediction_error=error)
+
+    np.testing.assert_allclose(trend(neighbour(1e-2, 1e-4)), [3.03, 4.04])
+    np.testing.assert_allclose(warm_starts(neighbour(1e-2, 1e-4)), [3.03, 4.04])
+    assert warm_starts(neighbour(1e-2, 1.1e-3)) is None  # missed by more than √1e-6
+    assert warm_starts(neighbour(5e-4, 6e-4)) is roots  # the roots moved less than the trend missed
+    assert warm_starts(neighbour(1e-2, math.nan)) is None  # no miss measured: the old rule
+    assert warm_starts(neighbour(3e-2, 1e-4, found=np.array([3.0, 3.06]))) is None  # gap 2 % < move 3 %
+    assert trend(StepSolution(roots, 0, np.zeros((2, 0, 6)))) is None  # no step before
+    assert trend(neighbour(0.7, 1e-4, found=np.array([1.0, 4.0]))) is None  # 2 - 2.97 < 0

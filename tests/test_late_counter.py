@@ -55,3 +55,32 @@ def test_clusters_are_parted_by_the_late_counts(gap):
     np.testing.assert_allclose(got.frequencies_hz, counted.frequencies_hz, rtol=1e-10)
     assert got.evaluations < 150 * 10
     assert got.precision == "float64"
+
+
+@pytest.mark.parametrize("beams_per_arm", [3, 6])
+def test_roots_exactly_rtol_apart_at_a_loose_rtol_are_all_listed(beams_per_arm):
+    """Planes 2e-6 apart, so the members of a cluster lie 1e-6 apart, asked for at rtol
+    1e-6: a value may stand for two roots within rtol of it (listed twice). A root listed
+    twice was one root and another 0.95e-6 below it; the count tight about it found one,
+    the bisection within half the distance to the root below found that one only, and
+    the other copy was dropped: 17 or 19 roots came back with the note that only so many
+    exist. The 20 must each lie within rtol of a root of the one-beam star (to 1e-12: the
+    members on the edge of a count's window at ±rtol may be counted inside it)."""
+    got = natural_frequencies(beam_star(beams_per_arm, 2e-6), 20, rtol=1e-6)
+    counted = natural_frequencies(beam_star(1, 2e-6), 20, rtol=1e-12)  # a counter at every root
+    assert got.note == ""
+    np.testing.assert_allclose(got.frequencies_hz, counted.frequencies_hz, rtol=1e-6 + 1e-12)
+
+
+def test_a_search_that_loses_a_root_says_so(monkeypatch):
+    """Where a search for the 20 lowest ends with fewer and the count finds more below its
+    ceiling, it raises rather than list fewer with the note that only so many exist; a
+    search at a looser rtol is then made again at the default one (here the loss is
+    forced, at every rtol)."""
+    from linmstmm.roots import RootFinder
+
+    separated = RootFinder._separated_above_floor
+    monkeypatch.setattr(RootFinder, "_separated_above_floor", lambda self, roots: separated(self, roots)[:-1])
+    for rtol in (None, 1e-6):
+        with pytest.raises(RuntimeError, match="the search ended with 19 roots where the count finds"):
+            natural_frequencies(beam_star(1, 1e-3), 20, rtol=rtol)

@@ -14,7 +14,7 @@ from linmstmm.determinant import FREQUENCIES_ASSUMED
 from linmstmm.mode_bound import check_range_request, clamped_modes_below
 from linmstmm.model import Model
 from linmstmm.results import Result, decode_array
-from linmstmm.roots import CERTIFIED_STEP, MAX_XTOL, RootFinder, RootSearchResult
+from linmstmm.roots import CERTIFIED_STEP, MAX_XTOL, RootFinder, RootSearchResult, SearchAtDefaultRtol
 from linmstmm.stages import report
 from linmstmm.threads import single_blas_thread
 from linmstmm.wording import counted
@@ -277,24 +277,32 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
     deduction, finder, released = frequency_finder(model, root, engine=engine, frequencies=frequencies,
                                                    predicted=predicted, **accuracy)
     report("finding roots")
-    abandoned = 0  # evaluations of a search made again at the default accuracy
+    loose = rtol is not None and rtol > CERTIFIED_STEP
     try:
         search = _searched(finder, count, fmax, guess_hz)
-    except RuntimeError:
-        if rtol is None or rtol <= CERTIFIED_STEP:
+    except (RuntimeError, SearchAtDefaultRtol):
+        if not loose:
             raise
-        # A looser rtol asks for less work, not for an answer that cannot be certified: where
-        # the search at it cannot certify (a varied test model with stiffnesses 4e10 apart at
-        # rtol 1e-4: two secant values at extrema of det, 4e-4 from their roots, then no
-        # count by the argument principle), the search is made again at the default accuracy.
+        search = None
+    abandoned = 0  # evaluations of a search made again at the default accuracy
+    if loose and (search is None or search.unseparated or _uncertain(search, finder.rtol)):
+        # A looser rtol asks for less work, not for an answer that cannot be certified, nor
+        # for more: where the search at it cannot certify (a varied test model with
+        # stiffnesses 4e10 apart at rtol 1e-4: two secant values at extrema of det, 4e-4
+        # from their roots, then no count by the argument principle), reaches a stretch
+        # its counts cannot search (SearchAtDefaultRtol), or leaves roots to mpmath (an
+        # octahedral star, one beam an arm, whose cluster members lie 1e-7 apart at rtol
+        # 1e-7: a 4-fold root that did not settle in mpmath, where the default rtol parts
+        # them in float64 in 0.7 s), the search is made again at the default accuracy,
+        # and what that leaves goes to mpmath.
         report("searching again at the default accuracy")
-        abandoned = finder.determinant.evaluations
+        abandoned = finder.determinant.evaluations - finder._evaluations_reported if search is None \
+            else search.evaluations
         deduction, finder, released = frequency_finder(model, root, engine=engine, frequencies=frequencies,
                                                        predicted=predicted)
         search = _searched(finder, count, fmax, guess_hz)
     omegas, unseparated = search.roots, dict(search.unseparated)
-    # (a root no Newton step reached has a NaN step: it is in unseparated)
-    uncertain = sorted({w for w, step in search.last_steps.items() if step > finder.rtol} - set(unseparated))
+    uncertain = _uncertain(search, finder.rtol)
     every = bool(digits and digits > FLOAT64_DIGITS)
     wanted = digits if every else (ESCALATION_DIGITS if uncertain or unseparated else None)
     if not wanted:
@@ -307,6 +315,13 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
         unseparated, wanted, cut_by_count=count is not None)
     return RootSolution(deduction, finder, search, released, omegas, precision, text, omega_text, unseparated,
                         abandoned + search.evaluations + finder.determinant.evaluations - before)
+
+
+def _uncertain(search: RootSearchResult, rtol: float) -> list[float]:
+    """The roots (rad/s, ascending, distinct) of ``search`` float64 could not certify to
+    ``rtol`` (a last Newton step above it), but for those it could not part (its
+    ``unseparated``: a root no Newton step reached has a NaN step and is among them)."""
+    return sorted({w for w, step in search.last_steps.items() if step > rtol} - set(search.unseparated))
 
 
 def _searched(finder: RootFinder, count: int | None, fmax: float | None, guess_hz) -> RootSearchResult:

@@ -84,3 +84,25 @@ def test_a_search_that_loses_a_root_says_so(monkeypatch):
     for rtol in (None, 1e-6):
         with pytest.raises(RuntimeError, match="the search ended with 19 roots where the count finds"):
             natural_frequencies(beam_star(1, 1e-3), 20, rtol=rtol)
+
+
+def test_clusters_exactly_rtol_apart_are_parted_in_float64():
+    """One beam an arm, planes 2e-7 apart (cluster members 1e-7 apart), at rtol 1e-7: the
+    search at that rtol left a 4-fold value to mpmath, where it did not settle (an
+    UnsettledRoot error after 9 s), while the default rtol parts the cluster in float64.
+    A loose-rtol search that leaves roots to mpmath is made again at the default rtol."""
+    got = natural_frequencies(beam_star(1, 2e-7), 20, rtol=1e-7)
+    counted = natural_frequencies(beam_star(1, 2e-7), 20, rtol=1e-12)
+    assert got.precision == "float64" and got.note == ""
+    np.testing.assert_allclose(got.frequencies_hz, counted.frequencies_hz, rtol=1e-7)
+
+
+def test_a_stretch_the_counts_cannot_search_at_a_loose_rtol_is_searched_at_the_default():
+    """Three beams an arm, planes 2e-5 apart, at rtol 1e-5 (cluster members 1e-5 apart): the
+    counted search of a stretch whose ends lie on roots cannot move them off at a loose
+    rtol, and the argument-principle search of that stretch took 18,675 evaluations of
+    det; the search is now made again at the default rtol, whose counts move the ends."""
+    got = natural_frequencies(beam_star(3, 2e-5), 20, rtol=1e-5)
+    counted = natural_frequencies(beam_star(1, 2e-5), 20, rtol=1e-12)
+    np.testing.assert_allclose(got.frequencies_hz, counted.frequencies_hz, rtol=1e-5 + 1e-12)
+    assert got.evaluations < 8000

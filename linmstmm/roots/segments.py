@@ -105,12 +105,24 @@ def _root_count(finder, lo: float, hi: float) -> int:
     return count_zeros(finder.log_det, lo, hi) if counted is None else counted
 
 
+class SearchAtDefaultRtol(Exception):
+    """A search at an rtol looser than the default reached a stretch of roots its
+    Wittrick–Williams counts cannot search (:func:`segment`): the caller makes the whole
+    search again at the default rtol (:func:`linmstmm.solve.solve_roots`). Not a
+    RuntimeError, which the steps of a search catch to try another way: the
+    argument-principle search of such a stretch took up to 60,000 evaluations of det on
+    clustered roots, where the default rtol's counts, whose ends move off the roots
+    (:mod:`~linmstmm.roots.counted_search`), searched it in a few thousand."""
+
+
 def segment(finder, lo: float, hi: float, expected: int | None = None) -> list[float]:
     """Every root in (lo, hi], rad/s, ascending, repeated per multiplicity.
 
     By Wittrick–Williams counts where they decide
     (:func:`~linmstmm.roots.counted_search.counted_segment`: bisection on the
-    count, each root from its sign change) and agree with ``expected``. Else the
+    count, each root from its sign change) and agree with ``expected``; where they
+    do not and the finder certifies to a looser rtol than the default, it raises
+    :class:`SearchAtDefaultRtol`. Else the
     argument-principle count says how many there are; a scan with at
     least ``points_per_root`` points per counted root finds them; bisection
     on the count finds any the scan missed. A segment wider than
@@ -120,6 +132,8 @@ def segment(finder, lo: float, hi: float, expected: int | None = None) -> list[f
     counted = counted_segment(finder, lo, hi)
     if counted is not None and (expected is None or len(counted) == expected):
         return counted
+    if not finder.fine_rtol and finder.counter is not None:
+        raise SearchAtDefaultRtol(f"the counts cannot search ({lo:.12g}, {hi:.12g}] rad/s at rtol {finder.rtol:g}")
     if expected is None:
         expected = count_zeros(finder.log_det, lo, hi)
     if expected == 0:

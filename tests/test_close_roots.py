@@ -238,3 +238,24 @@ def test_a_copy_taken_from_a_multiple_root_leaves_it_the_others(monkeypatch):
     finder = SimpleNamespace(_counted={}, rtol=1e-9)
     assert clusters._apart_by_offsets(finder, [root] * 6, {root: 6}) == [root] * 5 + [beside]
     assert finder._counted[root] == 5
+
+
+def test_a_cluster_whose_copies_lie_beyond_the_circle_is_found_again_by_its_count():
+    """A list that holds a cluster's middle member twice and its upper one not at all
+    (three roots 4.8e-6 apart on an octahedral star of one beam an arm, bending planes
+    1e-5 apart): the circle about the doubled root, half the distance to the lowest, holds
+    one root, and the second copy was dropped (or, at the default rtol, the search for an
+    octahedral star's 22 lowest with its planes 1e-8 apart came back with 21, the 21st
+    5e-9 off). The cluster is found again by bisection on the count of the stretch SPLIT
+    beyond its members: all three, within the default rtol of those the search finds."""
+    from linmstmm.builders import beam_star
+    from linmstmm.roots import clusters
+    from linmstmm.solve import frequency_finder
+
+    model = beam_star(1, 1e-5)
+    true = frequency_finder(model)[1].find(12, None).roots
+    _, finder, _ = frequency_finder(model)
+    doubled = [true[0], true[1], true[1], *true[3:]]
+    placed, replaced = clusters._cluster_isolated(finder, doubled, true[1])
+    assert replaced == {true[0], true[1]}
+    np.testing.assert_allclose(sorted(placed), true, rtol=1e-9)

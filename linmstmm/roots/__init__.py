@@ -45,6 +45,7 @@ through the finder:
 * :mod:`~linmstmm.roots.clusters` — clusters of close roots, multiplicities;
 * :mod:`~linmstmm.roots.certify` — argument-principle counts that certify;
 * :mod:`~linmstmm.roots.floor` — nothing hides below the floor;
+* :mod:`~linmstmm.roots.top_count` — the list at the end against the count at its top;
 * :mod:`~linmstmm.roots.settings` — scan densities, limits, frequency ratios;
 * :mod:`~linmstmm.roots.result` — the frozen result of a search.
 """

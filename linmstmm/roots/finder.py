@@ -9,7 +9,7 @@ import numpy as np
 from linmstmm.counting import deflated
 from linmstmm.predicted import predicted_roots
 from linmstmm.rayleigh import AS_PREDICTED_FROM, PREDICTED_TO, refined_predictions
-from linmstmm.roots import brackets, certify, fast_path, floor, pencil, segments
+from linmstmm.roots import brackets, certify, fast_path, floor, pencil, segments, top_count
 from linmstmm.roots import clusters as close_roots
 from linmstmm.roots.result import RootSearchResult, search_result
 from linmstmm.roots.settings import (
@@ -231,18 +231,6 @@ class RootFinder:
         at rtol 1e-4, and it was taken twice)."""
         return max(self.SAME_ROOT, self.xtol)
 
-    def _check_fewer(self, found: int) -> None:
-        """Raise RuntimeError where a search for more roots than ``found`` ended with them
-        and the Wittrick–Williams count finds more below the ceiling: a root the search
-        lost (an octahedral star, planes 2e-6 apart, once came back with 19 of its 20
-        lowest at rtol 1e-6, "only 19 exist"). The count is made by the late counter where
-        the model has no other (:meth:`counter_for_stretch`); without either it stands."""
-        self.counter_for_stretch()
-        total = self.stiffness_count([], None, self.ceiling)
-        if total is not None and total > found:
-            raise RuntimeError(f"the search ended with {found} roots where the count finds {total} "
-                               f"below {self.ceiling:.3g} rad/s")
-
     def _existing(self, count: int) -> int | None:
         """How many of ``count`` elastic roots exist below the ceiling where the
         Wittrick–Williams count says fewer do (the model has fewer than ``count``
@@ -309,8 +297,8 @@ class RootFinder:
         """
         self.note = ""
         found = self._found(count, omega_max)
-        if count is not None and omega_max is None and len(found) < count:
-            self._check_fewer(len(found))
+        if count is not None and omega_max is None:
+            self._check_listed(found, count)
         return self._search_result(self._placed_by_counts(found))
 
     def _found(self, count: int | None, omega_max: float | None) -> list[float]:
@@ -390,6 +378,9 @@ class RootFinder:
     _lowest = segments.lowest
     _next_top = staticmethod(segments.next_top)
     _search = segments.search
+
+    # the list at its end against the count at its top (:mod:`linmstmm.roots.top_count`)
+    _check_listed = top_count.check_listed
 
     # certification by counts: Wittrick–Williams, else the argument principle (:mod:`linmstmm.roots.certify`)
     _confirmed = certify.confirmed

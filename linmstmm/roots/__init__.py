@@ -78,7 +78,7 @@ from linmstmm.roots.settings import (
                                      SCAN_OCTAVES,
 )
 
-__all__ = ["RootFinder", "RootSearchResult", "SearchAtDefaultRtol", "CEILING_RATIO", "CERTIFIED_STEP", "CIRCLE_MAX_POINTS", "CIRCLE_POINTS",
-           "DEFAULT_SCALE", "DEFLATED_MAX_POINTS", "DEFLATED_POINTS", "FINE_SCAN_RATIO", "FIRST_CHUNK_RATIO",
+__all__ = ["RootFinder", "RootSearchResult", "SearchAtDefaultRtol", "CEILING_RATIO", "CERTIFIED_STEP",
+           "CIRCLE_MAX_POINTS", "CIRCLE_POINTS", "DEFAULT_SCALE", "DEFLATED_MAX_POINTS", "DEFLATED_POINTS", "FINE_SCAN_RATIO", "FIRST_CHUNK_RATIO",
            "FIRST_SEGMENT_RATIO", "FLOOR_CHECK", "FLOOR_MARGIN", "FLOOR_RATIO", "MAX_RTOL", "MAX_XTOL", "MIN_RTOL", "MIN_POINTS_PER_OCTAVE",
            "POINTS_PER_OCTAVE", "PREDICTION_MARGIN", "SCAN_OCTAVES"]

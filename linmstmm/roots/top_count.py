@@ -25,11 +25,12 @@ def check_listed(finder, found: list[float], count: int) -> None:
     a counter already made, across the highest value r listed k times among n: the count
     just above r must find at least n (none listed that is not there; a list may end
     inside a multiple root, so more is fine), and the count just below r at most n − k
-    (none missing below it). Each count is made at the narrowest width at which it decides,
-    from the finder's rtol up (:func:`~linmstmm.roots.certify.near_widths`: a value at a
-    loose rtol may stand that far from its root). Not checked across a value float64 could not place (its last step above
-    the finder's rtol, or one of :attr:`~linmstmm.roots.RootFinder.unseparated`), which
-    is refined or named after the search."""
+    (none missing below it). Each count is made at the narrowest width at which it
+    decides, from the finder's rtol up (:func:`~linmstmm.roots.certify.near_widths`: a
+    value at a loose rtol may stand that far from its root). Not checked across a value
+    float64 could not place (its last step above the finder's rtol, or one of
+    :attr:`~linmstmm.roots.RootFinder.unseparated`), which is refined or named after the
+    search."""
     if len(found) < count:
         _check_fewer(finder, len(found))
         return

@@ -382,7 +382,7 @@ def mode_shapes(model: Model, count: int | None = 10, *, fmax: float | None = No
     elastic = sum(m for _, m in eigenspaces)
     kept = {w for w, _ in eigenspaces}
     note = search_note(solution.search, elastic, {w: v for w, v in solution.unseparated.items() if w in kept},
-                       count, fmax)
+                       count, fmax, solution.fallback)
     if rigid_body and (rigid := solution.search.rigid_body_modes):
         eigenspaces.insert(0, (0.0, rigid))
     if not eigenspaces:

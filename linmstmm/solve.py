@@ -212,6 +212,10 @@ class RootSolution:
         float64 nor mpmath could separate.
     evaluations : int
         Float64 evaluations of det Ū_all the search and the mpmath refinement took.
+    fallback : str
+        Where a search at an rtol finer than the default could not be certified and the
+        default search's roots stand instead: why, and that they are certified to the
+        default rtol only ("" otherwise).
     """
 
     deduction: Deduction
@@ -224,6 +228,7 @@ class RootSolution:
     omegas_text: list | None = None
     unseparated: dict = field(default_factory=dict)
     evaluations: int = 0
+    fallback: str = ""
 
 
 def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None, *, digits: int | None = None,
@@ -278,12 +283,16 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
                                                    predicted=predicted, **accuracy)
     report("finding roots")
     loose = rtol is not None and rtol > CERTIFIED_STEP
+    fallback = ""  # why a finer rtol's search gave way to the default's
     try:
         search = _searched(finder, count, fmax, guess_hz)
-    except (RuntimeError, SearchAtDefaultRtol):
+    except (RuntimeError, SearchAtDefaultRtol) as error:
         if rtol is None or rtol == CERTIFIED_STEP:
             raise
         search = None
+        if not loose:
+            fallback = (f"the search at rtol {rtol:g} could not be certified ({error}): these frequencies are "
+                        f"certified to the default rtol {CERTIFIED_STEP:g} only")
     abandoned = 0  # evaluations of a search made again at the default accuracy
     if search is None or (loose and (search.unseparated or _uncertain(search, finder.rtol))):
         # A looser rtol asks for less work, not for an answer that cannot be certified, nor
@@ -296,8 +305,9 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
         # them in float64 in 0.7 s), the search is made again at the default accuracy,
         # and what that leaves goes to mpmath. So is a search at a finer rtol that fails
         # (an octahedral star, one beam an arm, planes 1e-6 apart, at rtol 1e-12: 8 values
-        # listed in a cluster of six roots, which the count at its top caught), its roots
-        # then sent to mpmath where their last step is above the rtol asked for.
+        # listed in a cluster of six roots, which the count at its top caught); the result
+        # then says it is certified to the default rtol only (the default search may list
+        # a pair 5e-11 apart as one double value, which rtol 1e-12 would part).
         report("searching again at the default accuracy")
         abandoned = finder.determinant.evaluations - finder._evaluations_reported if search is None \
             else search.evaluations
@@ -305,19 +315,19 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
                                                        predicted=predicted)
         search = _searched(finder, count, fmax, guess_hz)
     omegas, unseparated = search.roots, dict(search.unseparated)
-    uncertain = _uncertain(search, finder.rtol if rtol is None else rtol)
+    uncertain = _uncertain(search, finder.rtol if rtol is None or fallback else rtol)
     every = bool(digits and digits > FLOAT64_DIGITS)
     wanted = digits if every else (ESCALATION_DIGITS if uncertain or unseparated else None)
     if not wanted:
         return RootSolution(deduction, finder, search, released, omegas, unseparated=unseparated,
-                            evaluations=abandoned + search.evaluations)
+                            evaluations=abandoned + search.evaluations, fallback=fallback)
     report(f"refining in mpmath to {wanted} digits")
     before = finder.determinant.evaluations
     omegas, precision, text, omega_text = _refined_in_mpmath(
         deduction, model, finder, omegas, [w for w in omegas if w not in unseparated and (every or w in uncertain)],
         unseparated, wanted, cut_by_count=count is not None)
     return RootSolution(deduction, finder, search, released, omegas, precision, text, omega_text, unseparated,
-                        abandoned + search.evaluations + finder.determinant.evaluations - before)
+                        abandoned + search.evaluations + finder.determinant.evaluations - before, fallback)
 
 
 def _uncertain(search: RootSearchResult, rtol: float) -> list[float]:
@@ -399,7 +409,7 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
     solution = solve_roots(model, count, fmax, digits=digits, root=root, guess_hz=guess_hz, engine=engine,
                            rtol=rtol)
     search, omegas = solution.search, solution.omegas
-    note = search_note(search, omegas.size, solution.unseparated, count, fmax)
+    note = search_note(search, omegas.size, solution.unseparated, count, fmax, solution.fallback)
     return FrequencyResult(model.name, omegas / (2 * np.pi), search.rigid_body_modes,
                            solution.deduction.full_order, time.perf_counter() - start,
                            precision=solution.precision, note=note, indeterminate_released=solution.released,
@@ -407,12 +417,14 @@ def natural_frequencies(model: Model, count: int | None = 10, fmax: float | None
                            evaluations=solution.evaluations, engine=solution.finder.determinant.engine)
 
 
-def search_note(search: RootSearchResult, found: int, unseparated, count: int | None, fmax: float | None) -> str:
+def search_note(search: RootSearchResult, found: int, unseparated, count: int | None, fmax: float | None,
+                fallback: str = "") -> str:
     """What a result of ``found`` elastic roots, asked for by ``count`` and/or ``fmax``,
     must say about the ``search`` that found them ("" if nothing): each cluster float64
     could not separate (``unseparated``: root rad/s -> (multiplicity, radius rad/s)), a
-    search that stopped short of what was asked (:attr:`RootSearchResult.note`), or that
-    fewer than ``count`` exist (below :attr:`RootSearchResult.ceiling`)."""
+    search that stopped short of what was asked (:attr:`RootSearchResult.note`), that
+    fewer than ``count`` exist (below :attr:`RootSearchResult.ceiling`), and the
+    ``fallback`` of :class:`RootSolution` (a finer rtol not certified)."""
     notes = [(f"float64 could not tell {m} roots within ±{radius / (2 * np.pi):.3g} Hz of {w / (2 * np.pi):.10g} Hz "
               "apart (a cluster, or a multiple root it could not confirm): they are reported together there")
              if m > 1 else
@@ -426,7 +438,7 @@ def search_note(search: RootSearchResult, found: int, unseparated, count: int | 
     elif fewer and fmax is None:
         notes.append(f"only {counted(found, 'elastic natural frequency exists', 'elastic natural frequencies exist')} "
                      f"below {search.ceiling:.3g} rad/s")
-    return "; ".join(notes)
+    return "; ".join(notes + [fallback] if fallback else notes)
 
 
 def _refined_in_mpmath(deduction, model, finder, omegas, chosen, unseparated, digits, cut_by_count):

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import functools
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -213,9 +213,9 @@ class RootSolution:
     evaluations : int
         Float64 evaluations of det Ū_all the search and the mpmath refinement took.
     fallback : str
-        Where a search at an rtol finer than the default could not be certified and the
-        default search's roots stand instead: why, and that they are certified to the
-        default rtol only ("" otherwise).
+        Where a search at an rtol finer than the default could not be certified, or its
+        roots not refined in mpmath, and the default search's roots stand instead: why,
+        and that they are certified to the default rtol only ("" otherwise).
     """
 
     deduction: Deduction
@@ -323,9 +323,18 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
                             evaluations=abandoned + search.evaluations, fallback=fallback)
     report(f"refining in mpmath to {wanted} digits")
     before = finder.determinant.evaluations
-    omegas, precision, text, omega_text = _refined_in_mpmath(
-        deduction, model, finder, omegas, [w for w in omegas if w not in unseparated and (every or w in uncertain)],
-        unseparated, wanted, cut_by_count=count is not None)
+    try:
+        omegas, precision, text, omega_text = _refined_in_mpmath(
+            deduction, model, finder, omegas, [w for w in omegas if w not in unseparated and (every or w in uncertain)],
+            unseparated, wanted, cut_by_count=count is not None)
+    except RuntimeError as error:  # a finer rtol's refinement that does not settle: the default's roots
+        if rtol is None or rtol >= CERTIFIED_STEP or fallback:
+            raise
+        spent = abandoned + search.evaluations + finder.determinant.evaluations - before
+        solution = solve_roots(model, count, fmax, root=root, guess_hz=guess_hz, engine=engine)
+        return replace(solution, evaluations=spent + solution.evaluations, fallback=(
+            f"the roots at rtol {rtol:g} could not be refined in mpmath ({error}): these frequencies are "
+            f"certified to the default rtol {CERTIFIED_STEP:g} only"))
     return RootSolution(deduction, finder, search, released, omegas, precision, text, omega_text, unseparated,
                         abandoned + search.evaluations + finder.determinant.evaluations - before, fallback)
 

@@ -64,3 +64,13 @@ def test_a_star_whose_cluster_a_fine_rtol_listed_wrong_says_what_it_certifies():
     fe = fe_frequencies(star, 30)
     assert fe.error_estimate.max() < 1e-9
     np.testing.assert_allclose(got.frequencies_hz, fe.frequencies_hz, rtol=3e-9)
+
+
+def test_a_fine_rtol_whose_mpmath_refinement_does_not_settle_says_what_it_certifies():
+    """One beam an arm, planes 2e-7 apart, 30 lowest at rtol 1e-12: a member of a cluster of
+    double roots 1e-7 apart did not settle in mpmath, and the solve raised. The default
+    search's roots stand instead, with the note that they are certified to it only."""
+    star = beam_star(1, 2e-7)
+    got = natural_frequencies(star, 30, rtol=1e-12, engine="compiled")
+    assert "could not be refined in mpmath" in got.note and "certified to the default rtol 1e-09 only" in got.note
+    np.testing.assert_array_equal(got.frequencies_hz, natural_frequencies(star, 30, engine="compiled").frequencies_hz)

@@ -283,18 +283,18 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
                                                    predicted=predicted, **accuracy)
     report("finding roots")
     loose = rtol is not None and rtol > CERTIFIED_STEP
-    fallback = ""  # why a finer rtol's search gave way to the default's
     try:
         search = _searched(finder, count, fmax, guess_hz)
     except (RuntimeError, SearchAtDefaultRtol) as error:
         if rtol is None or rtol == CERTIFIED_STEP:
             raise
+        if not loose:  # (an octahedral star, planes 1e-6 apart, at rtol 1e-12: the count at its top caught it)
+            return _at_default_rtol(model, count, fmax, root, guess_hz, engine,
+                                    finder.determinant.evaluations - finder._evaluations_reported,
+                                    f"the search at rtol {rtol:g} could not be certified ({error})")
         search = None
-        if not loose:
-            fallback = (f"the search at rtol {rtol:g} could not be certified ({error}): these frequencies are "
-                        f"certified to the default rtol {CERTIFIED_STEP:g} only")
     abandoned = 0  # evaluations of a search made again at the default accuracy
-    if search is None or (loose and (search.unseparated or _uncertain(search, finder.rtol))):
+    if loose and (search is None or search.unseparated or _uncertain(search, finder.rtol)):
         # A looser rtol asks for less work, not for an answer that cannot be certified, nor
         # for more: where the search at it cannot certify (a varied test model with
         # stiffnesses 4e10 apart at rtol 1e-4: two secant values at extrema of det, 4e-4
@@ -303,11 +303,7 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
         # octahedral star, one beam an arm, whose cluster members lie 1e-7 apart at rtol
         # 1e-7: a 4-fold root that did not settle in mpmath, where the default rtol parts
         # them in float64 in 0.7 s), the search is made again at the default accuracy,
-        # and what that leaves goes to mpmath. So is a search at a finer rtol that fails
-        # (an octahedral star, one beam an arm, planes 1e-6 apart, at rtol 1e-12: 8 values
-        # listed in a cluster of six roots, which the count at its top caught); the result
-        # then says it is certified to the default rtol only (the default search may list
-        # a pair 5e-11 apart as one double value, which rtol 1e-12 would part).
+        # and what that leaves goes to mpmath.
         report("searching again at the default accuracy")
         abandoned = finder.determinant.evaluations - finder._evaluations_reported if search is None \
             else search.evaluations
@@ -315,28 +311,39 @@ def solve_roots(model: Model, count: int | None = 10, fmax: float | None = None,
                                                        predicted=predicted)
         search = _searched(finder, count, fmax, guess_hz)
     omegas, unseparated = search.roots, dict(search.unseparated)
-    uncertain = _uncertain(search, finder.rtol if rtol is None or fallback else rtol)
+    uncertain = _uncertain(search, finder.rtol if rtol is None else rtol)
     every = bool(digits and digits > FLOAT64_DIGITS)
     wanted = digits if every else (ESCALATION_DIGITS if uncertain or unseparated else None)
     if not wanted:
         return RootSolution(deduction, finder, search, released, omegas, unseparated=unseparated,
-                            evaluations=abandoned + search.evaluations, fallback=fallback)
+                            evaluations=abandoned + search.evaluations)
     report(f"refining in mpmath to {wanted} digits")
     before = finder.determinant.evaluations
     try:
         omegas, precision, text, omega_text = _refined_in_mpmath(
             deduction, model, finder, omegas, [w for w in omegas if w not in unseparated and (every or w in uncertain)],
             unseparated, wanted, cut_by_count=count is not None)
-    except RuntimeError as error:  # a finer rtol's refinement that does not settle: the default's roots
-        if rtol is None or rtol >= CERTIFIED_STEP or fallback:
+    except RuntimeError as error:  # (a cluster of double roots 1e-7 apart at rtol 1e-12)
+        if rtol is None or rtol >= CERTIFIED_STEP:
             raise
-        spent = abandoned + search.evaluations + finder.determinant.evaluations - before
-        solution = solve_roots(model, count, fmax, root=root, guess_hz=guess_hz, engine=engine)
-        return replace(solution, evaluations=spent + solution.evaluations, fallback=(
-            f"the roots at rtol {rtol:g} could not be refined in mpmath ({error}): these frequencies are "
-            f"certified to the default rtol {CERTIFIED_STEP:g} only"))
+        return _at_default_rtol(model, count, fmax, root, guess_hz, engine,
+                                abandoned + search.evaluations + finder.determinant.evaluations - before,
+                                f"the roots at rtol {rtol:g} could not be refined in mpmath ({error})")
     return RootSolution(deduction, finder, search, released, omegas, precision, text, omega_text, unseparated,
-                        abandoned + search.evaluations + finder.determinant.evaluations - before, fallback)
+                        abandoned + search.evaluations + finder.determinant.evaluations - before)
+
+
+def _at_default_rtol(model: Model, count, fmax, root, guess_hz, engine: str, spent: int, why: str) -> RootSolution:
+    """:func:`solve_roots` at the default rtol, where a solve at a finer rtol could not be
+    certified (``why``) after ``spent`` evaluations of det: its roots, with a
+    :attr:`RootSolution.fallback` that says they are certified to the default rtol only.
+    The default search may list a pair 5e-11 apart as one double value, which rtol 1e-12
+    would part: an octahedral star came back 52 rtol off at rtol 1e-12 where its roots
+    were refined in mpmath without saying so."""
+    report("searching again at the default accuracy")
+    solution = solve_roots(model, count, fmax, root=root, guess_hz=guess_hz, engine=engine)
+    return replace(solution, evaluations=spent + solution.evaluations,
+                   fallback=f"{why}: these frequencies are certified to the default rtol {CERTIFIED_STEP:g} only")
 
 
 def _uncertain(search: RootSearchResult, rtol: float) -> list[float]:
